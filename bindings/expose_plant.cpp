@@ -1,0 +1,123 @@
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "servohydraulics/plant.hpp"
+
+namespace py = pybind11;
+using namespace servohydraulics;
+
+void expose_plant(py::module_& m) {
+  py::enum_<ControlMode>(m, "ControlMode")
+      .value("Displacement", ControlMode::Displacement)
+      .value("Force", ControlMode::Force)
+      .value("Free", ControlMode::Free);
+
+  py::class_<Output>(m, "Output")
+      .def(py::init<>())
+      .def_readonly("t", &Output::t)
+      .def_readonly("displacement", &Output::displacement)
+      .def_readonly("velocity", &Output::velocity)
+      .def_readonly("acceleration", &Output::acceleration)
+      .def_readonly("force", &Output::force)
+      .def_readonly("pressure", &Output::pressure)
+      .def_readonly("spool", &Output::spool)
+      .def_readonly("drive", &Output::drive)
+      .def_readonly("flow", &Output::flow)
+      .def_readonly("flags", &Output::flags);
+
+  m.attr("FLAG_CAPACITY_EXCEEDED") = static_cast<unsigned>(kCapacityExceeded);
+  m.attr("FLAG_SUPPLY_LIMITED") = static_cast<unsigned>(kSupplyLimited);
+  m.attr("FLAG_SPOOL_SATURATED") = static_cast<unsigned>(kSpoolSaturated);
+  m.attr("FLAG_DRIVE_SATURATED") = static_cast<unsigned>(kDriveSaturated);
+
+  py::class_<SolverOptions> so(m, "SolverOptions");
+  py::enum_<SolverOptions::Method>(so, "Method")
+      .value("CvodeBdf", SolverOptions::Method::CvodeBdf)
+      .value("Rk4", SolverOptions::Method::Rk4);
+  py::enum_<SolverOptions::Restart>(so, "Restart")
+      .value("OnInputChange", SolverOptions::Restart::OnInputChange)
+      .value("Never", SolverOptions::Restart::Never);
+  so.def(py::init<>())
+      .def_readwrite("method", &SolverOptions::method)
+      .def_readwrite("restart", &SolverOptions::restart)
+      .def_readwrite("rtol", &SolverOptions::rtol)
+      .def_readwrite("atol_scale", &SolverOptions::atol_scale)
+      .def_readwrite("max_order", &SolverOptions::max_order)
+      .def_readwrite("max_steps_per_sample", &SolverOptions::max_steps_per_sample)
+      .def_readwrite("max_internal_step", &SolverOptions::max_internal_step)
+      .def_readwrite("rk4_substeps", &SolverOptions::rk4_substeps)
+      .def("validate", &SolverOptions::validate);
+
+  py::class_<Status> st(m, "Status");
+  py::enum_<Status::Code>(st, "Code")
+      .value("Ok", Status::Ok)
+      .value("SolverFailure", Status::SolverFailure)
+      .value("TooMuchWork", Status::TooMuchWork)
+      .value("NonFinite", Status::NonFinite)
+      .value("NotReady", Status::NotReady);
+  st.def_readonly("code", &Status::code)
+      .def_readonly("cvode_flag", &Status::cvode_flag)
+      .def_readonly("t", &Status::t)
+      .def_readonly("internal_steps", &Status::internal_steps)
+      .def_readonly("rhs_evals", &Status::rhs_evals)
+      .def_readonly("restarted", &Status::restarted)
+      .def("ok", &Status::ok)
+      .def_property_readonly("message", &Status::message);
+
+  py::class_<Dynamics>(m, "Dynamics", "Right-hand side, analytic Jacobian and outputs of the plant")
+      .def(py::init<const Rig&, ControlMode>(), py::arg("rig"), py::arg("mode"))
+      .def("rhs",
+           [](const Dynamics& d, const State& y, double u, double u_rate) {
+             State yd;
+             d.rhs(y.data(), {u, u_rate}, yd.data());
+             return yd;
+           },
+           py::arg("y"), py::arg("u"), py::arg("u_rate") = 0.0)
+      .def("jacobian",
+           [](const Dynamics& d, const State& y, double u, double u_rate) {
+             Jacobian J;
+             d.jacobian(y.data(), {u, u_rate}, J);
+             return J;
+           },
+           py::arg("y"), py::arg("u"), py::arg("u_rate") = 0.0)
+      .def("outputs",
+           [](const Dynamics& d, const State& y, double u) {
+             Output o;
+             d.outputs(y.data(), {u, 0.0}, o);
+             return o;
+           },
+           py::arg("y"), py::arg("u"))
+      .def("equilibrium", &Dynamics::equilibrium, py::arg("x0"))
+      .def("spring_force", &Dynamics::spring_force)
+      .def("friction_force", &Dynamics::friction_force)
+      .def("flow_gain", &Dynamics::flow_gain)
+      .def("pressure_factor", &Dynamics::pressure_factor)
+      .def_property_readonly("moving_mass", &Dynamics::moving_mass)
+      .def_property_readonly("mode", &Dynamics::mode);
+
+  py::class_<Plant>(m, "Plant", "The plant stepped at the controller rate (CVODE between samples)")
+      .def(py::init<const Rig&, ControlMode, double, const SolverOptions&>(), py::arg("rig"), py::arg("mode"),
+           py::arg("dt"), py::arg("options") = SolverOptions{})
+      .def("reset", &Plant::reset, py::arg("x0") = 0.0, py::arg("t0") = 0.0)
+      .def("reset_state", &Plant::reset_state, py::arg("y0"), py::arg("t0") = 0.0)
+      .def("step",
+           [](Plant& p, double u) {
+             Output o;
+             Status s = p.step(u, o);
+             return py::make_tuple(s, o);
+           },
+           py::arg("command"))
+      .def("observe",
+           [](const Plant& p) {
+             Output o;
+             p.observe(o);
+             return o;
+           })
+      .def_property_readonly("time", &Plant::time)
+      .def_property_readonly("dt", &Plant::dt)
+      .def_property_readonly("state", &Plant::state)
+      .def_property_readonly("dynamics", &Plant::dynamics, py::return_value_policy::reference_internal)
+      .def_property_readonly("total_internal_steps", &Plant::total_internal_steps)
+      .def_property_readonly("total_rhs_evals", &Plant::total_rhs_evals)
+      .def_property_readonly("total_restarts", &Plant::total_restarts);
+}

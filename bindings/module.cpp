@@ -1,0 +1,21 @@
+// pybind11 module servohydraulics._core: one expose_<topic>.cpp per core header.
+#include <pybind11/pybind11.h>
+
+#include "servohydraulics/error.hpp"
+
+namespace py = pybind11;
+
+void expose_rig(py::module_& m);
+void expose_plant(py::module_& m);
+void expose_record(py::module_& m);
+void expose_linearize(py::module_& m);
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "C++ core of servohydraulics (SUNDIALS CVODE, Eigen)";
+  // Bad input is a ValueError that names the field and the value.
+  py::register_exception<servohydraulics::Error>(m, "ServoHydraulicsError", PyExc_ValueError);
+  expose_rig(m);
+  expose_plant(m);
+  expose_record(m);
+  expose_linearize(m);
+}

@@ -1,0 +1,60 @@
+// Whole-record runs: a command array in, every channel out, one controller
+// sample per element.  Row k of the result is the state at t_k = t0 + k dt,
+// measured before command[k] is applied (the convention of a lab record:
+// the controller reads the sensors, then writes the command it holds for the
+// next sample).  The last command is therefore held but not seen.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "servohydraulics/plant.hpp"
+
+namespace servohydraulics {
+
+//! Destination arrays of a run, each of length n (or nullptr to skip a channel).
+struct Channels {
+  double* time = nullptr;
+  double* displacement = nullptr;
+  double* velocity = nullptr;
+  double* acceleration = nullptr;
+  double* force = nullptr;
+  double* pressure = nullptr;
+  double* spool = nullptr;
+  double* drive = nullptr;
+  double* flow = nullptr;
+  std::uint32_t* flags = nullptr;
+  int* internal_steps = nullptr;  //!< CVODE internal steps of the sample that starts at row k
+  int* rhs_evals = nullptr;
+};
+
+//! What a run did.
+struct RunSummary {
+  Status status;                  //!< the first failure, or Ok
+  std::size_t rows = 0;           //!< rows written (n on success)
+  long internal_steps = 0;        //!< CVODE internal steps in the run
+  long rhs_evals = 0;             //!< right-hand-side evaluations in the run
+  long restarts = 0;              //!< CVodeReInit calls in the run
+  int max_internal_steps = 0;     //!< the largest number in one sample
+  std::uint32_t flags_any = 0;    //!< OR of every row's OutputFlag bits
+  double peak_force = 0.0;        //!< max |load-cell force| [N]
+  double first_capacity_time = -1.0;  //!< first time |force| > F_cap [s], -1 if never
+};
+
+//! Runs n samples from the plant's current state.  No allocation, no throw:
+//! stops at the first failed sample and reports it.
+RunSummary run_record(Plant& plant, const double* command, std::size_t n, const Channels& out) noexcept;
+
+//! Every channel as vectors, for C++ users who want a convenient result.
+struct Trace {
+  std::vector<double> time, command, displacement, velocity, acceleration, force, pressure, spool, drive, flow;
+  std::vector<std::uint32_t> flags;
+  RunSummary summary;
+};
+
+//! Allocating convenience wrapper: validates the command (throws Error naming
+//! the first non-finite element), then runs it.
+Trace simulate(Plant& plant, const std::vector<double>& command);
+
+}  // namespace servohydraulics

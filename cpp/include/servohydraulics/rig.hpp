@@ -1,0 +1,88 @@
+// Parameters of a servo-hydraulic test rig: Eqs (1)-(5) of Zhao, French, Shield,
+// Posbergh (2003), "Considerations for the development of real-time dynamic
+// testing using servo-hydraulic actuation", EESD 32:1773-1794.
+//
+// Everything is SI: m, kg, s, N, Pa, V. The defaults are the calibrated preset
+// of the paper's rig (see presets.hpp and docs/calibration.md).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "servohydraulics/error.hpp"
+
+namespace servohydraulics {
+
+//! Normalised flow-spool opening curve g(x_v) of Fig 4(a): Q = K_v g(x_v) at
+//! zero load pressure, with g odd, g(0) = 0 and g'(0) = 1 so that K_v is the
+//! initial (null) flow gain of Eq (7).  The curve must be strictly increasing
+//! so that the nonlinear velocity-feedback compensator can invert it.
+struct FlowCurve {
+  enum class Kind {
+    Rational,  //!< g(x) = x / (1 + b |x|): gain falls from 1 to 1/(1+b)^2 at full opening
+    Table,     //!< piecewise linear through (opening[i], flow[i]), mirrored for x < 0
+  };
+  Kind kind = Kind::Rational;
+  double b = 0.6;                  //!< Rational shape factor [-]; g(1) = 1/(1+b)
+  std::vector<double> opening;     //!< Table: spool openings in [0, 1], first 0, increasing [-]
+  std::vector<double> flow;        //!< Table: normalised flow Q/K_v at those openings [-]
+
+  double eval(double x) const noexcept;     //!< g(x)
+  double slope(double x) const noexcept;    //!< g'(x)
+  double inverse(double q) const noexcept;  //!< x with g(x) = q (clamped to the curve's range)
+  void validate() const;                    //!< throws Error naming the bad field
+};
+
+//! Which physical effects are on.  Off gives the paper's linear-analysis model
+//! (Eqs 6-8) piece by piece.
+struct Effects {
+  bool servovalve_dynamics = true;  //!< Eq (2) second order; off: static valve v = k_ev x_v (Eq 6)
+  bool load_pressure = true;        //!< square-root load-pressure term of Eq (3); off: Eq (7)
+  bool flow_nonlinearity = true;    //!< flow gain falling with opening (Fig 4a); off: linear g(x) = x
+  bool coulomb_friction = true;     //!< F_c term of Eq (5)
+  bool spring_softening = true;     //!< stiffness k_2 beyond +-x_contact (springs lose contact)
+  bool piston_mass = true;          //!< piston mass m_p moves with the structure, seen by the load cell
+  bool drive_saturation = true;     //!< valve drive limited to +-v_max (controller output stage)
+  bool spool_saturation = true;     //!< metering opening limited to [-1, 1] (spool end stops)
+};
+
+//! Parameters of the rig.  Field names follow the paper's symbols (Table I).
+struct Rig {
+  // --- Structure, Eq (5) -----------------------------------------------------
+  double m = 7084.0;        //!< mass of the structure [kg] (Table I)
+  double c = 2.1e3;         //!< viscous damping [N s/m] (Table I, actuator attached: 1.5 %)
+  double k = 700.8e3;       //!< initial stiffness [N/m] (Table I; 4 springs x 175.2 kN/m)
+  double k_2 = 350.4e3;     //!< stiffness beyond +-x_contact [N/m] (p. 1777: one pair loses contact)
+  double x_contact = 0.025; //!< displacement where one spring pair loses contact [m] (2.5 cm precompression)
+  double F_c = 31.6;        //!< Coulomb friction [N] (Table I, actuator attached)
+  double v_stick = 1e-4;    //!< friction regularisation velocity: F = F_c tanh(v / v_stick) [m/s]
+  double m_p = 54.0;        //!< actuator piston mass [kg] (p. 1782)
+
+  // --- Actuator, Eq (4) ------------------------------------------------------
+  double A = 82.1e-4;       //!< piston area [m^2] (Table I)
+  double K_a = 6.5e-13;     //!< compressibility coefficient V_t/(4 beta_e) [m^5/N] (calibrated)
+  double C_l = 2.0e-11;     //!< total flow-pressure (leakage) coefficient [m^3/(s Pa)] (calibrated)
+  double p_s = 1.7e7;       //!< supply pressure [Pa] (Table I)
+  double F_cap = 170e3;     //!< rated actuator capacity [N] (p. 1777), reported when exceeded
+
+  // --- Servovalve, Eqs (2), (3), (6), (7) ------------------------------------
+  double K_v = 1.6e-2;      //!< main-stage flow gain at null [m^3/s per unit opening] (Table I)
+  double K_s = 0.1;         //!< static valve gain 1/k_ev [1/V] (Table I)
+  double f_v = 40.0;        //!< servovalve natural frequency [Hz] (chosen: docs/calibration.md)
+  double zeta_v = 0.9;      //!< servovalve damping ratio [-] ("highly damped")
+  FlowCurve flow_curve;     //!< g(x_v) of Fig 4(a)
+
+  // --- Servo controller, Eq (1) ----------------------------------------------
+  double C_F_disp = 78.74;     //!< conversion factor, displacement control [V/m] (Table I)
+  double C_F_force = 0.056e-3; //!< conversion factor, force control [V/N] (Table I: 0.056 V/kN)
+  double G_p = 0.8059;         //!< proportional gain [-] (Table I)
+  double G_d = 0.0;            //!< derivative gain [s] (Table I)
+  double v_max = 10.0;         //!< valve drive limit [V]
+
+  Effects effects;
+
+  //! Throws Error naming the first invalid field and its value.
+  void validate() const;
+};
+
+}  // namespace servohydraulics

@@ -1,0 +1,18 @@
+#include "servohydraulics/presets.hpp"
+
+namespace servohydraulics {
+
+Rig zhao2003(Zhao2003Variant variant, bool actuator_attached) {
+  Rig r;  // the defaults of Rig are the calibrated preset, actuator attached
+  if (!actuator_attached) {
+    r.c = 1.1e3;   // Table I, free structure (0.8 % of critical, p. 1777)
+    r.F_c = 95.7;  // Table I, free structure
+  }
+  if (variant == Zhao2003Variant::Printed) {
+    r.K_a = 0.3e-8 * 1e-3;  // Table I: 0.3e-8 m^5/kN -> m^5/N
+    r.C_l = 0.1e-8 * 1e-3;  // Table I: 0.1e-8 m^5/(kN s) -> m^3/(s Pa)
+  }
+  return r;
+}
+
+}  // namespace servohydraulics

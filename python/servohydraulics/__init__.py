@@ -1,0 +1,43 @@
+"""servohydraulics: servo-hydraulic actuators for real-time dynamic testing.
+
+A C++17 core (SUNDIALS CVODE, Eigen) with a thin Python layer, after
+Zhao, French, Shield, Posbergh (2003), Earthquake Engng Struct. Dyn. 32:1773-1794.
+
+    import servohydraulics as sh
+    rig = sh.zhao2003()
+    res = sh.simulate(rig, mode="displacement", command=u, dt=0.0005)
+"""
+
+from . import _core
+from ._core import ControlMode, Dynamics, FlowCurve, Plant, SolverOptions, linearize
+from .records import read_record, write_record
+from .rig import PARAMETERS, Error, Rig, copy_rig, load_rig, rig_from_dict, rig_to_dict, save_rig, zhao2003
+from .simulate import SimulationError, SimulationResult, make_plant, simulate, solver_options
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "PARAMETERS",
+    "ControlMode",
+    "Dynamics",
+    "Error",
+    "FlowCurve",
+    "Plant",
+    "Rig",
+    "SimulationError",
+    "SimulationResult",
+    "SolverOptions",
+    "_core",
+    "copy_rig",
+    "linearize",
+    "load_rig",
+    "make_plant",
+    "read_record",
+    "rig_from_dict",
+    "rig_to_dict",
+    "save_rig",
+    "simulate",
+    "solver_options",
+    "write_record",
+    "zhao2003",
+]
