@@ -62,9 +62,9 @@ class Rig:
     m: float = 7084.0  # moving mass [kg]
     c: float = 2.1e3  # viscous damping, actuator attached [N s/m]
     k: float = 700.8e3  # stiffness [N/m]
-    K_a: float = 1.3e-12  # compressibility coefficient V_t/(4 beta_e) [m^5/N]
-    C_l: float = 4.0e-11  # total flow-pressure coefficient [m^3/(s Pa)]
-    f_v: float = 2.0 / (TWO_PI * TAU_VALVE)  # valve natural frequency [Hz]
+    K_a: float = 1.36e-12  # compressibility coefficient V_t/(4 beta_e) [m^5/N]
+    C_l: float = 3.4e-11  # total flow-pressure coefficient [m^3/(s Pa)]
+    f_v: float = 70.7  # valve natural frequency [Hz]: 2 zeta_v/(2 pi f_v) = 4.5 ms
     zeta_v: float = 1.0  # valve damping ratio [-]
     dt: float = 0.5e-3  # digital controller sample time [s] (2 kHz)
 
@@ -252,8 +252,7 @@ def evaluate(rig: Rig) -> dict[str, Any]:
 
 def solve_K_a_for_T(C_l: float, rig: Rig, T: float = T_AMP) -> float:
     """K_a [m^5/N] at which the minimax-best amplitude-compensation constant equals T [s]."""
-    return float(brentq(lambda ka: best_T(replace(rig, K_a=ka, C_l=C_l))[0] - T,
-                        3e-13, 3e-12, xtol=1e-17))
+    return float(brentq(lambda ka: best_T(replace(rig, K_a=ka, C_l=C_l))[0] - T, 3e-13, 3e-12, xtol=1e-17))
 
 
 def calibrate(rig: Rig) -> tuple[float, float]:
@@ -280,11 +279,31 @@ def valve_variants() -> dict[str, Rig]:
     }
 
 
+def solve_C_l_for_gain_margin(rig: Rig, target: float = GAIN_MARGIN_TARGET) -> float:
+    """C_l [m^3/(s Pa)] at which G_p,max(7084 kg) = target * G_p for the rig's K_a."""
+    return float(
+        brentq(lambda cl: max_gain(replace(rig, C_l=cl)) / rig.G_p - target, 1e-12, 1e-9, xtol=1e-15)
+    )
+
+
+def min_best_T_over_C_l(rig: Rig) -> dict[str, float]:
+    """Smallest achievable minimax-best T [ms] over stable C_l, at the rig's K_a."""
+    cl_min = solve_C_l_for_gain_margin(rig, 1.01)
+    res = minimize_scalar(
+        lambda lc: best_T(replace(rig, C_l=10.0**lc))[0], bounds=(math.log10(cl_min), -9.0), method="bounded"
+    )
+    return {"C_l": float(10.0**res.x), "best_T_ms": float(res.fun) * 1e3, "C_l_stability_limit": cl_min}
+
+
 def alternatives() -> dict[str, Rig]:
     """Candidate explanations evaluated and rejected in docs/calibration.md."""
+    printed_ka = replace(CALIBRATED, K_a=3e-12)
     return {
-        "geometry_Ka_only_6.5e-13_Cl_2e-11": replace(CALIBRATED, K_a=6.5e-13, C_l=2e-11),
-        "printed_Ka_raise_Cl_to_gm2": replace(CALIBRATED, K_a=3e-12, C_l=1.5e-10),
+        "geometry_Ka_6.5e-13_Cl_2e-11": replace(CALIBRATED, K_a=6.5e-13, C_l=2e-11),
+        "geometry_Ka_6.5e-13_Cl_gm2": replace(
+            CALIBRATED, K_a=6.5e-13, C_l=solve_C_l_for_gain_margin(replace(CALIBRATED, K_a=6.5e-13))
+        ),
+        "printed_Ka_raise_Cl_to_gm2": replace(printed_ka, C_l=solve_C_l_for_gain_margin(printed_ka)),
         "printed_Ka_Cl_swapped": replace(CALIBRATED, K_a=1e-12, C_l=3e-12),
         "kN_read_as_N_Ka_3e-9": replace(CALIBRATED, K_a=3e-9, C_l=1e-9),
     }
@@ -297,9 +316,16 @@ def summarize(rig: Rig) -> dict[str, Any]:
     T, dev = best_T(rig)
     kf = rig.A * rig.K_v * rig.C_F_force * rig.K_s
     return {
-        "K_a": rig.K_a, "C_l": rig.C_l, "f_v_Hz": rig.f_v, "zeta_v": rig.zeta_v,
-        "stable": is_stable(g), "oil_column_Hz": f_oc, "oil_column_zeta": z_oc,
-        "best_T_ms": T * 1e3, "best_T_max_dev": dev, "max_dev_T68": max_deviation(rig, T_AMP),
+        "K_a": rig.K_a,
+        "C_l": rig.C_l,
+        "f_v_Hz": rig.f_v,
+        "zeta_v": rig.zeta_v,
+        "stable": is_stable(g),
+        "oil_column_Hz": f_oc,
+        "oil_column_zeta": z_oc,
+        "best_T_ms": T * 1e3,
+        "best_T_max_dev": dev,
+        "max_dev_T68": max_deviation(rig, T_AMP),
         "Gp_max_7084kg": max_gain(rig),
         "static_gain_loss": rig.C_l * rig.k / (rig.C_l * rig.k + rig.loop_gain),
         "eq11_force_rolloff_Hz": (rig.C_l + kf * rig.G_p) / rig.K_a / TWO_PI,
@@ -355,18 +381,28 @@ def main(argv: list[str] | None = None) -> int:
         "calibrated": evaluate(CALIBRATED),
         "calibration_solution": {
             "targets": {"best_T_ms": T_AMP * 1e3, "Gp_max_over_Gp_at_7084kg": GAIN_MARGIN_TARGET},
-            "K_a": K_a, "C_l": C_l,
-            "f_v_Hz": CALIBRATED.f_v, "zeta_v": CALIBRATED.zeta_v,
+            "K_a": K_a,
+            "C_l": C_l,
+            "f_v_Hz": CALIBRATED.f_v,
+            "zeta_v": CALIBRATED.zeta_v,
             "V_t_L_at_beta_0.69GPa": 4.0 * K_a * 0.69e9 * 1e3,
             "V_t_L_at_beta_1.0GPa": 4.0 * K_a * 1.0e9 * 1e3,
             "K_p0_fraction_ps_per_percent": CALIBRATED.K_v / C_l * 0.01 / 1.7e7,
         },
         "valve_sensitivity": {
-            name: {**dict(zip(("K_a", "C_l"), calibrate(r))), "f_v_Hz": r.f_v, "zeta_v": r.zeta_v,
-                   **eft_valve_check(r)}
+            name: {
+                **dict(zip(("K_a", "C_l"), calibrate(r))),
+                "f_v_Hz": r.f_v,
+                "zeta_v": r.zeta_v,
+                **eft_valve_check(r),
+            }
             for name, r in valve_variants().items()
         },
         "alternatives": {name: summarize(r) for name, r in alternatives().items()},
+        "min_best_T_over_C_l": {
+            f"K_a={ka:.2e}": min_best_T_over_C_l(replace(CALIBRATED, K_a=ka))
+            for ka in (4e-13, 6.5e-13, 7.9e-13, 1.0e-12, 1.36e-12)
+        },
         "swept_volume_L": CALIBRATED.A * 0.254 * 1e3,
         "command": "python scripts/calibration_table1.py --out DIR",
     }
@@ -375,15 +411,20 @@ def main(argv: list[str] | None = None) -> int:
 
     for name in ("printed", "calibrated"):
         r, v = result[name], result[name]["valve"]
-        print(f"{name:10s} K_a={r['parameters']['K_a']:.2e} C_l={r['parameters']['C_l']:.2e} "
-              f"stable={v['stable']} oil={v['oil_column_Hz']:.1f} Hz zeta={v['oil_column_zeta']:+.3f} "
-              f"|G(2Hz)|={v['G_xu_2Hz']:.3f} T*={v['best_T_ms']:.1f} ms dev68={v['max_dev_T68']:.3f} "
-              f"Gp_max={v['Gp_max']['7084kg']:.3f} Eq11={r['eq11_force_rolloff_Hz']:.0f} Hz")
+        print(
+            f"{name:10s} K_a={r['parameters']['K_a']:.2e} C_l={r['parameters']['C_l']:.2e} "
+            f"stable={v['stable']} oil={v['oil_column_Hz']:.1f} Hz zeta={v['oil_column_zeta']:+.3f} "
+            f"|G(2Hz)|={v['G_xu_2Hz']:.3f} T*={v['best_T_ms']:.1f} ms dev68={v['max_dev_T68']:.3f} "
+            f"Gp_max={v['Gp_max']['7084kg']:.3f} Eq11={r['eq11_force_rolloff_Hz']:.0f} Hz"
+        )
     s = result["calibration_solution"]
-    print(f"solved: K_a={s['K_a']:.3e} m^5/N  C_l={s['C_l']:.3e} m^3/(s Pa)  "
-          f"f_v={s['f_v_Hz']:.1f} Hz zeta_v={s['zeta_v']}")
-    print(f"wrote {args.out / 'calibration.json'} and calibration_bode.png "
-          f"in {time.perf_counter() - t0:.1f} s")
+    print(
+        f"solved: K_a={s['K_a']:.3e} m^5/N  C_l={s['C_l']:.3e} m^3/(s Pa)  "
+        f"f_v={s['f_v_Hz']:.1f} Hz zeta_v={s['zeta_v']}"
+    )
+    print(
+        f"wrote {args.out / 'calibration.json'} and calibration_bode.png in {time.perf_counter() - t0:.1f} s"
+    )
     return 0
 
 

@@ -8,7 +8,14 @@ Zhao, French, Shield, Posbergh (2003), Earthquake Engng Struct. Dyn. 32:1773-179
     res = sh.simulate(rig, mode="displacement", command=u, dt=0.0005)
 """
 
-from . import _core
+import os as _os
+
+# Development hook: SERVOHYDRAULICS_CORE_DIR names a CMake build directory whose
+# _core module is used instead of an installed one (scripts/dev-build.sh).
+if _os.environ.get("SERVOHYDRAULICS_CORE_DIR"):
+    __path__.insert(0, _os.environ["SERVOHYDRAULICS_CORE_DIR"])
+
+from . import _core  # noqa: E402
 from ._core import ControlMode, Dynamics, FlowCurve, Plant, SolverOptions, linearize
 from .records import read_record, write_record
 from .rig import PARAMETERS, Error, Rig, copy_rig, load_rig, rig_from_dict, rig_to_dict, save_rig, zhao2003
