@@ -50,6 +50,7 @@ void expose_rig(py::module_& m) {
       .def_readwrite("K_s", &Rig::K_s)
       .def_readwrite("f_v", &Rig::f_v)
       .def_readwrite("zeta_v", &Rig::zeta_v)
+      .def_readwrite("x_v_max", &Rig::x_v_max)
       .def_readwrite("flow_curve", &Rig::flow_curve)
       .def_readwrite("C_F_disp", &Rig::C_F_disp)
       .def_readwrite("C_F_force", &Rig::C_F_force)

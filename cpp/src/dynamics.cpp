@@ -151,8 +151,8 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
     xv = r.K_s * g.drive;
     for (int j = 0; j < kNG; ++j) dxv[j] = r.K_s * g.ddrive[j];
   }
-  g.spool_sat = r.effects.spool_saturation && std::fabs(xv) >= 1.0;
-  g.s = g.spool_sat ? std::copysign(1.0, xv) : xv;
+  g.spool_sat = r.effects.spool_saturation && std::fabs(xv) >= r.x_v_max;
+  g.s = g.spool_sat ? std::copysign(r.x_v_max, xv) : xv;
   for (int j = 0; j < kNG; ++j) g.ds[j] = g.spool_sat ? 0.0 : dxv[j];
 
   // Valve flow, Eq (3) (Eq 7 with the effects off).

@@ -106,6 +106,7 @@ void Rig::validate() const {
   require(finite_positive(K_s), "K_s", K_s, "valve gain must be finite and > 0 [1/V]");
   require(finite_positive(f_v), "f_v", f_v, "servovalve natural frequency must be finite and > 0 [Hz]");
   require(finite_positive(zeta_v), "zeta_v", zeta_v, "servovalve damping ratio must be finite and > 0");
+  require(finite_positive(x_v_max), "x_v_max", x_v_max, "spool opening limit must be finite and > 0 [-]");
   require(finite_positive(C_F_disp), "C_F_disp", C_F_disp, "conversion factor must be finite and > 0 [V/m]");
   require(finite_positive(C_F_force), "C_F_force", C_F_force, "conversion factor must be finite and > 0 [V/N]");
   require(finite_nonneg(G_p), "G_p", G_p, "proportional gain must be finite and >= 0");

@@ -29,7 +29,7 @@ using Jacobian = std::array<std::array<double, kNumStates>, kNumStates>;  //!< J
 enum OutputFlag : std::uint32_t {
   kCapacityExceeded = 1u << 0,  //!< |load-cell force| > F_cap
   kSupplyLimited = 1u << 1,     //!< |p| >= 0.98 p_s: the force demand is at the supply-pressure limit
-  kSpoolSaturated = 1u << 2,    //!< |x_v| >= 1
+  kSpoolSaturated = 1u << 2,    //!< |x_v| >= x_v_max
   kDriveSaturated = 1u << 3,    //!< |valve drive| >= v_max
 };
 

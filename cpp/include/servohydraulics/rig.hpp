@@ -43,7 +43,7 @@ struct Effects {
   bool spring_softening = true;     //!< stiffness k_2 beyond +-x_contact (springs lose contact)
   bool piston_mass = true;          //!< piston mass m_p moves with the structure, seen by the load cell
   bool drive_saturation = true;     //!< valve drive limited to +-v_max (controller output stage)
-  bool spool_saturation = true;     //!< metering opening limited to [-1, 1] (spool end stops)
+  bool spool_saturation = true;     //!< metering opening limited to [-x_v_max, x_v_max] (spool end stops)
 };
 
 //! Parameters of the rig.  Field names follow the paper's symbols (Table I).
@@ -70,6 +70,7 @@ struct Rig {
   double K_s = 0.1;         //!< static valve gain 1/k_ev [1/V] (Table I)
   double f_v = 40.0;        //!< servovalve natural frequency [Hz] (chosen: docs/calibration.md)
   double zeta_v = 0.9;      //!< servovalve damping ratio [-] ("highly damped")
+  double x_v_max = 1.0;     //!< metering opening limit (spool end stop) [-] (Eq 2: -1 <= x_v <= 1)
   FlowCurve flow_curve;     //!< g(x_v) of Fig 4(a)
 
   // --- Servo controller, Eq (1) ----------------------------------------------
