@@ -55,7 +55,7 @@ PARAMETERS: tuple[Parameter, ...] = (
     Parameter("servovalve", "K_v", "m^3/s", "main-stage flow gain at null", "Table I: 1.6e-2 m^3/s"),
     Parameter("servovalve", "K_s", "1/V", "static valve gain 1/k_ev", "Table I: 0.1"),
     Parameter("servovalve", "f_v", "Hz", "servovalve natural frequency (Eq 2)", "chosen, docs/calibration.md"),
-    Parameter("servovalve", "zeta_v", "-", "servovalve damping ratio (Eq 2)", "chosen: 'highly damped'"),
+    Parameter("servovalve", "zeta_v", "-", "servovalve damping ratio (Eq 2)", "chosen: 'highly damped', docs/calibration.md"),
     Parameter("servovalve", "x_v_max", "-", "spool opening limit (end stops)", "Eq (2): |x_v| <= 1"),
     Parameter("controller", "C_F_disp", "V/m", "conversion factor, displacement control", "Table I: 78.74 V/m"),
     Parameter("controller", "C_F_force", "V/N", "conversion factor, force control", "Table I: 0.056 V/kN"),

@@ -60,16 +60,16 @@ struct Rig {
 
   // --- Actuator, Eq (4) ------------------------------------------------------
   double A = 82.1e-4;       //!< piston area [m^2] (Table I)
-  double K_a = 6.5e-13;     //!< compressibility coefficient V_t/(4 beta_e) [m^5/N] (calibrated)
-  double C_l = 2.0e-11;     //!< total flow-pressure (leakage) coefficient [m^3/(s Pa)] (calibrated)
+  double K_a = 1.36e-12;    //!< compressibility coefficient V_t/(4 beta_e) [m^5/N] (calibrated; printed 3e-12)
+  double C_l = 3.4e-11;     //!< total flow-pressure coefficient, valve null K_c0 + leakage [m^3/(s Pa)] (calibrated; printed 1e-12)
   double p_s = 1.7e7;       //!< supply pressure [Pa] (Table I)
   double F_cap = 170e3;     //!< rated actuator capacity [N] (p. 1777), reported when exceeded
 
   // --- Servovalve, Eqs (2), (3), (6), (7) ------------------------------------
   double K_v = 1.6e-2;      //!< main-stage flow gain at null [m^3/s per unit opening] (Table I)
   double K_s = 0.1;         //!< static valve gain 1/k_ev [1/V] (Table I)
-  double f_v = 40.0;        //!< servovalve natural frequency [Hz] (chosen: docs/calibration.md)
-  double zeta_v = 0.9;      //!< servovalve damping ratio [-] ("highly damped")
+  double f_v = 70.7;        //!< servovalve natural frequency [Hz] (chosen: 4.5 ms group delay, -3 dB at 45 Hz; docs/calibration.md)
+  double zeta_v = 1.0;      //!< servovalve damping ratio [-] ("highly damped": critically damped)
   double x_v_max = 1.0;     //!< metering opening limit (spool end stop) [-] (Eq 2: -1 <= x_v <= 1)
   FlowCurve flow_curve;     //!< g(x_v) of Fig 4(a)
 
