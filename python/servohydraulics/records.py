@@ -11,7 +11,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Union
 
 import numpy as np
 
@@ -27,7 +26,7 @@ class Record:
     """A lab (or simulated) record: named channels of equal length."""
 
     channels: dict[str, np.ndarray]
-    path: Union[Path, None] = None
+    path: Path | None = None
 
     def __getattr__(self, name: str) -> np.ndarray:
         try:
@@ -58,7 +57,7 @@ def _check_time(t: np.ndarray, where: str) -> None:
                          f"the mean step is {dt:.9g} s")
 
 
-def read_record(path: Union[str, Path]) -> Record:
+def read_record(path: str | Path) -> Record:
     """Reads a record CSV; errors name the file, column and row."""
     path = Path(path)
     if not path.exists():
@@ -87,7 +86,7 @@ def read_record(path: Union[str, Path]) -> Record:
     return Record(channels, path)
 
 
-def write_record(path: Union[str, Path], record) -> Path:
+def write_record(path: str | Path, record) -> Path:
     """Writes a record CSV from a Record, a SimulationResult or a dict of arrays."""
     path = Path(path)
     if isinstance(record, Record):

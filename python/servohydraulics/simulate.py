@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Optional
 
 import numpy as np
 
@@ -98,7 +97,7 @@ def _check_dt(dt: float) -> float:
     return float(dt)
 
 
-def _command_array(command, duration: Optional[float], dt: float) -> np.ndarray:
+def _command_array(command, duration: float | None, dt: float) -> np.ndarray:
     if command is None:
         if duration is None:
             raise ValueError("give a command array or a duration [s]")
@@ -122,7 +121,7 @@ def _command_array(command, duration: Optional[float], dt: float) -> np.ndarray:
     return u
 
 
-def make_plant(rig: Rig, mode: str, dt: float = 5e-4, options: Optional[_core.SolverOptions] = None,
+def make_plant(rig: Rig, mode: str, dt: float = 5e-4, options: _core.SolverOptions | None = None,
                x0: float = 0.0) -> _core.Plant:
     """Constructs and resets a plant (validates everything, raises ValueError)."""
     if mode not in MODES:
@@ -135,8 +134,8 @@ def make_plant(rig: Rig, mode: str, dt: float = 5e-4, options: Optional[_core.So
 
 
 def simulate(rig: Rig, mode: str = "displacement", command=None, dt: float = 5e-4,
-             duration: Optional[float] = None, x0: float = 0.0,
-             options: Optional[_core.SolverOptions] = None, raise_on_failure: bool = True) -> SimulationResult:
+             duration: float | None = None, x0: float = 0.0,
+             options: _core.SolverOptions | None = None, raise_on_failure: bool = True) -> SimulationResult:
     """Simulates the rig under a held command, one controller sample per element.
 
     Args:

@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# The README's entry point.  On a fresh Debian machine (root, Python and a C++
+# compiler present) it installs what it needs itself, then:
+#   scripts/run.sh demo    the main job on built-in defaults (plots + summaries in demo_out/)
+#   scripts/run.sh test    all tests: C++ (ctest) and Python (pytest)
+#   scripts/run.sh bench   the step-time benchmarks (docs/benchmarks.md)
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"
+venv="$root/.venv"
+py=${PYTHON:-python3}
+jobs=${JOBS:-2}
+
+as_root() { if [ "$(id -u)" = 0 ]; then "$@"; elif command -v sudo >/dev/null; then sudo "$@"; else
+  echo "need root (or sudo) to install: $*" >&2; exit 1; fi; }
+
+system_deps() {
+  # Debian packages: SUNDIALS (CVODE) and Eigen; Python headers and venv if missing.
+  local need=()
+  dpkg -s libsundials-dev >/dev/null 2>&1 || need+=(libsundials-dev)
+  dpkg -s libeigen3-dev >/dev/null 2>&1 || need+=(libeigen3-dev)
+  "$py" -c 'import sysconfig, os, sys; sys.exit(not os.path.exists(os.path.join(sysconfig.get_paths()["include"], "Python.h")))' \
+    || need+=(python3-dev)
+  "$py" -m venv --help >/dev/null 2>&1 && "$py" -c 'import ensurepip' 2>/dev/null || need+=(python3-venv)
+  if [ ${#need[@]} -gt 0 ]; then
+    echo "installing Debian packages: ${need[*]}"
+    as_root apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq --no-install-recommends "${need[@]}"
+  fi
+}
+
+python_env() {
+  [ -x "$venv/bin/python" ] || "$py" -m venv "$venv"
+  "$venv/bin/python" -m pip install -q --upgrade pip
+  # Build tools for the C++ tests, then the package itself (scikit-build-core builds the C++ core).
+  "$venv/bin/python" -m pip install -q cmake ninja "pybind11>=2.12"
+  "$venv/bin/python" -m pip install -q "$root[test]"
+}
+
+cxx_tests() {
+  local b="$root/build/ctest"
+  "$venv/bin/cmake" -S "$root" -B "$b" -G Ninja -DSH_BUILD_TESTS=ON -DCMAKE_BUILD_TYPE=Release \
+    -DCMAKE_MAKE_PROGRAM="$venv/bin/ninja" -Dpybind11_DIR="$("$venv/bin/python" -c 'import pybind11; print(pybind11.get_cmake_dir())')" >/dev/null
+  "$venv/bin/cmake" --build "$b" -j "$jobs"
+  PATH="$venv/bin:$PATH" "$venv/bin/ctest" --test-dir "$b" --output-on-failure -j "$jobs"
+}
+
+case "${1:-}" in
+  demo)
+    system_deps; python_env
+    "$venv/bin/servohydraulics" demo --out "$root/demo_out"
+    if "$venv/bin/servohydraulics" --help | grep -q reproduce; then
+      "$venv/bin/servohydraulics" reproduce --out "$root/demo_out/reproduce"
+    fi
+    ;;
+  test)
+    system_deps; python_env
+    cxx_tests
+    # Run pytest from the tests directory so that the installed package is the one imported.
+    PATH="$venv/bin:$PATH" "$venv/bin/python" -m pytest "$root/tests/python" -q -p no:cacheprovider
+    ;;
+  bench)
+    system_deps; python_env
+    PATH="$venv/bin:$PATH" "$venv/bin/python" "$root/benchmarks/run.py"
+    ;;
+  *)
+    echo "usage: scripts/run.sh demo|test|bench" >&2
+    exit 2
+    ;;
+esac
