@@ -8,6 +8,7 @@
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -64,6 +65,8 @@ struct Plant::Impl {
   bool have_prev_u = false;
   bool failed = false;
   bool need_reinit = true;
+  int exp_mode = std::getenv("SH_EXP") ? std::atoi(std::getenv("SH_EXP")) : 0;
+  double h_next = 0.0;
   long steps_done = 0, rhs_done = 0, restarts = 0;  // totals of past CVODE instances (ReInit resets counters)
 
   // CVODE objects (only for CvodeBdf).
@@ -147,6 +150,11 @@ struct Plant::Impl {
       accumulate_counters();
       for (int i = 0; i < kNumStates; ++i) NV_Ith_S(nv, i) = y[i];
       CVodeReInit(cvode, t, nv);
+      if (exp_mode == 1 || exp_mode == 5) { if (h_next > 0) CVodeSetInitStep(cvode, h_next); }
+      else if (exp_mode == 2) CVodeSetInitStep(cvode, dt);
+      else if (exp_mode == 3) CVodeSetInitStep(cvode, dt / 4);
+      else if (exp_mode == 4) CVodeSetInitStep(cvode, dt / 16);
+      else if (exp_mode == 6) CVodeSetInitStep(cvode, dt / 64);
       need_reinit = false;
       st.restarted = true;
       ++restarts;
@@ -157,6 +165,7 @@ struct Plant::Impl {
     CVodeSetStopTime(cvode, t_next);
     sunrealtype tret = t;
     const int flag = CVode(cvode, t_next, nv, &tret, CV_NORMAL);
+    if (st.restarted && (exp_mode == 1 || exp_mode == 5)) { double h0 = 0; CVodeGetActualInitStep(cvode, &h0); h_next = exp_mode == 5 ? std::min(2 * h0, dt) : h0; }
     long ns1 = 0, nf1 = 0;
     CVodeGetNumSteps(cvode, &ns1);
     CVodeGetNumRhsEvals(cvode, &nf1);
