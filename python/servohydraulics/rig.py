@@ -128,8 +128,16 @@ def rig_from_dict(data: dict[str, Any], base: Rig | None = None) -> Rig:
     """Builds a rig from nested dicts (a parsed rig file) over ``base``
     (default: the calibrated preset).  Unknown sections or keys are an error;
     the result is validated (ValueError naming the field and value)."""
-    rig = copy_rig(base) if base is not None else zhao2003()
-    known = {}
+    rig = zhao2003()
+    if base is not None:
+        _apply(rig, rig_to_dict(base))
+    _apply(rig, data)
+    rig.validate()
+    return rig
+
+
+def _apply(rig: Rig, data: dict[str, Any]) -> None:
+    known: dict[str, set[str]] = {}
     for p in PARAMETERS:
         known.setdefault(p.section, set()).add(p.key)
     sections = set(known) | {"effects"}
@@ -152,8 +160,6 @@ def rig_from_dict(data: dict[str, Any], base: Rig | None = None) -> Rig:
                 setattr(rig, key, _number(where, value))
             else:
                 raise ValueError(f"unknown rig key {where}: expected one of {sorted(known[section])}")
-    rig.validate()
-    return rig
 
 
 def _flow_curve_from_dict(table: Any) -> _core.FlowCurve:
@@ -182,7 +188,7 @@ def _flow_curve_from_dict(table: Any) -> _core.FlowCurve:
 
 def copy_rig(rig: Rig) -> Rig:
     """An independent copy of a rig."""
-    return rig_from_dict(rig_to_dict(rig), base=_core.Rig())
+    return rig_from_dict(rig_to_dict(rig))
 
 
 def load_rig(path: str | Path) -> Rig:
@@ -217,10 +223,12 @@ def parameter_table() -> str:
     lines = ["| key | unit | default | meaning | source |", "|---|---|---|---|---|"]
     for p in PARAMETERS:
         lines.append(f"| `{p.section}.{p.key}` | {p.unit} | {getattr(default, p.key):.6g} | {p.doc} | {p.source} |")
-    lines.append("| `servovalve.flow_curve.kind` | - | rational | `rational`: g(x)=x/(1+b|x|); `table`: "
-                 "`opening`, `flow` lists | Fig 4a shape |")
-    lines.append(f"| `servovalve.flow_curve.b` | - | {default.flow_curve.b:g} | rational shape factor, "
-                 "g(1) = 1/(1+b) | chosen, docs/calibration.md |")
+    fc = default.flow_curve
+    pts = ", ".join(f"({o:g}, {q:g})" for o, q in zip(fc.opening, fc.flow))
+    lines.append("| `servovalve.flow_curve.kind` | - | table | `table` (lists `opening`, `flow`: normalised "
+                 "Q/K_v, mirrored for x < 0) or `rational` (g = x/(1 + b abs(x)), key `b`) | Fig 4a |")
+    lines.append(f"| `servovalve.flow_curve.opening`, `.flow` | - | {pts} | linear below 10 %, rated flow "
+                 "at full opening | p. 1780, MTS 256.09 rating; docs/calibration.md |")
     for name in EFFECTS:
         lines.append(f"| `effects.{name}` | bool | {str(getattr(default.effects, name)).lower()} | "
                      "switch the effect on/off | |")

@@ -33,6 +33,14 @@ struct FlowCurve {
   void validate() const;                    //!< throws Error naming the bad field
 };
 
+//! The flow curve of the preset: linear (g = x) below 10 % opening, where the
+//! paper found the constant initial gain adequate (p. 1780), bending to the
+//! rated flow at full opening: the MTS 256.09 is rated 5.7 l/s (90 gpm) at the
+//! standard 6.9 MPa valve drop, i.e. 5.7 sqrt(17 / 6.9) = 8.95 l/s at the
+//! 17 MPa supply with no load, g(1) = 8.95 / 16 = 0.56.  Slopes fall
+//! monotonically (concave), so the curve is invertible.  docs/calibration.md.
+FlowCurve zhao2003_flow_curve();
+
 //! Which physical effects are on.  Off gives the paper's linear-analysis model
 //! (Eqs 6-8) piece by piece.
 struct Effects {
@@ -71,7 +79,7 @@ struct Rig {
   double f_v = 70.7;        //!< servovalve natural frequency [Hz] (chosen: 4.5 ms group delay, -3 dB at 45 Hz; docs/calibration.md)
   double zeta_v = 1.0;      //!< servovalve damping ratio [-] ("highly damped": critically damped)
   double x_v_max = 1.0;     //!< metering opening limit (spool end stop) [-] (Eq 2: -1 <= x_v <= 1)
-  FlowCurve flow_curve;     //!< g(x_v) of Fig 4(a)
+  FlowCurve flow_curve = zhao2003_flow_curve();  //!< g(x_v) of Fig 4(a)
 
   // --- Servo controller, Eq (1) ----------------------------------------------
   double C_F_disp = 78.74;     //!< conversion factor, displacement control [V/m] (Table I)

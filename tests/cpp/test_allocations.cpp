@@ -1,0 +1,156 @@
+// The real-time promise: Plant::step, reset, observe and run_record allocate
+// nothing, in every control mode, with CVODE (restarting at every input change
+// or never) and with RK4, on success and on the failure paths.  Allocations are
+// counted by interposing malloc & co. and operator new (alloc_counter.hpp), so
+// C allocations inside SUNDIALS count too; the first block of main checks that
+// the counter really sees both kinds.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "alloc_counter.hpp"
+#include "check.hpp"
+#include "servohydraulics/plant.hpp"
+#include "servohydraulics/presets.hpp"
+#include "servohydraulics/record.hpp"
+
+using namespace servohydraulics;
+
+namespace {
+constexpr double kDt = 5e-4;
+constexpr double kPi = 3.14159265358979323846;
+
+// A command that changes every sample (every CVODE step restarts with
+// OnInputChange), with a hold and a jump: [m] or [N] by mode.
+double command(ControlMode mode, int k) {
+  const double t = k * kDt;
+  const double amp = mode == ControlMode::Displacement ? 0.01 : 2e4;
+  if (k >= 1500 && k < 1700) return 0.3 * amp;  // held: no restart with OnInputChange
+  return amp * (std::sin(2.0 * kPi * 2.0 * t) + 0.3 * std::sin(2.0 * kPi * 7.0 * t));
+}
+
+const char* method_name(const SolverOptions& o) {
+  if (o.method == SolverOptions::Method::Rk4) return "rk4";
+  return o.restart == SolverOptions::Restart::Never ? "cvode/never" : "cvode/on-input-change";
+}
+
+void check_plant(ControlMode mode, const SolverOptions& opt) {
+  Plant plant(zhao2003(), mode, kDt, opt);
+  const int n = 3000;
+  // run_record's destinations are allocated before counting.
+  std::vector<double> cmd(n), time(n), disp(n), vel(n), acc(n), force(n), pres(n), spool(n), drive(n), flow(n);
+  std::vector<std::uint32_t> flags(n);
+  std::vector<int> steps(n), rhs(n);
+  for (int k = 0; k < n; ++k) cmd[k] = command(mode, k);
+  Channels ch;
+  ch.time = time.data();
+  ch.displacement = disp.data();
+  ch.velocity = vel.data();
+  ch.acceleration = acc.data();
+  ch.force = force.data();
+  ch.pressure = pres.data();
+  ch.spool = spool.data();
+  ch.drive = drive.data();
+  ch.flow = flow.data();
+  ch.flags = flags.data();
+  ch.internal_steps = steps.data();
+  ch.rhs_evals = rhs.data();
+
+  Output out;
+  int failed = 0;
+  long restarts = 0;
+  long allocations, frees;
+  {
+    sh_test::AllocationCounter counter;
+    for (int k = 0; k < n; ++k) {
+      const Status st = plant.step(cmd[k], out);
+      failed += !st.ok();
+      restarts += st.restarted;
+    }
+    plant.observe(out);
+    plant.reset(0.005, 1.0);  // restart mid-run from another equilibrium
+    for (int k = 0; k < 500; ++k) failed += !plant.step(cmd[k], out).ok();
+    State y = plant.state();
+    plant.reset_state(y, plant.time());
+    const RunSummary sum = run_record(plant, cmd.data(), cmd.size(), ch);
+    failed += !sum.status.ok();
+    restarts += sum.restarts;
+    // Failure paths: a NaN command, then a step while failed, then reset.
+    failed += plant.step(std::nan(""), out).code != Status::NonFinite;
+    failed += plant.step(0.0, out).code != Status::NotReady;
+    plant.reset();
+    failed += !plant.step(cmd[1], out).ok();
+    allocations = counter.count();
+    frees = counter.frees();
+  }
+  std::printf("%-13s %-22s %5d samples: %ld allocations, %ld frees, %ld restarts\n", to_string(mode), method_name(opt),
+              2 * n + 502, allocations, frees, restarts);
+  CHECK(failed == 0);
+  CHECK(allocations == 0);
+  CHECK(frees == 0);
+  if (opt.method == SolverOptions::Method::CvodeBdf && opt.restart == SolverOptions::Restart::OnInputChange)
+    CHECK(restarts > n);  // the restart path was exercised
+}
+
+// An overrun (CVODE's too-much-work return) must not allocate either, e.g. for
+// an error message.
+void check_overrun() {
+  SolverOptions opt;
+  opt.max_steps_per_sample = 1;
+  Plant plant(zhao2003(), ControlMode::Displacement, kDt, opt);
+  Output out;
+  Status st, st2;
+  long allocations;
+  {
+    sh_test::AllocationCounter counter;
+    st = plant.step(0.01, out);
+    st2 = plant.step(0.01, out);
+    allocations = counter.count();
+  }
+  CHECK(st.code == Status::TooMuchWork);
+  CHECK(st2.code == Status::NotReady);
+  CHECK(allocations == 0);
+}
+}  // namespace
+
+int main() {
+  // The counter must see C++ and C allocations, including those made inside
+  // SUNDIALS (CVodeCreate, N_VNew_Serial, ...).
+  {
+    sh_test::AllocationCounter counter;
+    std::vector<double>* v = new std::vector<double>(16);
+    delete v;
+    CHECK(counter.count() == 2);
+    CHECK(counter.frees() == 2);
+    void* (*volatile cmalloc)(std::size_t) = &std::malloc;
+    void* p = cmalloc(32);
+    std::free(p);
+    CHECK(counter.count() == 3);
+  }
+  long rk4_construct, cvode_construct;
+  {
+    SolverOptions rk4;
+    rk4.method = SolverOptions::Method::Rk4;
+    sh_test::AllocationCounter counter;
+    { Plant p(zhao2003(), ControlMode::Force, kDt, rk4); }
+    rk4_construct = counter.count();
+    counter.restart();
+    { Plant p(zhao2003(), ControlMode::Force, kDt); }
+    cvode_construct = counter.count();
+  }
+  std::printf("construction: %ld allocations with RK4, %ld with CVODE (SUNDIALS' own mallocs are seen)\n",
+              rk4_construct, cvode_construct);
+  CHECK(rk4_construct >= 1);
+  CHECK(cvode_construct >= rk4_construct + 5);
+
+  SolverOptions cvode;
+  SolverOptions never;
+  never.restart = SolverOptions::Restart::Never;
+  SolverOptions rk4;
+  rk4.method = SolverOptions::Method::Rk4;
+  for (ControlMode mode : {ControlMode::Displacement, ControlMode::Force, ControlMode::Free})
+    for (const SolverOptions* o : {&cvode, &never, &rk4}) check_plant(mode, *o);
+  check_overrun();
+  return sh_test::report("test_allocations");
+}

@@ -1,0 +1,292 @@
+// Analytic Jacobian df/dy, input gradient df/du and the linearised output
+// matrices (C, D) against central finite differences of Dynamics::rhs and
+// Dynamics::outputs, at many fixed-seed random states, in every control mode
+// and for every combination of the eight effect switches.
+//
+// States are drawn away from the model's kinks (where the derivative is not
+// defined or the finite difference straddles a switch): spring contact
+// |x| = x_contact, the sign of the spool opening (load-pressure term, |x_v| in
+// the flow curve), drive saturation |v| = v_max, spool end stops |x_v| = x_v_max,
+// the breakpoints of a tabulated flow curve, and the C1 patch of the signed
+// square root (|p| <= 0.9 p_s keeps its argument in [0.1, 1.9]).
+//
+// Tolerance.  The finite-difference step of state j is h_j = 1e-6 s_j (s_j: the
+// state's scale below), so the truncation error is ~(1e-6)^2 relative and the
+// round-off error is ~eps T_i / h_j, where T_i = |f_i| + sum_k |J_ik| (|y_k| + s_k)
+// is the size of the terms that make up f_i.  An entry passes when
+//   |J_an - J_fd| s_j <= 1e-6 T_i            (scaled: 1e-6 of the row's terms)
+// and, where the entry is not negligible (|J_an| s_j > 1e-3 T_i), also
+//   |J_an - J_fd| <= 1e-5 |J_an|             (element-wise relative).
+// A wrong entry (sign, missing factor, missing term) is off by O(1) relative.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "check.hpp"
+#include "randomizer.hpp"
+#include "servohydraulics/linearize.hpp"
+#include "servohydraulics/plant.hpp"
+#include "servohydraulics/presets.hpp"
+
+using namespace servohydraulics;
+
+namespace {
+
+constexpr double kScale[kNumStates] = {1e-2, 1e-1, 1e6, 1e-1, 1e1};  // x [m], v [m/s], p [Pa], x_v [-], x_v' [1/s]
+constexpr double kRelStep = 1e-6;
+constexpr double kScaledTol = 1e-6;
+constexpr double kElementTol = 1e-5;
+
+double input_scale(ControlMode mode) { return mode == ControlMode::Displacement ? 1e-2 : 1e4; }
+
+void set_effects(Effects& e, unsigned mask) {
+  e.servovalve_dynamics = mask & 1u;
+  e.load_pressure = mask & 2u;
+  e.flow_nonlinearity = mask & 4u;
+  e.coulomb_friction = mask & 8u;
+  e.spring_softening = mask & 16u;
+  e.piston_mass = mask & 32u;
+  e.drive_saturation = mask & 64u;
+  e.spool_saturation = mask & 128u;
+}
+
+struct Draw {
+  State y;
+  Dynamics::Input in;
+};
+
+// Distances from the kinks, as the test computes them independently of the core.
+bool away_from_kinks(const Dynamics& dyn, const Draw& d) {
+  const Rig& r = dyn.rig();
+  const double* y = d.y.data();
+  const double margin_x = 1e-5, margin_v = 1e-3, margin_s = 1e-4;
+  if (r.effects.spring_softening && std::fabs(std::fabs(y[kX]) - r.x_contact) < margin_x) return false;
+  if (dyn.mode() == ControlMode::Free) return true;
+  Output o;
+  dyn.outputs(y, d.in, o);
+  double raw;
+  if (dyn.mode() == ControlMode::Displacement) {
+    const double CF = r.C_F_disp;
+    raw = CF * (r.G_p * (d.in.u - y[kX]) + r.G_d * (d.in.u_rate - y[kV]));
+  } else {
+    raw = r.C_F_force * r.G_p * (d.in.u - o.force);
+  }
+  if (r.effects.drive_saturation && std::fabs(std::fabs(raw) - r.v_max) < margin_v) return false;
+  const double drive = (r.effects.drive_saturation && std::fabs(raw) >= r.v_max) ? std::copysign(r.v_max, raw) : raw;
+  const double xv = r.effects.servovalve_dynamics ? y[kXv] : r.K_s * drive;
+  if (r.effects.spool_saturation && std::fabs(std::fabs(xv) - r.x_v_max) < margin_s) return false;
+  const double s = (r.effects.spool_saturation && std::fabs(xv) >= r.x_v_max) ? std::copysign(r.x_v_max, xv) : xv;
+  if ((r.effects.load_pressure || r.effects.flow_nonlinearity) && std::fabs(s) < margin_s) return false;
+  if (r.effects.flow_nonlinearity && r.flow_curve.kind == FlowCurve::Kind::Table)
+    for (double b : r.flow_curve.opening)
+      if (std::fabs(std::fabs(s) - b) < margin_s) return false;
+  return true;
+}
+
+Draw draw(sh_test::Randomizer& rnd, const Dynamics& dyn) {
+  const Rig& r = dyn.rig();
+  Draw d;
+  d.y[kX] = rnd.signed_uniform(0.0, 2.4 * r.x_contact);
+  // A quarter of the draws put v inside the steep part of the regularised friction.
+  d.y[kV] = rnd.uniform(0.0, 1.0) < 0.25 ? rnd.signed_uniform(0.0, 3.0 * r.v_stick) : rnd.signed_uniform(0.0, 0.5);
+  d.y[kP] = rnd.signed_uniform(0.0, 0.9 * r.p_s);
+  d.y[kXv] = rnd.signed_uniform(0.0, 1.3 * r.x_v_max);
+  d.y[kXvDot] = rnd.signed_uniform(0.0, 50.0);
+  if (dyn.mode() == ControlMode::Displacement) {
+    d.in.u = rnd.signed_uniform(0.0, 0.06);
+    d.in.u_rate = rnd.signed_uniform(0.0, 0.5);
+  } else {
+    d.in.u = rnd.signed_uniform(0.0, 1.6e5);
+  }
+  return d;
+}
+
+// Step of state j at this draw: relative to the scale, and well inside the
+// friction regularisation width when v is in its steep part.
+double fd_step(const Dynamics& dyn, const Draw& d, int j) {
+  double h = kRelStep * kScale[j];
+  if (j == kV && std::fabs(d.y[kV]) < 10.0 * dyn.rig().v_stick) h = 1e-4 * dyn.rig().v_stick;
+  return h;
+}
+
+struct Stats {
+  long entries = 0;
+  double worst_scaled = 0.0;
+};
+
+// Compares one column of analytic derivatives with its central difference.
+// f(eps) evaluates the function with the perturbed variable, n values.
+template <class F>
+void compare_column(const char* what, int col, const double* analytic, int n, double h, double scale,
+                    const double* terms, F&& f, Stats& st, const std::string& where) {
+  std::vector<double> fp(n), fm(n);
+  f(+h, fp.data());
+  f(-h, fm.data());
+  for (int i = 0; i < n; ++i) {
+    const double fd = (fp[i] - fm[i]) / (2.0 * h);
+    const double err = std::fabs(analytic[i] - fd);
+    const double T = terms[i] + 1e-300;
+    const double scaled = err * scale / T;
+    st.worst_scaled = std::max(st.worst_scaled, scaled);
+    ++st.entries;
+    bool ok = scaled <= kScaledTol;
+    if (ok && std::fabs(analytic[i]) * scale > 1e-3 * T) ok = err <= kElementTol * std::fabs(analytic[i]);
+    if (!CHECK(ok))
+      std::fprintf(stderr, "  %s: %s[%d][col %d] analytic %.12g fd %.12g (scaled err %.3g)\n", where.c_str(), what, i,
+                   col, analytic[i], fd, scaled);
+  }
+}
+
+Stats check_dynamics(const Dynamics& dyn, sh_test::Randomizer& rnd, int wanted, const std::string& name) {
+  Stats st;
+  int accepted = 0, attempts = 0;
+  const double su = input_scale(dyn.mode());
+  while (accepted < wanted && attempts < 50 * wanted) {
+    ++attempts;
+    Draw d = draw(rnd, dyn);
+    if (!away_from_kinks(dyn, d)) continue;
+    // Also every perturbed point must stay on the same side of every kink.
+    bool all_away = true;
+    for (int j = 0; j < kNumStates && all_away; ++j)
+      for (double sgn : {-1.0, 1.0}) {
+        Draw p = d;
+        p.y[j] += sgn * fd_step(dyn, d, j);
+        all_away = all_away && away_from_kinks(dyn, p);
+      }
+    for (double sgn : {-1.0, 1.0}) {
+      Draw p = d;
+      p.in.u += sgn * kRelStep * su;
+      all_away = all_away && away_from_kinks(dyn, p);
+    }
+    if (!all_away) continue;
+    ++accepted;
+    const std::string where = name + " draw " + std::to_string(accepted);
+
+    Jacobian J;
+    State B;
+    dyn.jacobian(d.y.data(), d.in, J, &B);
+    State f;
+    dyn.rhs(d.y.data(), d.in, f.data());
+    double T[kNumStates];
+    for (int i = 0; i < kNumStates; ++i) {
+      T[i] = std::fabs(f[i]) + std::fabs(B[i]) * (std::fabs(d.in.u) + su);
+      for (int k = 0; k < kNumStates; ++k) T[i] += std::fabs(J[i][k]) * (std::fabs(d.y[k]) + kScale[k]);
+    }
+    for (int j = 0; j < kNumStates; ++j) {
+      double col[kNumStates];
+      for (int i = 0; i < kNumStates; ++i) col[i] = J[i][j];
+      compare_column("J", j, col, kNumStates, fd_step(dyn, d, j), kScale[j], T,
+                     [&](double e, double* out) {
+                       State y = d.y;
+                       y[j] += e;
+                       dyn.rhs(y.data(), d.in, out);
+                     },
+                     st, where);
+    }
+    compare_column("B", kNumStates, B.data(), kNumStates, kRelStep * su, su, T,
+                   [&](double e, double* out) {
+                     Dynamics::Input in = d.in;
+                     in.u += e;
+                     dyn.rhs(d.y.data(), in, out);
+                   },
+                   st, where);
+
+    // Output gradients through linearize() (u_rate = 0 there): C = d out / d y, D = d out / d u.
+    Draw d0 = d;
+    d0.in.u_rate = 0.0;
+    if (!away_from_kinks(dyn, d0)) continue;
+    const LinearModel lm = linearize(dyn, d0.y, d0.in.u);
+    auto channels = [&](const State& y, double u, double* out) {
+      Output o;
+      dyn.outputs(y.data(), {u, 0.0}, o);
+      const double v[8] = {o.displacement, o.velocity, o.acceleration, o.force, o.pressure, o.spool, o.drive, o.flow};
+      std::copy(v, v + 8, out);
+    };
+    double o0[8];
+    channels(d0.y, d0.in.u, o0);
+    double To[8];
+    for (int i = 0; i < 8; ++i) {
+      To[i] = std::fabs(o0[i]) + std::fabs(lm.D(i)) * (std::fabs(d0.in.u) + su);
+      for (int k = 0; k < kNumStates; ++k) To[i] += std::fabs(lm.C(i, k)) * (std::fabs(d0.y[k]) + kScale[k]);
+    }
+    for (int j = 0; j < kNumStates; ++j) {
+      double col[8];
+      for (int i = 0; i < 8; ++i) col[i] = lm.C(i, j);
+      compare_column("C", j, col, 8, fd_step(dyn, d0, j), kScale[j], To,
+                     [&](double e, double* out) {
+                       State y = d0.y;
+                       y[j] += e;
+                       channels(y, d0.in.u, out);
+                     },
+                     st, where);
+    }
+    double Dcol[8];
+    for (int i = 0; i < 8; ++i) Dcol[i] = lm.D(i);
+    compare_column("D", kNumStates, Dcol, 8, kRelStep * su, su, To,
+                   [&](double e, double* out) { channels(d0.y, d0.in.u + e, out); }, st, where);
+    // linearize's A, B are the Jacobian at u_rate = 0; inactive states have no dynamics.
+    Jacobian J0;
+    State B0;
+    dyn.jacobian(d0.y.data(), d0.in, J0, &B0);
+    for (int i = 0; i < kNumStates; ++i) {
+      CHECK(lm.B(i) == B0[i]);
+      for (int k = 0; k < kNumStates; ++k) CHECK(lm.A(i, k) == J0[i][k]);
+      if (!lm.active[i]) {
+        State fi;
+        dyn.rhs(d0.y.data(), d0.in, fi.data());
+        CHECK(fi[i] == 0.0);
+        for (int k = 0; k < kNumStates; ++k) CHECK(lm.A(i, k) == 0.0);
+      }
+    }
+  }
+  if (!CHECK(accepted == wanted))
+    std::fprintf(stderr, "  %s: only %d of %d draws away from the kinks in %d attempts\n", name.c_str(), accepted, wanted,
+                 attempts);
+  return st;
+}
+
+}  // namespace
+
+int main() {
+  sh_test::Randomizer rnd(20030917);  // fixed seed: the same draws on every run
+  const ControlMode modes[] = {ControlMode::Displacement, ControlMode::Force, ControlMode::Free};
+  long entries = 0;
+  double worst = 0.0;
+  auto run = [&](const Rig& rig, ControlMode mode, int n, const std::string& name) {
+    const Dynamics dyn(rig, mode);
+    const Stats st = check_dynamics(dyn, rnd, n, name + " / " + to_string(mode));
+    entries += st.entries;
+    worst = std::max(worst, st.worst_scaled);
+  };
+
+  // Every combination of the eight effect switches, calibrated preset.
+  for (unsigned mask = 0; mask < 256; ++mask)
+    for (ControlMode mode : modes) {
+      Rig rig = zhao2003();
+      set_effects(rig.effects, mask);
+      run(rig, mode, 6, "calibrated effects mask " + std::to_string(mask));
+    }
+  // All effects on, more draws, on several rigs.
+  for (ControlMode mode : modes) {
+    run(zhao2003(), mode, 200, "calibrated");
+    run(zhao2003(Zhao2003Variant::Printed, false), mode, 100, "printed, free-structure dissipation");
+    Rig table = zhao2003();
+    table.flow_curve.kind = FlowCurve::Kind::Table;
+    table.flow_curve.opening = {0.0, 0.1, 0.4, 0.7, 1.0};
+    table.flow_curve.flow = {0.0, 0.1, 0.33, 0.5, 0.6};
+    run(table, mode, 100, "tabulated flow curve");
+  }
+  Rig derivative = zhao2003();
+  derivative.G_d = 0.02;  // derivative term of Eq (1), displacement control only
+  run(derivative, ControlMode::Displacement, 200, "G_d = 0.02 s");
+  Rig underdamped = zhao2003();
+  underdamped.zeta_v = 0.3;
+  underdamped.f_v = 30.0;
+  run(underdamped, ControlMode::Force, 100, "valve 30 Hz, zeta 0.3");
+
+  std::printf("compared %ld Jacobian/output-gradient entries; worst scaled error %.3g (tolerance %.0e)\n", entries,
+              worst, kScaledTol);
+  return sh_test::report("test_jacobian");
+}
