@@ -9,6 +9,8 @@ void expose_rig(py::module_& m);
 void expose_plant(py::module_& m);
 void expose_record(py::module_& m);
 void expose_linearize(py::module_& m);
+void expose_compensators(py::module_& m);
+void expose_loops(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "C++ core of servohydraulics (SUNDIALS CVODE, Eigen)";
@@ -18,4 +20,6 @@ PYBIND11_MODULE(_core, m) {
   expose_plant(m);
   expose_record(m);
   expose_linearize(m);
+  expose_compensators(m);
+  expose_loops(m);
 }

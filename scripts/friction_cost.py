@@ -9,6 +9,7 @@ difference to the sharpest regularisation.
 """
 
 import numpy as np
+
 import servohydraulics as sh
 
 
