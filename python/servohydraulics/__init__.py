@@ -15,36 +15,56 @@ import os as _os
 if _os.environ.get("SERVOHYDRAULICS_CORE_DIR"):
     __path__.insert(0, _os.environ["SERVOHYDRAULICS_CORE_DIR"])
 
-from . import _core  # noqa: E402
+from . import (  # noqa: E402
+    _core,  # noqa: E402
+    analysis,
+    identify,
+)
 from ._core import ControlMode, Dynamics, FlowCurve, Plant, SolverOptions, linearize
+from .diagnose import Diagnosis, diagnose  # the function shadows the subpackage name
+from .methods import MethodResult, TestMethodError, run_eft, run_rpsd, run_tracking
 from .records import read_record, write_record
+from .reproduce import reproduce  # the function shadows the module name
 from .rig import PARAMETERS, Error, Rig, copy_rig, load_rig, rig_from_dict, rig_to_dict, save_rig, zhao2003
 from .simulate import SimulationError, SimulationResult, make_plant, simulate, solver_options
+from .sweep import summary_run, sweep
 
 __version__ = "0.1.0"
 
 __all__ = [
     "PARAMETERS",
     "ControlMode",
+    "Diagnosis",
     "Dynamics",
     "Error",
     "FlowCurve",
+    "MethodResult",
     "Plant",
     "Rig",
     "SimulationError",
     "SimulationResult",
     "SolverOptions",
+    "TestMethodError",
     "_core",
     "copy_rig",
+    "diagnose",
     "linearize",
     "load_rig",
     "make_plant",
     "read_record",
     "rig_from_dict",
     "rig_to_dict",
+    "run_eft",
+    "run_rpsd",
+    "run_tracking",
     "save_rig",
     "simulate",
     "solver_options",
+    "summary_run",
+    "sweep",
     "write_record",
+    "analysis",
+    "identify",
+    "reproduce",
     "zhao2003",
 ]

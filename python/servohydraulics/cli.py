@@ -33,6 +33,32 @@ def _simulate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _reproduce(args: argparse.Namespace) -> int:
+    from .reproduce import reproduce
+
+    rep = reproduce(out=args.out, quick=args.quick)
+    print(f"wrote {args.out}/reproduction.md: {rep.agree_count} of {len(rep.rows)} rows agree, "
+          f"{len(rep.figures)} figures, {rep.runtime:.1f} s")
+    return 0
+
+
+def _diagnose(args: argparse.Namespace) -> int:
+    from .diagnose import diagnose
+    from .rig import load_rig
+
+    d = diagnose(args.records, load_rig(args.rig), mode=args.mode, progress=not args.quiet)
+    d.write(args.out)
+    print(f"{d.verdict}: {d.summary}")
+    for e in d.effects:
+        pars = ", ".join(f"{k} = {v['value']:.4g} {v['unit']}" for k, v in e["parameters"].items()
+                         if v["value"] is not None)
+        print(f"  + {e['name']}: {pars}")
+    print("  gap (normalised RMS): " + ", ".join(f"{c} {100 * d.gap_before[c]:.2f} % -> {100 * d.gap_after[c]:.2f} %"
+                                                  for c in d.gap_before))
+    print(f"wrote {args.out}/diagnosis.json, rig_updated.toml, report.md ({d.runtime_s:.1f} s)")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="servohydraulics", description=__doc__)
     sub = p.add_subparsers(dest="command", required=True)
@@ -52,6 +78,19 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--x0", type=float, default=0.0, help="initial displacement [m]")
     s.add_argument("--out", required=True, help="record CSV to write")
     s.set_defaults(func=_simulate)
+
+    r = sub.add_parser("reproduce", help="regenerate the paper's figures and reproduction.md (paper vs ours)")
+    r.add_argument("--out", default="reproduction", help="output directory (default: reproduction)")
+    r.add_argument("--quick", action="store_true", help="shorter sweeps (a faster, coarser table)")
+    r.set_defaults(func=_reproduce)
+    g = sub.add_parser("diagnose", help="name the effect the model is missing in lab records, fit it, show the gap")
+    g.add_argument("records", nargs="+", help="record CSV file(s) of the same rig (time, command, displacement, force)")
+    g.add_argument("--rig", required=True, help="the nominal rig TOML file")
+    g.add_argument("--mode", required=True, choices=["displacement", "force", "free"],
+                   help="control mode of the records")
+    g.add_argument("--out", required=True, help="output directory (diagnosis.json, rig_updated.toml, report.md)")
+    g.add_argument("--quiet", action="store_true", help="no progress bar")
+    g.set_defaults(func=_diagnose)
     return p
 
 

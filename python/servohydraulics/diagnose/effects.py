@@ -1,0 +1,390 @@
+"""The library of candidate effects: each a named physical effect with its
+parameters, units, the rig keys it sets, the value that means "absent", a
+plausible range, the nominal parameters it interacts with, its signature in the
+structure's equation of motion (for screening) and the experiment that would
+separate it from look-alikes.
+
+Every candidate acts through rig parameters that exist (``rig.PARAMETERS`` and
+the effect switches of ``rig.EFFECTS``), except ``time_delay``, which delays the
+record's command (integer + fractional samples, linear interpolation) before it
+is simulated.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ..rig import Rig, rig_from_dict, rig_to_dict
+
+
+@dataclass(frozen=True)
+class Param:
+    """One fitted parameter of a candidate."""
+
+    key: str  #: rig attribute (or "tau" for the command delay)
+    unit: str
+    rig_key: str  #: "section.key" in a rig file, or a note for non-rig parameters
+    reciprocal: bool = False  #: fitted as 1/value, so that "absent" (an infinite value) is 0
+
+
+@dataclass
+class Context:
+    """What a candidate needs to know about the nominal model and the data."""
+
+    rig: Rig  #: the current model (nominal plus effects already added)
+    nominal: Rig  #: the user's nominal rig
+    mode: str
+    peak_spool: float  #: largest |spool opening| of the current model's simulation [-]
+    peak_pressure: float  #: largest |load pressure| of the current model's simulation [Pa]
+    peak_x: float  #: largest measured |displacement| [m]
+    rms_v: float  #: rms measured velocity [m/s]
+
+
+@dataclass
+class Candidate:
+    """A named candidate effect."""
+
+    name: str
+    params: tuple[Param, ...]
+    doc: str
+    #: absent value(s) of the parameters for this context
+    absent: Callable[[Context], np.ndarray]
+    #: lower, upper bounds (physically plausible)
+    bounds: Callable[[Context], tuple[np.ndarray, np.ndarray]]
+    #: probe value(s) for the secant signature (a finite, clearly visible step)
+    probe: Callable[[Context], np.ndarray]
+    #: rig with the effect at parameter values theta
+    apply: Callable[[Rig, np.ndarray], Rig]
+    #: nominal parameters re-fitted with it (rig attribute, unit), +-interact_span around the current value
+    interacts: tuple[tuple[str, str], ...] = ()
+    #: which modes can show it at all
+    modes: tuple[str, ...] = ("displacement", "force", "free")
+    #: column of the structure-equation signature (None: not a structural effect)
+    structural_signature: Callable[[Rig, dict], np.ndarray] | None = None
+    #: the experiment that separates it from the others
+    separate: str = ""
+    #: a reason it cannot be seen in these records, or None
+    exercised: Callable[[Context], str | None] = field(default=lambda ctx: None)
+    #: True if the parameter is a delay applied to the command
+    delays_command: bool = False
+
+
+INTERACT_SPAN = 0.25  #: bounded re-fit of interacting nominal parameters: +-25 % of the current value
+
+
+def _copy(rig: Rig) -> Rig:
+    """An independent copy of a rig (through its rig-file dict)."""
+    return rig_from_dict(rig_to_dict(rig))
+
+
+# --- apply functions -----------------------------------------------------------------
+
+def _apply_coulomb(rig: Rig, th: np.ndarray) -> Rig:
+    r = _copy(rig)
+    r.effects.coulomb_friction = True
+    r.F_c = float(max(th[0], 0.0))
+    return r
+
+
+def _apply_viscous(rig: Rig, th: np.ndarray) -> Rig:
+    r = _copy(rig)
+    r.c = float(max(th[0], 0.0))
+    return r
+
+
+def _apply_softening(rig: Rig, th: np.ndarray) -> Rig:
+    r = _copy(rig)
+    r.effects.spring_softening = True
+    r.k_2 = float(th[0])
+    return r
+
+
+def _apply_load_pressure(rig: Rig, th: np.ndarray) -> Rig:
+    # theta = p_s [Pa]; +inf (or beyond 1e12) means the effect is off.
+    r = _copy(rig)
+    if not math.isfinite(th[0]) or th[0] > 1e12:
+        r.effects.load_pressure = False
+    else:
+        r.effects.load_pressure = True
+        r.p_s = float(th[0])
+    return r
+
+
+def _apply_flow(rig: Rig, th: np.ndarray) -> Rig:
+    r = _copy(rig)
+    b = float(max(th[0], 0.0))
+    if b <= 0.0:
+        r.effects.flow_nonlinearity = False
+        return r
+    fc = r.flow_curve
+    fc.kind = type(fc.kind).Rational
+    fc.b = b
+    r.flow_curve = fc
+    r.effects.flow_nonlinearity = True
+    return r
+
+
+def _apply_delay(rig: Rig, th: np.ndarray) -> Rig:
+    return rig  # the delay acts on the command, see Candidate.delays_command
+
+
+def _apply_valve(rig: Rig, th: np.ndarray) -> Rig:
+    r = _copy(rig)
+    if not math.isfinite(th[0]) or th[0] > 1e5:
+        r.effects.servovalve_dynamics = False
+        return r
+    r.effects.servovalve_dynamics = True
+    r.f_v = float(th[0])
+    r.zeta_v = float(th[1])
+    return r
+
+
+def _apply_leakage(rig: Rig, th: np.ndarray) -> Rig:
+    r = _copy(rig)
+    r.C_l = float(max(th[0], 0.0))
+    return r
+
+
+def _apply_piston_mass(rig: Rig, th: np.ndarray) -> Rig:
+    r = _copy(rig)
+    r.effects.piston_mass = True
+    r.m_p = float(max(th[0], 0.0))
+    return r
+
+
+def _apply_spool(rig: Rig, th: np.ndarray) -> Rig:
+    r = _copy(rig)
+    r.effects.spool_saturation = True
+    r.x_v_max = float(th[0])
+    return r
+
+
+def _apply_stiffness(rig: Rig, th: np.ndarray) -> Rig:
+    r = _copy(rig)
+    ratio = r.k_2 / r.k
+    r.k = float(th[0])
+    r.k_2 = float(th[0] * ratio)  # the softened branch keeps its ratio to k
+    return r
+
+
+def _apply_compressibility(rig: Rig, th: np.ndarray) -> Rig:
+    r = _copy(rig)
+    r.K_a = float(th[0])
+    return r
+
+
+# --- contexts -----------------------------------------------------------------------
+
+def _a(*v: float) -> np.ndarray:
+    return np.asarray(v, dtype=float)
+
+
+def _coulomb_absent(ctx: Context) -> np.ndarray:
+    return _a(ctx.rig.F_c if ctx.rig.effects.coulomb_friction else 0.0)
+
+
+def _softening_absent(ctx: Context) -> np.ndarray:
+    return _a(ctx.rig.k_2 if ctx.rig.effects.spring_softening else ctx.rig.k)
+
+
+def _load_pressure_absent(ctx: Context) -> np.ndarray:
+    return _a(ctx.rig.p_s if ctx.rig.effects.load_pressure else math.inf)
+
+
+def _flow_absent(ctx: Context) -> np.ndarray:
+    fc = ctx.rig.flow_curve
+    on = ctx.rig.effects.flow_nonlinearity and fc.kind == type(fc.kind).Rational
+    return _a(fc.b if on else 0.0)
+
+
+def _spool_absent(ctx: Context) -> np.ndarray:
+    lim = ctx.rig.x_v_max if ctx.rig.effects.spool_saturation else math.inf
+    return _a(min(lim, ctx.peak_spool))
+
+
+def _piston_absent(ctx: Context) -> np.ndarray:
+    return _a(ctx.rig.m_p if ctx.rig.effects.piston_mass else 0.0)
+
+
+def _softening_exercised(ctx: Context) -> str | None:
+    if ctx.peak_x <= ctx.rig.x_contact * 1.02:
+        return (f"not exercised: |displacement| never exceeds x_contact = {ctx.rig.x_contact * 1e3:.1f} mm "
+                f"(peak {ctx.peak_x * 1e3:.1f} mm)")
+    return None
+
+
+def _spool_exercised(ctx: Context) -> str | None:
+    if ctx.peak_spool <= 1e-4:
+        return "not exercised: the simulated spool never opens"
+    return None
+
+
+def _actuator_only(ctx: Context) -> str | None:
+    return None
+
+
+# --- structural signatures: d(residual of m a + c v + f_s(x) + F_c sgn v - F)/d(theta) -----
+
+def _sig_coulomb(rig: Rig, s: dict) -> np.ndarray:
+    return np.tanh(s["velocity"] / max(rig.v_stick, 0.05 * s["rms_v"]))
+
+
+def _sig_viscous(rig: Rig, s: dict) -> np.ndarray:
+    return s["velocity"]
+
+
+def _sig_softening(rig: Rig, s: dict) -> np.ndarray:
+    x = s["displacement"]
+    return np.sign(x) * np.maximum(np.abs(x) - rig.x_contact, 0.0)
+
+
+def _sig_stiffness(rig: Rig, s: dict) -> np.ndarray:
+    return s["displacement"]
+
+
+def _sig_mass(rig: Rig, s: dict) -> np.ndarray:
+    return s["acceleration"]
+
+
+def build_library() -> dict[str, Candidate]:
+    """The candidate effects by name (the names used in reports)."""
+    c = [
+        Candidate(
+            "coulomb_friction", (Param("F_c", "N", "structure.F_c"),),
+            "Coulomb friction F_c sgn(v) in the structure, Eq (5) (effects.coulomb_friction on)",
+            absent=_coulomb_absent,
+            bounds=lambda ctx: (_a(0.0), _a(5e3)),
+            probe=lambda ctx: _coulomb_absent(ctx) + max(20.0, 0.004 * ctx.rig.k * max(ctx.peak_x, 1e-3)),
+            apply=_apply_coulomb, interacts=(("c", "N s/m"),),
+            structural_signature=_sig_coulomb,
+            separate="repeat the test at two amplitudes (or a free vibration): Coulomb friction's share of the "
+                     "response falls with amplitude and makes the decay linear, viscous damping's does not",
+        ),
+        Candidate(
+            "viscous_damping", (Param("c", "N s/m", "structure.c"),),
+            "error in the viscous damping c of Eq (5)",
+            absent=lambda ctx: _a(ctx.rig.c),
+            bounds=lambda ctx: (_a(0.0), _a(max(20 * ctx.rig.c, 0.2 * 2 * math.sqrt(ctx.rig.k * ctx.rig.m)))),
+            probe=lambda ctx: _a(ctx.rig.c * 1.5 + 0.005 * 2 * math.sqrt(ctx.rig.k * ctx.rig.m)),
+            apply=_apply_viscous, interacts=(("F_c", "N"),),
+            structural_signature=_sig_viscous,
+            separate="repeat at two amplitudes: viscous damping gives the same decay ratio at every amplitude",
+        ),
+        Candidate(
+            "spring_softening", (Param("k_2", "N/m", "structure.k_2"),),
+            "stiffness k_2 beyond +-x_contact (effects.spring_softening on; x_contact kept)",
+            absent=_softening_absent,
+            bounds=lambda ctx: (_a(0.02 * ctx.rig.k), _a(2.0 * ctx.rig.k)),
+            probe=lambda ctx: _softening_absent(ctx) - 0.3 * ctx.rig.k,
+            apply=_apply_softening, interacts=(("x_contact", "m"),),
+            structural_signature=_sig_softening, exercised=_softening_exercised,
+            separate="a slow test with the amplitude stepped across x_contact: the stiffness changes only beyond it",
+        ),
+        Candidate(
+            "load_pressure", (Param("p_s", "Pa", "actuator.p_s (effects.load_pressure on)", reciprocal=True),),
+            "the load-pressure square-root term of Eq (3) with supply pressure p_s",
+            absent=_load_pressure_absent,
+            bounds=lambda ctx: (_a(max(1.02 * ctx.peak_pressure, 1e5)), _a(1e9)),
+            probe=lambda ctx: _a(max(1.6 * ctx.peak_pressure, 0.5 * min(ctx.rig.p_s, 1e9))),
+            apply=_apply_load_pressure, interacts=(("K_v", "m^3/s"),),
+            modes=("displacement", "force"),
+            separate="a test at high force and low velocity (large load pressure, small spool opening) versus one "
+                     "at low force and high velocity: load pressure acts on the first, the flow curve on the second",
+        ),
+        Candidate(
+            "flow_gain_nonlinearity", (Param("b", "-", "servovalve.flow_curve.b (rational, "
+                                                       "effects.flow_nonlinearity on)"),),
+            "flow gain falling with spool opening, g(x) = x/(1+b|x|) (the Fig 4a curve)",
+            absent=_flow_absent,
+            bounds=lambda ctx: (_a(0.0), _a(20.0)),
+            probe=lambda ctx: _flow_absent(ctx) + max(0.5, 0.1 / max(ctx.peak_spool, 1e-3)),
+            apply=_apply_flow, interacts=(("K_v", "m^3/s"),), modes=("displacement", "force"),
+            exercised=_spool_exercised,
+            separate="a test at large spool opening with little load (fast, low force): the flow curve acts there, "
+                     "load pressure does not",
+        ),
+        Candidate(
+            "time_delay", (Param("tau", "s", "none: the record's command is delayed by tau (integer + fractional "
+                                               "samples) before simulating"),),
+            "a pure delay of the command (controller, DSP or communication latency)",
+            absent=lambda ctx: _a(0.0),
+            bounds=lambda ctx: (_a(0.0), _a(0.05)),
+            probe=lambda ctx: _a(0.002),
+            apply=_apply_delay, delays_command=True, modes=("displacement", "force"),
+            separate="a sine sweep to higher frequency: a delay's phase lag grows linearly with frequency without "
+                     "amplitude loss, the servovalve's saturates and costs amplitude",
+        ),
+        Candidate(
+            "servovalve_dynamics",
+            (Param("f_v", "Hz", "servovalve.f_v", reciprocal=True), Param("zeta_v", "-", "servovalve.zeta_v")),
+            "the servovalve's second-order dynamics, Eq (2) (natural frequency, damping)",
+            absent=lambda ctx: _a(ctx.rig.f_v, ctx.rig.zeta_v) if ctx.rig.effects.servovalve_dynamics
+            else _a(math.inf, ctx.rig.zeta_v),
+            bounds=lambda ctx: (_a(3.0, 0.1), _a(1000.0, 5.0)),
+            probe=lambda ctx: _a(0.7 * min(ctx.rig.f_v, 1000.0), ctx.rig.zeta_v * 0.6),
+            apply=_apply_valve, modes=("displacement", "force"),
+            separate="a sine sweep to 50-100 Hz: the valve's amplitude roll-off and phase saturation separate it "
+                     "from a pure delay",
+        ),
+        Candidate(
+            "leakage", (Param("C_l", "m^3/(s Pa)", "actuator.C_l"),),
+            "leakage / flow-pressure coefficient C_l of Eq (4)",
+            absent=lambda ctx: _a(ctx.rig.C_l),
+            bounds=lambda ctx: (_a(0.0), _a(max(50 * ctx.rig.C_l, 1e-9))),
+            probe=lambda ctx: _a(ctx.rig.C_l * 1.5 + 1e-12),
+            apply=_apply_leakage, interacts=(("K_a", "m^5/N"),), modes=("displacement", "force"),
+            separate="hold a static force: leakage needs a steady spool offset (drive) to hold pressure",
+        ),
+        Candidate(
+            "piston_mass", (Param("m_p", "kg", "structure.m_p (effects.piston_mass on)"),),
+            "mass moving between the load cell and the structure (piston, fixtures)",
+            absent=_piston_absent,
+            bounds=lambda ctx: (_a(0.0), _a(0.3 * ctx.rig.m)),
+            probe=lambda ctx: _piston_absent(ctx) + max(100.0, 0.02 * ctx.rig.m),
+            apply=_apply_piston_mass, modes=("displacement", "force"),
+            structural_signature=None,
+            separate="a high-frequency test with the specimen detached: the load cell then reads m_p a only",
+        ),
+        Candidate(
+            "spool_saturation", (Param("x_v_max", "-", "servovalve.x_v_max (effects.spool_saturation on)"),),
+            "spool travel limited to +-x_v_max (end stops)",
+            absent=_spool_absent,
+            bounds=lambda ctx: (_a(max(0.01 * ctx.peak_spool, 1e-4)), _a(max(ctx.peak_spool, 2e-4))),
+            probe=lambda ctx: _a(0.7 * ctx.peak_spool),
+            apply=_apply_spool, modes=("displacement", "force"), exercised=_spool_exercised,
+            separate="a fast ramp: saturation caps the velocity at a constant, a flow curve only bends it",
+        ),
+        Candidate(
+            "stiffness_error", (Param("k", "N/m", "structure.k (k_2 scaled with it)"),),
+            "error in the initial stiffness k of Eq (5) (added: a mis-identified specimen)",
+            absent=lambda ctx: _a(ctx.rig.k),
+            bounds=lambda ctx: (_a(0.3 * ctx.rig.k), _a(3.0 * ctx.rig.k)),
+            probe=lambda ctx: _a(1.05 * ctx.rig.k),
+            apply=_apply_stiffness, structural_signature=_sig_stiffness,
+            separate="a quasi-static test: the stiffness is the force-displacement slope",
+        ),
+        Candidate(
+            "compressibility", (Param("K_a", "m^5/N", "actuator.K_a"),),
+            "oil compressibility K_a = V_t/(4 beta_e) of Eq (4) (added: entrained air, hoses)",
+            absent=lambda ctx: _a(ctx.rig.K_a),
+            bounds=lambda ctx: (_a(0.1 * ctx.rig.K_a), _a(20 * ctx.rig.K_a)),
+            probe=lambda ctx: _a(1.6 * ctx.rig.K_a),
+            apply=_apply_compressibility, interacts=(("C_l", "m^3/(s Pa)"),), modes=("displacement", "force"),
+            separate="a sweep through the oil-column resonance: compressibility moves it, leakage damps it",
+        ),
+    ]
+    return {cand.name: cand for cand in c}
+
+
+LIBRARY: dict[str, Candidate] = build_library()
+NAMES: tuple[str, ...] = tuple(LIBRARY)
+
+
+def separating_experiment(a: str, b: str) -> str:
+    """The experiment that would separate candidates a and b."""
+    ca, cb = LIBRARY[a], LIBRARY[b]
+    return f"to separate {a} from {b}: {ca.separate}; or: {cb.separate}"

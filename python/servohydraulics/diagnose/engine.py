@@ -1,0 +1,408 @@
+"""Numerics of the diagnosis: records as cases, simulation with the record's own
+command, normalised residuals, noise floor, screening by signatures, fitting by
+simulation error, and the statistics (effective sample size, BIC, intervals).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.signal import savgol_filter
+
+from ..records import Record
+from ..rig import Rig
+from ..simulate import SimulationError, simulate, solver_options
+from .effects import INTERACT_SPAN, Candidate, Context, _copy
+
+#: channels compared, in order of preference, per mode (those present in the record are used)
+CHANNELS = {
+    "displacement": ("displacement", "force", "velocity", "acceleration", "pressure", "spool"),
+    "force": ("displacement", "force", "velocity", "acceleration", "pressure", "spool"),
+    "free": ("displacement", "velocity", "acceleration"),
+}
+N_SEGMENTS = 6  #: held-out split: contiguous segments, even ones train, odd ones test
+
+
+@dataclass
+class Case:
+    """One record prepared for simulation and comparison."""
+
+    name: str
+    mode: str
+    dt: float
+    t: np.ndarray  #: time from 0 [s]
+    u: np.ndarray  #: the record's command [m or N]
+    x0: float  #: initial displacement [m]
+    meas: dict  #: channel -> measured samples (SI)
+    scale: dict  #: channel -> rms of the measured channel (normalisation)
+    sigma: dict  #: channel -> noise standard deviation estimated from the record itself
+    train: np.ndarray  #: boolean mask of the training samples
+    derived: dict  #: measured velocity/acceleration (Savitzky-Golay when not recorded)
+    x0_data: float = 0.0  #: initial displacement estimated from the record alone [m]
+    x0_sd: float = 0.0  #: its standard deviation [m]
+
+    @property
+    def channels(self) -> tuple[str, ...]:
+        return tuple(self.meas)
+
+
+def noise_sigma(y: np.ndarray) -> float:
+    """Noise standard deviation of a record channel from its third differences
+    (robust MAD; smooth signal content sampled well above its bandwidth cancels)."""
+    d3 = np.diff(y, 3)
+    return float(1.4826 * np.median(np.abs(d3 - np.median(d3))) / math.sqrt(20.0))
+
+
+def make_case(rec: Record, mode: str, name: str) -> Case:
+    ch = rec.channels
+    t = ch["time"] - ch["time"][0]
+    dt = rec.dt
+    meas, scale, sigma = {}, {}, {}
+    for c in CHANNELS[mode]:
+        if c not in ch:
+            continue
+        y = np.asarray(ch[c], dtype=float)
+        s = float(np.sqrt(np.mean(y ** 2)))
+        if s <= 0.0:
+            continue
+        if c == "force" and mode == "free":
+            continue
+        meas[c] = y
+        scale[c] = s
+        sigma[c] = max(noise_sigma(y), 1e-5 * s)
+    if "displacement" not in meas:
+        raise ValueError(f"{name}: column 'displacement' is all zero: nothing to diagnose")
+    n = len(t)
+    seg = np.minimum((np.arange(n) * N_SEGMENTS) // n, N_SEGMENTS - 1)
+    train = seg % 2 == 0
+    # Velocity and acceleration for the balance-equation screen: measured, or
+    # Savitzky-Golay derivatives of the displacement (window ~25 ms).
+    win = max(7, int(round(0.025 / dt)) | 1)
+    win = min(win, (n - 1) | 1 if (n - 1) % 2 else n - 2)
+    x = ch["displacement"]
+    derived = {
+        "displacement": savgol_filter(x, win, 3) if n > win else x,
+        "velocity": ch["velocity"] if "velocity" in ch else (savgol_filter(x, win, 3, deriv=1, delta=dt)
+                                                            if n > win else np.gradient(x, dt)),
+        "acceleration": ch["acceleration"] if "acceleration" in ch else (
+            savgol_filter(x, win, 3, deriv=2, delta=dt) if n > win else np.gradient(np.gradient(x, dt), dt)),
+        "force": ch["force"] if mode != "free" else ch["command"],
+    }
+    derived["rms_v"] = float(np.sqrt(np.mean(derived["velocity"] ** 2)))
+    x0, x0_sd = initial_displacement(t, x, sigma["displacement"])
+    return Case(name, mode, dt, t, np.asarray(ch["command"], float), x0, meas, scale, sigma, train, derived,
+                x0, x0_sd)
+
+
+def initial_displacement(t: np.ndarray, x: np.ndarray, sigma: float) -> tuple[float, float]:
+    """The displacement at t = 0 with the noise averaged out, and its standard
+    deviation: x0 + a t^2 + b t^4 fitted to the first 100 ms (a record starts at
+    rest, so x(t) is even there).  ``refine_x0`` then fits it against the model."""
+    m = min(int(np.searchsorted(t, 0.1)), t.size // 20)
+    if m < 5:
+        return float(x[0]), sigma
+    X = np.column_stack([np.ones(m), t[:m] ** 2, t[:m] ** 4])
+    coef = np.linalg.lstsq(X, x[:m], rcond=None)[0]
+    sd = sigma * math.sqrt(float(np.linalg.inv(X.T @ X)[0, 0]))
+    return float(coef[0]), sd
+
+
+def refine_x0(rig: Rig, cases: list[Case], tau: float) -> None:
+    """Fits each record's initial displacement (a nuisance state, not an effect)
+    by simulation error with the current model, within +-4 sd of the estimate
+    from the record alone (so that it cannot absorb a missing effect)."""
+    for case in cases:
+        x0, sd = case.x0_data, max(case.x0_sd, 1e-8)
+
+        def fun(z, case=case):
+            case.x0 = float(z[0])
+            return residuals([simulate_case(rig, case, tau)], [case])
+
+        try:
+            res = least_squares(fun, [x0], bounds=([x0 - 4 * sd], [x0 + 4 * sd]), x_scale=[sd], diff_step=1e-3,
+                                max_nfev=10)
+            case.x0 = float(res.x[0])
+        except ValueError:
+            case.x0 = x0
+
+
+# --- simulation ---------------------------------------------------------------------
+
+_RK4: dict = {}
+
+
+def _fastest_rate(rig: Rig, mode: str) -> float:
+    """A bound on the plant's fastest eigenvalue [1/s]: valve poles, friction
+    regularisation, leakage and oil-column rates (sets the RK4 substep)."""
+    M = rig.m + (rig.m_p if rig.effects.piston_mass and mode != "free" else 0.0)
+    rates = [rig.c / M]
+    if rig.effects.coulomb_friction:
+        rates.append(rig.F_c / (rig.v_stick * M))
+    if mode != "free":
+        wv = 2 * math.pi * rig.f_v
+        z = rig.zeta_v
+        if rig.effects.servovalve_dynamics:
+            rates.append(wv * (z + math.sqrt(max(z * z - 1.0, 0.0))) if z >= 1 else wv)
+        rates.append(rig.C_l / rig.K_a)
+        rates.append(rig.A / math.sqrt(rig.K_a * M))
+    return max(rates)
+
+
+def _options(rig: Rig, mode: str, dt: float):
+    """RK4 with enough substeps that h times the fastest rate stays below 1.2 (at least 4)."""
+    n = max(4, int(math.ceil(_fastest_rate(rig, mode) * dt / 1.2)))
+    if n > 64:
+        return None  # too stiff for RK4: CVODE
+    if n not in _RK4:
+        _RK4[n] = solver_options(method="rk4", rk4_substeps=n)
+    return _RK4[n]
+
+
+def delayed(u: np.ndarray, dt: float, tau: float) -> np.ndarray:
+    """The command delayed by tau [s]: integer + fractional samples by linear
+    interpolation, holding the first value before the record starts."""
+    if tau <= 0.0:
+        return u
+    k = np.arange(u.size) - tau / dt
+    return np.interp(k, np.arange(u.size), u, left=u[0])
+
+
+def simulate_case(rig: Rig, case: Case, tau: float = 0.0) -> dict | None:
+    """The model's channels for the record's command (None if the run fails).
+    Fixed-step RK4 (4 substeps a sample) for speed; CVODE if RK4 fails."""
+    u = delayed(case.u, case.dt, tau)
+    first = _options(rig, case.mode, case.dt)
+    for opts in ((first, None) if first is not None else (None,)):
+        try:
+            r = simulate(rig, case.mode, u, case.dt, x0=case.x0, options=opts)
+        except (SimulationError, ValueError):
+            continue
+        return {c: getattr(r, c) for c in ("displacement", "force", "velocity", "acceleration", "pressure", "spool")}
+    return None
+
+
+def residuals(sims: list, cases: list[Case], which: str = "all") -> np.ndarray:
+    """Stacked normalised residuals (measured - simulated) / rms(measured)."""
+    out = []
+    for sim, case in zip(sims, cases):
+        mask = {"all": slice(None), "train": case.train, "test": ~case.train}[which]
+        for c, y in case.meas.items():
+            e = (y - sim[c]) / case.scale[c] if sim is not None else np.full(y.size, 10.0)
+            out.append(e[mask])
+    return np.concatenate(out)
+
+
+def channel_stats(sims: list, cases: list[Case], which: str = "all") -> dict:
+    """Per (record, channel): normalised SSR, count, lag-1 autocorrelation, noise-floor SSR."""
+    out = {}
+    for sim, case in zip(sims, cases):
+        mask = {"all": np.ones(case.t.size, bool), "train": case.train, "test": ~case.train}[which]
+        for c, y in case.meas.items():
+            e = ((y - sim[c]) / case.scale[c] if sim is not None else np.full(y.size, 10.0))[mask]
+            e0 = e - e.mean()
+            den = float(e0 @ e0)
+            rho = float(e0[1:] @ e0[:-1] / den) if den > 0 else 0.0
+            out[(case.name, c)] = {
+                "ssr": float(e @ e), "n": int(e.size), "rho": max(min(rho, 0.999), 0.0),
+                "floor": float(e.size * (case.sigma[c] / case.scale[c]) ** 2),
+            }
+    return out
+
+
+def n_eff(stats: dict) -> dict:
+    """Effective sample size per channel from the residual's lag-1 autocorrelation:
+    n (1 - rho) / (1 + rho), at least 10."""
+    return {k: max(10.0, s["n"] * (1 - s["rho"]) / (1 + s["rho"])) for k, s in stats.items()}
+
+
+def bic(stats: dict, k: int, neff: dict) -> float:
+    """BIC with a per-channel unknown noise variance and effective sample sizes:
+    sum_c n_eff,c log(SSR_c / n_c) + k log(sum_c n_eff,c)."""
+    total = sum(neff.values())
+    return float(sum(neff[c] * math.log(max(s["ssr"], 1e-300) / s["n"]) for c, s in stats.items())
+                 + k * math.log(total))
+
+
+def gap(sims: list, cases: list[Case]) -> dict:
+    """Normalised RMS gap per channel (over all records): rms(meas - sim) / rms(meas)."""
+    num, den = {}, {}
+    for sim, case in zip(sims, cases):
+        for c, y in case.meas.items():
+            e = y - sim[c] if sim is not None else y * 10
+            num[c] = num.get(c, 0.0) + float(e @ e)
+            den[c] = den.get(c, 0.0) + float(y @ y)
+    return {c: math.sqrt(num[c] / den[c]) for c in num}
+
+
+def floor_gap(cases: list[Case]) -> dict:
+    """The gap that measurement noise alone leaves, per channel."""
+    num, den = {}, {}
+    for case in cases:
+        for c, y in case.meas.items():
+            num[c] = num.get(c, 0.0) + y.size * case.sigma[c] ** 2
+            den[c] = den.get(c, 0.0) + float(y @ y)
+    return {c: math.sqrt(num[c] / den[c]) for c in num}
+
+
+def at_noise_floor(stats: dict, margin: float = 0.05) -> bool:
+    """True if every channel's residual variance is within (1 + margin) of its
+    noise floor, or within four standard deviations of a chi-square with n_eff
+    degrees of freedom if that is wider."""
+    ne = n_eff(stats)
+    return all(s["ssr"] <= s["floor"] * (1 + max(margin, 4 * math.sqrt(2 / ne[k]))) for k, s in stats.items())
+
+
+# --- parameters in fitting coordinates ---------------------------------------------------
+
+@dataclass
+class Space:
+    """A candidate's fitted parameters (main + interacting) in fitting coordinates
+    (reciprocals where "absent" is infinite)."""
+
+    cand: Candidate
+    ctx: Context
+    interacting: tuple[tuple[str, str], ...]
+
+    def __post_init__(self) -> None:
+        c = self.cand
+        self.n_main = len(c.params)
+        rec = [p.reciprocal for p in c.params] + [False] * len(self.interacting)
+        self.rec = np.array(rec)
+        lo, hi = c.bounds(self.ctx)
+        cur = np.array([getattr(self.ctx.rig, k) for k, _ in self.interacting], float)
+        ext_lo = np.concatenate([lo, cur * (1 - INTERACT_SPAN)])
+        ext_hi = np.concatenate([hi, cur * (1 + INTERACT_SPAN)])
+        self.lo = np.where(self.rec, np.where(ext_hi >= 1e9, 0.0, 1.0 / ext_hi), ext_lo)
+        self.hi = np.where(self.rec, 1.0 / np.maximum(ext_lo, 1e-300), ext_hi)
+        self.absent = self.to_internal(np.concatenate([c.absent(self.ctx), cur]))
+        probe = self.to_internal(np.concatenate([c.probe(self.ctx), cur]))
+        self.probe = np.clip(probe, self.lo, self.hi)
+        step = np.abs(self.probe - self.absent)
+        self.scale = np.where(np.arange(step.size) < self.n_main, np.maximum(step, 1e-12),
+                              np.maximum(np.abs(cur) * 0.1, 1e-30) if cur.size else 1.0)
+
+    def to_internal(self, ext: np.ndarray) -> np.ndarray:
+        ext = np.asarray(ext, float)
+        with np.errstate(divide="ignore"):
+            return np.where(self.rec, np.where(np.isinf(ext), 0.0, 1.0 / np.where(ext == 0, np.inf, ext)), ext)
+
+    def to_external(self, z: np.ndarray) -> np.ndarray:
+        z = np.asarray(z, float)
+        with np.errstate(divide="ignore"):
+            return np.where(self.rec, np.where(z <= 0, np.inf, 1.0 / np.where(z <= 0, 1.0, z)), z)
+
+    def rig_and_tau(self, z: np.ndarray, base_tau: float) -> tuple[Rig, float]:
+        ext = self.to_external(z)
+        main = ext[: self.n_main]
+        if self.cand.delays_command:
+            rig, tau = self.ctx.rig, base_tau + float(main[0])
+        else:
+            rig, tau = self.cand.apply(self.ctx.rig, main), base_tau
+        if self.interacting:
+            rig = _copy(rig) if rig is self.ctx.rig else rig
+            for (key, _), v in zip(self.interacting, ext[self.n_main:]):
+                setattr(rig, key, float(v))
+        return rig, tau
+
+
+def simulate_all(rig: Rig, cases: list[Case], tau: float) -> list:
+    return [simulate_case(rig, c, tau) for c in cases]
+
+
+# --- screening ----------------------------------------------------------------------------
+
+def secant_screen(space: Space, cases: list[Case], sims0: list, r0: np.ndarray, base_tau: float) -> dict:
+    """Regress the current residual on the effect's signature: the change of the
+    simulated channels between "absent" and a probe value of each parameter.
+    Returns the explained fraction of the residual and the implied estimate."""
+    cols = []
+    for i in range(space.n_main):
+        z = space.absent.copy()
+        z[i] = space.probe[i]
+        rig, tau = space.rig_and_tau(z, base_tau)
+        sims = simulate_all(rig, cases, tau)
+        if any(s is None for s in sims):
+            return {"score": 0.0, "z0": space.probe.copy(), "signature": None, "failed": True}
+        cols.append(-(residuals(sims, cases) - r0))  # change of the normalised simulation
+    D = np.column_stack(cols)
+    alpha, *_ = np.linalg.lstsq(D, r0, rcond=None)
+    z0 = space.absent.copy()
+    z0[: space.n_main] = space.absent[: space.n_main] + alpha * (space.probe[: space.n_main]
+                                                                 - space.absent[: space.n_main])
+    z0 = np.clip(z0, space.lo, space.hi)
+    alpha_c = np.where(np.abs(space.probe[: space.n_main] - space.absent[: space.n_main]) > 0,
+                       (z0[: space.n_main] - space.absent[: space.n_main])
+                       / np.where(space.probe[: space.n_main] == space.absent[: space.n_main], 1.0,
+                                  space.probe[: space.n_main] - space.absent[: space.n_main]), 0.0)
+    rr = float(r0 @ r0)
+    res = r0 - D @ alpha_c
+    score = max(0.0, 1.0 - float(res @ res) / rr) if rr > 0 else 0.0
+    return {"score": score, "z0": z0, "signature": D @ alpha_c, "failed": False}
+
+
+def balance_screen(rig: Rig, cases: list[Case], signature) -> float:
+    """R^2 of the structure's equation-of-motion residual regressed on one effect's
+    signature: e = F - (m a + c v + f_s(x) + F_c tanh(v/v_stick)) with measured
+    (or differentiated) displacement, velocity, acceleration and force."""
+    es, ss = [], []
+    for case in cases:
+        d = case.derived
+        x, v, a, F = d["displacement"], d["velocity"], d["acceleration"], d["force"]
+        xc = rig.x_contact
+        if rig.effects.spring_softening:
+            fs = np.where(np.abs(x) <= xc, rig.k * x, np.sign(x) * (rig.k * xc + rig.k_2 * (np.abs(x) - xc)))
+        else:
+            fs = rig.k * x
+        fr = rig.F_c * np.tanh(v / rig.v_stick) if rig.effects.coulomb_friction else 0.0
+        e = F - (rig.m * a + rig.c * v + fs + fr)
+        s = signature(rig, {"displacement": x, "velocity": v, "acceleration": a, "rms_v": d["rms_v"]})
+        n = x.size
+        cut = slice(n // 50, n - n // 50)  # drop the filter's edge samples
+        es.append(e[cut] / max(np.sqrt(np.mean(F ** 2)), rig.k * np.sqrt(np.mean(x ** 2)), 1e-9))
+        ss.append(s[cut])
+    e, s = np.concatenate(es), np.concatenate(ss)
+    e = e - e.mean()
+    s = s - s.mean()
+    den = float(s @ s) * float(e @ e)
+    return float((s @ e) ** 2 / den) if den > 0 else 0.0
+
+
+# --- fitting ----------------------------------------------------------------------------
+
+def fit(space: Space, cases: list[Case], z0: np.ndarray, base_tau: float, which: str,
+        max_nfev: int = 30) -> tuple[np.ndarray, object]:
+    """Bounded least-squares fit of the candidate's parameters by simulation error."""
+    lo, hi = space.lo, space.hi
+    z0 = np.clip(z0, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
+
+    def fun(z):
+        rig, tau = space.rig_and_tau(z, base_tau)
+        return residuals(simulate_all(rig, cases, tau), cases, which)
+
+    res = least_squares(fun, z0, bounds=(lo, hi), x_scale=space.scale, diff_step=1e-3, max_nfev=max_nfev,
+                        method="trf", xtol=1e-6, ftol=1e-8)
+    return res.x, res
+
+
+def intervals(space: Space, res, stats: dict) -> tuple[np.ndarray, np.ndarray]:
+    """95 % intervals (fitting coordinates) from the Gauss-Newton covariance,
+    inflated by n / n_eff for autocorrelated residuals."""
+    J = res.jac
+    r = res.fun
+    n, p = J.shape
+    s2 = float(r @ r) / max(n - p, 1)
+    ne = sum(n_eff(stats).values())
+    infl = max(n / ne, 1.0)
+    D = np.maximum(np.abs(space.scale), 1e-300)  # column scaling: parameters differ by 10 orders of magnitude
+    Js = J * D
+    try:
+        cov = np.linalg.pinv(Js.T @ Js, rcond=1e-12) * s2 * infl
+        sd = D * np.sqrt(np.maximum(np.diag(cov), 0.0))
+    except np.linalg.LinAlgError:
+        sd = np.full(p, np.inf)
+    zero_col = np.linalg.norm(J, axis=0) == 0
+    sd = np.where(zero_col, np.inf, sd)
+    return res.x - 1.96 * sd, res.x + 1.96 * sd

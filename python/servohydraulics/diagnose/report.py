@@ -1,0 +1,174 @@
+"""Writes a diagnosis: diagnosis.json, rig_updated.toml, report.md and its plots."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..rig import save_rig
+
+
+def _clean(o):
+    if isinstance(o, dict):
+        return {str(k): _clean(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_clean(v) for v in o]
+    if isinstance(o, (np.floating, float)):
+        return float(o) if math.isfinite(o) else None
+    if isinstance(o, (np.integer,)):
+        return int(o)
+    if isinstance(o, np.bool_):
+        return bool(o)
+    return o
+
+
+def write_outputs(d, out: Path) -> Path:
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "diagnosis.json").write_text(json.dumps(_clean(d.to_dict()), indent=2))
+    save_rig(d.rig, out / "rig_updated.toml")
+    figs = _plots(d, out)
+    (out / "report.md").write_text(_markdown(d, figs))
+    return out
+
+
+def _plots(d, out: Path) -> dict:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    P = d.plots
+    if not P:
+        return {}
+    cases, before, after = P["cases"], P["sims_before"], P["sims_after"]
+    figs = {}
+    chans = list(cases[0].meas)
+    # 1. residual before/after
+    fig, axes = plt.subplots(len(chans), 1, figsize=(9, 2.2 * len(chans)), sharex=True, squeeze=False)
+    for ax, c in zip(axes[:, 0], chans):
+        t0 = 0.0
+        for case, sb, sa in zip(cases, before, after):
+            t = case.t + t0
+            ax.plot(t, (case.meas[c] - sb[c]) / case.scale[c], lw=0.6, color="tab:red",
+                    label="before" if t0 == 0 else None)
+            ax.plot(t, (case.meas[c] - sa[c]) / case.scale[c], lw=0.6, color="tab:blue",
+                    label="after" if t0 == 0 else None)
+            t0 = t[-1] + case.dt
+        ax.set_ylabel(f"{c} residual\n/ rms({c})")
+        ax.grid(alpha=0.3)
+    axes[0, 0].legend(loc="upper right")
+    axes[-1, 0].set_xlabel("time [s] (records end to end)")
+    fig.tight_layout()
+    fig.savefig(out / "residual_before_after.png", dpi=110)
+    plt.close(fig)
+    figs["residual"] = "residual_before_after.png"
+    # 2. the signature that named the effect (screening scores + signature vs residual)
+    first = [c for c in d.candidates if c["round"] == 1 and c["screening_score"] is not None]
+    if first:
+        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 3.6), gridspec_kw={"width_ratios": [1, 1.6]})
+        names = [c["name"] for c in first]
+        a1.barh(names, [c["screening_score"] for c in first], color=[
+            "tab:green" if c["accepted"] else "tab:gray" for c in first])
+        a1.set_xlabel("share of the residual its signature explains (round 1)")
+        a1.invert_yaxis()
+        sig = P["signatures"].get(d.effects[0]["name"]) if d.effects else None
+        if sig is not None:
+            n = cases[0].t.size
+            c0 = chans[0] if len(chans) == 1 else max(chans, key=lambda c: d.gap_before.get(c, 0))
+            k = chans.index(c0)
+            r = (cases[0].meas[c0] - before[0][c0]) / cases[0].scale[c0]
+            a2.plot(cases[0].t, r, lw=0.6, color="tab:red", label="residual (nominal)")
+            a2.plot(cases[0].t, sig[k * n:(k + 1) * n], lw=0.8, color="tab:green",
+                    label=f"signature of {d.effects[0]['name']}")
+            a2.set_xlabel("time [s]")
+            a2.set_ylabel(f"{c0} / rms")
+            a2.legend(loc="upper right", fontsize=8)
+        else:
+            a2.text(0.5, 0.5, "no effect named", ha="center", va="center")
+        fig.tight_layout()
+        fig.savefig(out / "signature.png", dpi=110)
+        plt.close(fig)
+        figs["signature"] = "signature.png"
+    # 3. the gap closing
+    hist = P["history"]
+    fig, ax = plt.subplots(figsize=(7, 3.4))
+    w = 0.8 / (len(hist) + 1)
+    for i, (label, g) in enumerate(hist):
+        ax.bar(np.arange(len(chans)) + i * w, [100 * g[c] for c in chans], w,
+               label=label if i == 0 else f"+ {label}")
+    ax.bar(np.arange(len(chans)) + len(hist) * w, [100 * d.noise_floor[c] for c in chans], w,
+           color="k", alpha=0.3, label="noise floor")
+    ax.set_xticks(np.arange(len(chans)) + 0.4 - w / 2)
+    ax.set_xticklabels(chans)
+    ax.set_ylabel("gap: normalised RMS error [%]")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "gap_closing.png", dpi=110)
+    plt.close(fig)
+    figs["gap"] = "gap_closing.png"
+    return figs
+
+
+def _fmt(v) -> str:
+    if v is None:
+        return "-"
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    return str(v)
+
+
+def _markdown(d, figs: dict) -> str:
+    L = ["# Diagnosis", "", f"**Verdict: {d.verdict}.** {d.summary}", "",
+         f"Mode: {d.mode}. Records: " + ", ".join(f"`{r}`" for r in d.records) + f". Runtime {d.runtime_s:.1f} s.",
+         ""]
+    L += ["## Gap per channel (normalised RMS error, %)", "",
+          "| channel | before | after | noise floor | gap closed (of the part above the floor) |",
+          "|---|---|---|---|---|"]
+    for c in d.gap_before:
+        gc = d.gap_closed.get(c)
+        L.append(f"| {c} | {100 * d.gap_before[c]:.2f} | {100 * d.gap_after[c]:.2f} | "
+                 f"{100 * d.noise_floor[c]:.2f} | {'-' if gc is None else f'{100 * gc:.0f} %'} |")
+    L.append("")
+    w = d.gap_where
+    if w:
+        L += [f"Where the nominal gap sits (channel `{w['channel']}`, residual rms / channel rms): "
+              f"by |displacement| quartile {', '.join(f'{v:.3f}' for v in w['abs_displacement_quartiles'])}; "
+              f"near velocity reversal {w['velocity_magnitude']['near_reversal']:.3f} vs moving "
+              f"{w['velocity_magnitude']['moving']:.3f}; residual power by band "
+              + ", ".join(f"{k}: {100 * v:.0f} %" for k, v in w["frequency_share"].items()) + ".", ""]
+    if d.effects:
+        L += ["## Effects added (in order)", ""]
+        for e in d.effects:
+            L.append(f"### {e['name']}: {e['doc']}")
+            L.append("")
+            L.append("| parameter | value | unit | 95 % interval | absent | rig key |")
+            L.append("|---|---|---|---|---|---|")
+            for k, p in e["parameters"].items():
+                L.append(f"| {k} | {_fmt(p['value'])} | {p['unit']} | [{_fmt(p['interval_95'][0])}, "
+                         f"{_fmt(p['interval_95'][1])}] | {_fmt(p['absent'])} | {p['rig_key']} |")
+            L.append("")
+            L.append(f"BIC improvement {e['delta_bic']:.1f}; held-out error down "
+                     f"{100 * e['heldout_improvement']:.1f} %." + (f" Note: {e['note']}" if "note" in e else ""))
+            L.append("")
+    if d.ambiguous_between:
+        L += ["## Ambiguous", "", f"{d.ambiguous_between[0]} or {d.ambiguous_between[1]}: "
+              f"{d.separating_experiment}.", ""]
+    L += ["## Candidates", "", "| round | name | screening | balance eq. | ΔBIC | held-out | result |",
+          "|---|---|---|---|---|---|---|"]
+    for c in d.candidates:
+        L.append(f"| {c['round']} | {c['name']} | {_fmt(c['screening_score'])} | {_fmt(c['balance_score'])} | "
+                 f"{_fmt(c['delta_bic'])} | {_fmt(c['heldout_improvement'])} | "
+                 f"{'accepted' if c['accepted'] else c['rejection']} |")
+    L.append("")
+    L += ["## Plots", ""]
+    if "residual" in figs:
+        L += ["Residual before (red) and after (blue):", "", f"![residual]({figs['residual']})", ""]
+    if "signature" in figs:
+        L += ["The signature that named the effect:", "", f"![signature]({figs['signature']})", ""]
+    if "gap" in figs:
+        L += ["The gap closing:", "", f"![gap]({figs['gap']})", ""]
+    L += ["The updated rig is `rig_updated.toml`; the full result is `diagnosis.json`.", ""]
+    return "\n".join(L)

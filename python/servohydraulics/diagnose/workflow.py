@@ -1,0 +1,358 @@
+"""The diagnosis workflow: nominal gap, screening, confirmation by simulation-error
+fits, acceptance by BIC (effective sample size), held-out error and intervals,
+greedy for a second and third effect, verdict."""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..records import Record, read_record
+from ..rig import Rig, rig_to_dict
+from ..simulate import MODES
+from . import engine as E
+from .effects import LIBRARY, Context, _copy, separating_experiment
+
+#: acceptance thresholds (documented in docs/diagnose.md)
+DELTA_BIC_MIN = 10.0  #: "very strong" evidence on the Kass-Raftery scale
+DELTA_BIC_AMBIGUOUS = 6.0  #: two passing candidates closer than this are "equally good"
+HELDOUT_MIN = 0.02  #: held-out SSR must fall by at least 2 %
+KEEP = 3  #: candidates kept by screening for the full fit
+MAX_EFFECTS = 3
+
+
+@dataclass
+class Diagnosis:
+    """What ``diagnose`` found; ``to_dict()`` is the content of diagnosis.json."""
+
+    verdict: str
+    effects: list
+    gap_before: dict
+    gap_after: dict
+    candidates: list
+    rig: Rig
+    mode: str
+    records: list
+    noise_floor: dict = field(default_factory=dict)
+    gap_closed: dict = field(default_factory=dict)
+    gap_where: dict = field(default_factory=dict)
+    ambiguous_between: list = field(default_factory=list)
+    separating_experiment: str = ""
+    command_delay: float = 0.0
+    summary: str = ""
+    runtime_s: float = 0.0
+    #: arrays for the report (not in the JSON)
+    plots: dict = field(default_factory=dict, repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "verdict": self.verdict,
+            "summary": self.summary,
+            "mode": self.mode,
+            "records": self.records,
+            "effects": self.effects,
+            "gap_before": self.gap_before,
+            "gap_after": self.gap_after,
+            "noise_floor": self.noise_floor,
+            "gap_closed": self.gap_closed,
+            "gap_where": self.gap_where,
+            "candidates": self.candidates,
+            "ambiguous_between": self.ambiguous_between,
+            "separating_experiment": self.separating_experiment,
+            "command_delay_s": self.command_delay,
+            "rig_updated": rig_to_dict(self.rig),
+            "runtime_s": self.runtime_s,
+        }
+
+    def write(self, out: str | Path) -> Path:
+        """Writes diagnosis.json, rig_updated.toml and report.md (with plots) to ``out``."""
+        from .report import write_outputs
+
+        return write_outputs(self, Path(out))
+
+
+def _as_records(records) -> list[Record]:
+    if isinstance(records, (str, Path, Record)):
+        records = [records]
+    out = []
+    for r in records:
+        out.append(r if isinstance(r, Record) else read_record(r))
+    if not out:
+        raise ValueError("invalid records = []: give at least one record")
+    return out
+
+
+def _progress(total: int, enabled: bool, desc: str):
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=desc, disable=not enabled, file=sys.stderr, leave=False,
+                bar_format="{desc}: {n_fmt}/{total_fmt} {bar} {elapsed} {postfix}")
+
+
+def gap_where(sims: list, cases: list[E.Case]) -> dict:
+    """Where the gap sits, for the channel with the largest normalised gap:
+    residual rms by time segment, frequency band, |displacement| quartile,
+    velocity sign and |velocity| (reversals vs. motion)."""
+    g = E.gap(sims, cases)
+    ch = max(g, key=g.get)
+    e = np.concatenate([(c.meas[ch] - s[ch]) / c.scale[ch] for s, c in zip(sims, cases)])
+    x = np.concatenate([c.derived["displacement"] for c in cases])
+    v = np.concatenate([c.derived["velocity"] for c in cases])
+    dt = cases[0].dt
+
+    def rms(m):
+        return float(np.sqrt(np.mean(e[m] ** 2))) if np.any(m) else float("nan")
+
+    n = e.size
+    seg = np.minimum(np.arange(n) * 10 // n, 9)
+    out: dict[str, Any] = {"channel": ch, "time_deciles": [rms(seg == i) for i in range(10)]}
+    spec = np.abs(np.fft.rfft(e - e.mean())) ** 2
+    f = np.fft.rfftfreq(n, dt)
+    bands = [(0, 1), (1, 3), (3, 10), (10, 30), (30, 100), (100, 1 / (2 * dt))]
+    tot = float(spec.sum()) or 1.0
+    out["frequency_share"] = {f"{a:g}-{b:g} Hz": float(spec[(f >= a) & (f < b)].sum() / tot) for a, b in bands}
+    q = np.quantile(np.abs(x), [0.25, 0.5, 0.75])
+    ax = np.abs(x)
+    out["abs_displacement_quartiles"] = [rms(ax <= q[0]), rms((ax > q[0]) & (ax <= q[1])),
+                                         rms((ax > q[1]) & (ax <= q[2])), rms(ax > q[2])]
+    out["velocity_sign"] = {"positive": rms(v > 0), "negative": rms(v <= 0)}
+    vs = np.quantile(np.abs(v), 0.2)
+    out["velocity_magnitude"] = {"near_reversal": rms(np.abs(v) <= vs), "moving": rms(np.abs(v) > vs)}
+    return out
+
+
+def _param_report(space: E.Space, z: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> dict:
+    ext = space.to_external(z)
+    elo, ehi = space.to_external(lo), space.to_external(hi)
+    absent = space.to_external(space.absent)
+    out = {}
+    keys = [(p.key, p.unit, p.rig_key) for p in space.cand.params] + \
+           [(k, u, "re-fitted nominal parameter") for k, u in space.interacting]
+    for i, (key, unit, where) in enumerate(keys):
+        a, b = (ehi[i], elo[i]) if space.rec[i] else (elo[i], ehi[i])
+        a, b = min(a, b), max(a, b)
+        out[key] = {"value": _num(ext[i]), "unit": unit, "interval_95": [_num(a), _num(b)],
+                    "absent": _num(absent[i]), "rig_key": where}
+    return out
+
+
+def _num(v: float) -> float | None:
+    return float(v) if math.isfinite(v) else None
+
+
+def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = True,
+             keep: int = KEEP, max_effects: int = MAX_EFFECTS, candidates: Sequence[str] | None = None,
+             refit_interacting: bool = True) -> Diagnosis:
+    """Finds the effect the model ``rig`` is missing in lab ``records``.
+
+    Args:
+        records: one or more records of the same rig (paths to CSV files or
+            ``Record`` objects, read with ``read_record``: uniform time).
+        rig: the nominal model you believe in.
+        mode: ``"displacement"``, ``"force"`` or ``"free"``; the records'
+            command column is the command sent in that mode (m or N).
+        progress: show progress on the terminal (stderr).
+        keep: candidates kept by screening for the full simulation fit.
+        max_effects: most effects added greedily.
+        candidates: restrict the library (names); default all.
+        refit_interacting: allow a bounded (+-25 %) re-fit of the nominal
+            parameters each effect interacts with.
+
+    Returns:
+        A ``Diagnosis`` (``.write(dir)`` writes diagnosis.json, rig_updated.toml, report.md).
+    """
+    t_start = time.time()
+    if mode not in MODES:
+        raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(MODES)}")
+    names = list(candidates) if candidates is not None else list(LIBRARY)
+    for nme in names:
+        if nme not in LIBRARY:
+            raise ValueError(f"unknown candidate {nme!r}: expected one of {list(LIBRARY)}")
+    recs = _as_records(records)
+    rig.validate()
+    cases = [E.make_case(r, mode, str(r.path) if r.path else f"record{i}") for i, r in enumerate(recs)]
+    for i, c in enumerate(cases):
+        if any(c.name == o.name for o in cases[:i]):
+            c.name = f"{c.name}#{i}"
+
+    current, tau = _copy(rig), 0.0
+    E.refine_x0(current, cases, tau)
+    sims0 = E.simulate_all(current, cases, tau)
+    if any(s is None for s in sims0):
+        raise ValueError("the nominal rig's simulation fails on this record: check the rig and --mode")
+    gap_before = E.gap(sims0, cases)
+    floor = E.floor_gap(cases)
+    where = gap_where(sims0, cases)
+    effects: list = []
+    cand_log: list = []
+    verdict, summary = None, ""
+    amb: list = []
+    sep = ""
+    history = [("nominal", gap_before)]
+    signatures: dict = {}
+    sims = sims0
+    bar = _progress(max_effects * (len(names) + keep), progress, "diagnose")
+
+    for rnd in range(1, max_effects + 1):
+        stats = E.channel_stats(sims, cases)
+        if E.at_noise_floor(stats):
+            summary = (f"round {rnd}: the model explains the records to the noise floor "
+                       "(every channel's residual variance within 5 % of its noise floor)")
+            break
+        x_peak = max(float(np.max(np.abs(c.meas["displacement"]))) for c in cases)
+        ctx = Context(rig=current, nominal=rig, mode=mode,
+                      peak_spool=max(float(np.max(np.abs(s["spool"]))) for s in sims),
+                      peak_pressure=max(float(np.max(np.abs(s["pressure"]))) for s in sims),
+                      peak_x=x_peak, rms_v=float(np.mean([c.derived["rms_v"] for c in cases])))
+        r0 = E.residuals(sims, cases)
+        base_train = E.channel_stats(sims, cases, "train")
+        base_test = E.channel_stats(sims, cases, "test")
+        bar.set_description_str(f"round {rnd}: screening")
+        screened = []
+        added = {e["name"] for e in effects}
+        for nme in names:
+            bar.update(1)
+            cand = LIBRARY[nme]
+            entry = {"name": nme, "round": rnd, "screening_score": None, "balance_score": None,
+                     "score": None, "delta_bic": None, "heldout_improvement": None, "parameters": None,
+                     "accepted": False, "rejection": None}
+            cand_log.append(entry)
+            if nme in added:
+                entry["rejection"] = "already added"
+                continue
+            if mode not in cand.modes:
+                entry["rejection"] = f"cannot act in {mode} mode"
+                continue
+            why = cand.exercised(ctx)
+            if why:
+                entry["rejection"] = why
+                continue
+            inter = cand.interacts if refit_interacting else ()
+            inter = tuple((k, u) for k, u in inter if getattr(current, k) > 0
+                          and (k != "F_c" or current.effects.coulomb_friction))
+            space = E.Space(cand, ctx, inter)
+            sc = E.secant_screen(space, cases, sims, r0, tau)
+            entry["screening_score"] = sc["score"]
+            if cand.structural_signature is not None:
+                entry["balance_score"] = E.balance_screen(current, cases, cand.structural_signature)
+            screened.append((nme, space, sc, entry))
+        screened.sort(key=lambda s: -s[2]["score"])
+        survivors = screened[:keep]
+        # the best structural candidate of the balance-equation screen also goes on
+        structural = [s for s in screened if s[3]["balance_score"] is not None]
+        if structural:
+            best_bal = max(structural, key=lambda s: s[3]["balance_score"])
+            if best_bal[0] not in {s[0] for s in survivors} and best_bal[3]["balance_score"] > 0.1:
+                survivors.append(best_bal)
+        kept = {s[0] for s in survivors}
+        for rank, (nme, _space, sc, entry) in enumerate(screened):
+            if nme not in kept:
+                entry["rejection"] = (f"screening: its signature explains {100 * sc['score']:.1f} % of the residual "
+                                      f"(rank {rank + 1}; kept the best {keep})")
+        passing = []
+        for nme, space, sc, entry in survivors:
+            bar.set_description_str(f"round {rnd}: fitting {nme}")
+            bar.update(1)
+            t_fit = time.time()
+            z_tr, res_tr = E.fit(space, cases, sc["z0"], tau, "train")
+            rig_tr, tau_tr = space.rig_and_tau(z_tr, tau)
+            sims_tr = E.simulate_all(rig_tr, cases, tau_tr)
+            test = E.channel_stats(sims_tr, cases, "test")
+            ssr_test_base = sum(s["ssr"] for s in base_test.values())
+            ssr_test = sum(s["ssr"] for s in test.values())
+            held = 1.0 - ssr_test / ssr_test_base
+            z, res = E.fit(space, cases, z_tr, tau, "all", max_nfev=12)
+            rig_c, tau_c = space.rig_and_tau(z, tau)
+            sims_c = E.simulate_all(rig_c, cases, tau_c)
+            st_c = E.channel_stats(sims_c, cases)
+            neff = E.n_eff(st_c)
+            k = z.size
+            dbic = E.bic(stats, 0, neff) - E.bic(st_c, k, neff)
+            lo, hi = E.intervals(space, res, st_c)
+            nm = space.n_main
+            excludes = bool(np.any((space.absent[:nm] < lo[:nm]) | (space.absent[:nm] > hi[:nm])))
+            entry.update({"score": dbic, "delta_bic": dbic, "heldout_improvement": held,
+                          "parameters": _param_report(space, z, lo, hi), "screening_refit_start": None})
+            entry.pop("screening_refit_start")
+            entry["fit_seconds"] = time.time() - t_fit
+            reasons = []
+            if dbic < DELTA_BIC_MIN:
+                reasons.append(f"BIC improvement {dbic:.1f} < {DELTA_BIC_MIN:g}")
+            if held < HELDOUT_MIN:
+                reasons.append(f"held-out error improves by {100 * held:.1f} % < {100 * HELDOUT_MIN:g} %")
+            if not excludes:
+                reasons.append("95 % interval includes 'absent'")
+            if reasons:
+                entry["rejection"] = "; ".join(reasons)
+            else:
+                passing.append({"name": nme, "space": space, "z": z, "lo": lo, "hi": hi, "rig": rig_c,
+                                "tau": tau_c, "sims": sims_c, "dbic": dbic, "entry": entry, "sc": sc,
+                                "stats": st_c, "held": held})
+            _ = base_train
+        if not passing:
+            summary = (f"round {rnd}: no candidate passed (BIC, held-out error and interval tests); "
+                       + ("the residual is above the noise floor: the missing effect may not be in the library"
+                          if not E.at_noise_floor(stats, 0.5) else "the residual is near the noise floor"))
+            break
+        passing.sort(key=lambda p: -p["dbic"])
+        best = passing[0]
+        if len(passing) > 1 and best["dbic"] - passing[1]["dbic"] < DELTA_BIC_AMBIGUOUS:
+            other = passing[1]
+            amb = [best["name"], other["name"]]
+            sep = separating_experiment(best["name"], other["name"])
+            for p in passing[:2]:
+                p["entry"]["rejection"] = (f"ambiguous with {other['name'] if p is best else best['name']}: "
+                                           f"BIC differs by {best['dbic'] - other['dbic']:.1f} < "
+                                           f"{DELTA_BIC_AMBIGUOUS:g}")
+            for p in passing[2:]:
+                p["entry"]["rejection"] = f"passed, but BIC improvement {p['dbic']:.1f} below {best['name']}'s"
+            verdict = "ambiguous"
+            summary = f"round {rnd}: ambiguous: {amb[0]} or {amb[1]} explain the records equally well"
+            break
+        best["entry"]["accepted"] = True
+        for p in passing[1:]:
+            p["entry"]["rejection"] = (f"passed, but BIC improvement {p['dbic']:.1f} < {best['name']}'s "
+                                       f"{best['dbic']:.1f}")
+        current, tau = best["rig"], best["tau"]
+        E.refine_x0(current, cases, tau)
+        sims = E.simulate_all(current, cases, tau)
+        g_after = E.gap(sims, cases)
+        history.append((best["name"], g_after))
+        signatures[best["name"]] = best["sc"]["signature"]
+        eff = {"name": best["name"], "doc": LIBRARY[best["name"]].doc,
+               "parameters": best["entry"]["parameters"], "delta_bic": best["dbic"],
+               "heldout_improvement": best["held"], "gap_after": g_after, "round": rnd}
+        if LIBRARY[best["name"]].delays_command:
+            eff["note"] = ("time_delay is not a rig parameter: delay the command by tau (integer + fractional "
+                           "samples) before simulating; rig_updated.toml cannot hold it")
+        effects.append(eff)
+    bar.close()
+
+    gap_after = E.gap(sims, cases)
+    closed = {}
+    for c in gap_before:
+        den = gap_before[c] - floor[c]
+        closed[c] = float(np.clip((gap_before[c] - gap_after[c]) / den, 0.0, 1.0)) if den > 1e-12 else None
+    if verdict is None:
+        verdict = "effect_found" if effects else "no_effect"
+    if not summary:
+        summary = f"stopped after {len(effects)} effect(s)"
+    head = {"effect_found": "missing effect(s): " + ", ".join(e["name"] for e in effects),
+            "no_effect": "no missing effect", "ambiguous": f"ambiguous: {' or '.join(amb)}"}[verdict]
+    if verdict == "ambiguous" and effects:
+        head = "found " + ", ".join(e["name"] for e in effects) + "; then " + head
+    d = Diagnosis(verdict=verdict, effects=effects, gap_before=gap_before, gap_after=gap_after,
+                  candidates=cand_log, rig=current, mode=mode,
+                  records=[c.name for c in cases], noise_floor=floor, gap_closed=closed, gap_where=where,
+                  ambiguous_between=amb, separating_experiment=sep, command_delay=tau,
+                  summary=f"{head}. {summary}", runtime_s=time.time() - t_start)
+    d.plots = {"cases": cases, "sims_before": sims0, "sims_after": sims, "history": history,
+               "signatures": signatures}
+    return d

@@ -1,0 +1,249 @@
+"""Evaluation of the diagnose workflow on records with hidden effects.
+
+    python tests/diagnose_eval/generate.py --out build/diagnose_eval
+    python tests/diagnose_eval/evaluate.py --data build/diagnose_eval --jobs 2
+
+Runs ``sh.diagnose`` on every record of the manifest (the workflow sees only the
+record, the mode and the nominal rig), then, and only then, reads the answer key
+and writes docs/diagnose_eval.md and docs/diagnose_eval.json: naming precision and
+recall, false-positive rate on no-effect records, confusion matrix, parameter
+error and interval coverage, fraction of the gap closed, runtime.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+TARGETS = {"recall_single": 0.90, "false_positive": 0.05, "param_error": 0.20, "gap_closed": 0.80}
+
+
+def run_one(args: tuple[str, str, str, str]) -> dict:
+    rid, record, rig_path, mode = args
+    import servohydraulics as sh
+
+    t0 = time.time()
+    d = sh.diagnose([record], sh.load_rig(rig_path), mode=mode, progress=False)
+    js = d.to_dict()
+    closed = [v for v in js["gap_closed"].values() if v is not None]
+    main = max(js["gap_before"], key=lambda c: js["gap_before"][c] - js["noise_floor"][c])
+    return {"id": rid, "verdict": js["verdict"], "named": [e["name"] for e in js["effects"]],
+            "ambiguous": js["ambiguous_between"],
+            "parameters": [{k: v for k, v in e["parameters"].items()} for e in js["effects"]],
+            "gap_before": js["gap_before"], "gap_after": js["gap_after"], "noise_floor": js["noise_floor"],
+            "gap_closed_main": js["gap_closed"][main], "gap_closed_mean": float(np.mean(closed)) if closed else None,
+            "main_channel": main, "runtime": time.time() - t0}
+
+
+def _frac(a, b) -> float | None:
+    return a / b if b else None
+
+
+def metrics(results: list[dict], key: list[dict]) -> dict:
+    ans = {k["id"]: k for k in key}
+    rows = []
+    for r in results:
+        k = ans[r["id"]]
+        rows.append((r, k))
+    out: dict = {}
+    names = sorted({a["name"] for k in key for a in k["answers"]})
+    for label, sel in (("snr>=30", lambda k: k["snr"] >= 30), ("snr=40", lambda k: k["snr"] == 40),
+                       ("snr=30", lambda k: k["snr"] == 30), ("snr=20", lambda k: k["snr"] == 20),
+                       ("all", lambda k: True)):
+        rs = [(r, k) for r, k in rows if sel(k) and not k["runtime_check"]]
+        singles = [(r, k) for r, k in rs if k["kind"] == "single"]
+        nones = [(r, k) for r, k in rs if k["kind"] == "none"]
+        pairs = [(r, k) for r, k in rs if k["kind"] == "pair"]
+        right = [(r, k) for r, k in singles if r["named"][:1] == [k["answers"][0]["name"]]]
+        right_any = [(r, k) for r, k in singles if k["answers"][0]["name"] in r["named"]]
+        amb = [(r, k) for r, k in singles if r["verdict"] == "ambiguous" and not r["named"]]
+        fp = [(r, k) for r, k in nones if r["named"]]
+        perr, cover = [], []
+        for r, k in right_any:
+            i = r["named"].index(k["answers"][0]["name"])
+            for pk, tv in k["answers"][0]["parameters"].items():
+                p = r["parameters"][i][pk]
+                if p["value"] is not None and tv:
+                    perr.append(abs(p["value"] - tv) / abs(tv))
+                    lo, hi = p["interval_95"]
+                    cover.append(lo is not None and hi is not None and lo <= tv <= hi)
+        closed = [r["gap_closed_main"] for r, k in right_any if r["gap_closed_main"] is not None]
+        pair_both = [(r, k) for r, k in pairs if all(a["name"] in r["named"] for a in k["answers"])]
+        pair_one = [(r, k) for r, k in pairs if any(a["name"] in r["named"] for a in k["answers"])]
+        per_name = {}
+        for n in names:
+            truth_n = [(r, k) for r, k in rs if any(a["name"] == n for a in k["answers"])]
+            named_n = [(r, k) for r, k in rs if n in r["named"]]
+            tp = [(r, k) for r, k in named_n if any(a["name"] == n for a in k["answers"])]
+            per_name[n] = {"recall": _frac(len([1 for r, k in truth_n if n in r["named"]]), len(truth_n)),
+                           "precision": _frac(len(tp), len(named_n)), "n_truth": len(truth_n),
+                           "n_named": len(named_n)}
+        out[label] = {
+            "n_single": len(singles), "n_none": len(nones), "n_pair": len(pairs),
+            "single_right_first": _frac(len(right), len(singles)),
+            "single_right_any": _frac(len(right_any), len(singles)),
+            "single_ambiguous": _frac(len(amb), len(singles)),
+            "false_positive_rate": _frac(len(fp), len(nones)),
+            "param_error_median": float(np.median(perr)) if perr else None,
+            "param_within_20pct": _frac(sum(e <= 0.2 for e in perr), len(perr)),
+            "interval_coverage": _frac(sum(cover), len(cover)),
+            "gap_closed_median": float(np.median(closed)) if closed else None,
+            "gap_closed_at_least_80pct": _frac(sum(c >= 0.8 for c in closed), len(closed)),
+            "pair_both_named": _frac(len(pair_both), len(pairs)), "pair_one_named": _frac(len(pair_one), len(pairs)),
+            "per_name": per_name,
+        }
+    # confusion matrix over single-effect and no-effect records (first name, or verdict)
+    labels = names + ["none"]
+    preds = names + ["no_effect", "ambiguous"]
+    cm = {t: {p: 0 for p in preds} for t in labels}
+    for r, k in rows:
+        if k["kind"] == "pair" or k["runtime_check"]:
+            continue
+        t = k["answers"][0]["name"] if k["answers"] else "none"
+        p = r["named"][0] if r["named"] else ("ambiguous" if r["verdict"] == "ambiguous" else "no_effect")
+        cm[t][p] += 1
+    out["confusion"] = cm
+    rt = [r["runtime"] for r, k in rows if not k["runtime_check"]]
+    out["runtime"] = {"median_s": float(np.median(rt)), "max_s": float(np.max(rt)), "total_s": float(np.sum(rt))}
+    big = [(r, k) for r, k in rows if k["runtime_check"]]
+    if big:
+        r, k = big[0]
+        out["runtime"]["record_10s_2kHz_s"] = r["runtime"]
+        out["runtime"]["record_10s_2kHz_named"] = r["named"]
+    return out
+
+
+def _p(v) -> str:
+    return "-" if v is None else f"{100 * v:.0f} %"
+
+
+def write_doc(m: dict, per: list[dict], key: list[dict], doc: Path, cmd: str, wall: float, jobs: int) -> None:
+    ans = {k["id"]: k for k in key}
+    L = ["# Diagnose: evaluation on hidden effects", "",
+         "Made by (every number below):", "", "```", cmd, "```", "",
+         f"Wall time {wall:.0f} s with {jobs} worker processes. Records: 2 kHz, "
+         f"{key[0]['duration']:g} s each (one extra 10 s record for the runtime check), made by "
+         "`tests/diagnose_eval/independent_plant.py` (plain-Python RK4 of Eqs 1-5, no code shared with the "
+         "core) with white noise on displacement and force. The workflow sees the record, the mode and the "
+         "nominal rig only; the answer key is read after all diagnoses are done.", "",
+         "## Against the targets (SNR >= 30 dB)", "",
+         "| measure | target | measured |", "|---|---|---|"]
+    s = m["snr>=30"]
+    L.append(f"| right name (first effect) on single-effect records | >= 90 % | {_p(s['single_right_first'])} "
+             f"({s['n_single']} records) |")
+    L.append(f"| false positives on no-effect records | <= 5 % | {_p(s['false_positive_rate'])} "
+             f"({s['n_none']} records) |")
+    L.append(f"| fitted parameter within 20 % of truth (right name) | all | {_p(s['param_within_20pct'])} "
+             f"(median error {_p(s['param_error_median'])}) |")
+    L.append(f"| gap closed (main channel, of the part above the noise floor) | >= 80 % | median "
+             f"{_p(s['gap_closed_median'])}; >= 80 % in {_p(s['gap_closed_at_least_80pct'])} of records |")
+    L.append(f"| 95 % interval covers the truth | (report) | {_p(s['interval_coverage'])} |")
+    rt = m["runtime"]
+    L.append(f"| runtime, 10 s 2 kHz record | < 120 s | {rt.get('record_10s_2kHz_s', float('nan')):.1f} s |")
+    s = m["snr>=30"]
+    unmet = []
+    if (s["single_right_first"] or 0) < TARGETS["recall_single"]:
+        unmet.append("right name on single-effect records")
+    if (s["false_positive_rate"] or 0) > TARGETS["false_positive"]:
+        unmet.append(f"false-positive rate ({s['n_none']} no-effect records: one false positive is "
+                     f"{_p(1 / max(s['n_none'], 1))})")
+    if (s["param_within_20pct"] or 0) < 1.0:
+        unmet.append("parameter within 20 % of truth on every correctly named record (see the list below: "
+                     "the misses are effects hidden in forms the library does not have, LuGre/Stribeck friction "
+                     "and the tabulated flow curve, whose 'true' library parameter is a convention, and weak "
+                     "effects at 30 dB)")
+    if (s["gap_closed_at_least_80pct"] or 0) < 1.0:
+        unmet.append("gap closed >= 80 % on every record (the median meets it; the misses are the form-mismatch "
+                     "records, where the library's form cannot reach the noise floor)")
+    if (s["interval_coverage"] or 0) < 0.95:
+        unmet.append("95 % interval coverage (no target; intervals assume the library's form and white residuals "
+                     "after n_eff inflation, and are too narrow when the form differs or the fit is at a bound)")
+    L += ["", "Not met, or met only in part: " + ("; ".join(unmet) if unmet else "none") + "."]
+    L += ["", "Truth for forms outside the library: Stribeck and LuGre friction -> their Coulomb level F_c; "
+          "tabulated flow curve -> the rational b fitting the table best over [0, 2 x the record's peak opening]; "
+          "filter delay -> the Bessel filter's DC group delay."]
+    L += ["", "## By noise level", "",
+          "| SNR | single: right first | right anywhere | ambiguous | false positives | param within 20 % | "
+          "coverage | gap closed (median) | pairs: both named | pairs: one named |",
+          "|---|---|---|---|---|---|---|---|---|---|"]
+    for lab in ("snr=40", "snr=30", "snr=20", "all"):
+        s = m[lab]
+        L.append(f"| {lab} | {_p(s['single_right_first'])} | {_p(s['single_right_any'])} | "
+                 f"{_p(s['single_ambiguous'])} | {_p(s['false_positive_rate'])} | {_p(s['param_within_20pct'])} | "
+                 f"{_p(s['interval_coverage'])} | {_p(s['gap_closed_median'])} | {_p(s['pair_both_named'])} | "
+                 f"{_p(s['pair_one_named'])} |")
+    L += ["", "## Precision and recall per name (all SNR)", "", "| name | recall | precision | records with it | "
+          "times named |", "|---|---|---|---|---|"]
+    for n, v in m["all"]["per_name"].items():
+        L.append(f"| {n} | {_p(v['recall'])} | {_p(v['precision'])} | {v['n_truth']} | {v['n_named']} |")
+    cm = m["confusion"]
+    preds = list(next(iter(cm.values())))
+    short = {p: p.replace("_", " ") for p in preds}
+    L += ["", "## Confusion matrix (single-effect and no-effect records, all SNR; rows: truth, columns: first "
+          "name or verdict)", "", "| truth \\ named | " + " | ".join(short[p] for p in preds) + " |",
+          "|---|" + "---|" * len(preds)]
+    for t, row in cm.items():
+        L.append(f"| {t} | " + " | ".join(str(row[p]) if row[p] else "." for p in preds) + " |")
+    L += ["", f"Runtime per record: median {rt['median_s']:.1f} s, max {rt['max_s']:.1f} s.", "",
+          "## Every record", "", "| id | mode | SNR | hidden (form) | verdict | named | parameter (truth) | gap "
+          "closed |", "|---|---|---|---|---|---|---|---|"]
+    for r in per:
+        k = ans[r["id"]]
+        par = []
+        for a in k["answers"]:
+            if a["name"] in r["named"]:
+                i = r["named"].index(a["name"])
+                for pk, tv in a["parameters"].items():
+                    v = r["parameters"][i][pk]["value"]
+                    par.append(f"{pk} {v:.4g} ({tv:.4g})" if v is not None else f"{pk} - ({tv:.4g})")
+        L.append(f"| {r['id']} | {k['mode']} | {k['snr']} | {'; '.join(k['forms']) or 'none'} | {r['verdict']} | "
+                 f"{', '.join(r['named']) or ('/'.join(r['ambiguous']) if r['ambiguous'] else '-')} | "
+                 f"{'; '.join(par) or '-'} | {_p(r['gap_closed_main'])} |")
+    doc.write_text("\n".join(L) + "\n")
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--data", default="build/diagnose_eval")
+    p.add_argument("--jobs", type=int, default=2)
+    p.add_argument("--doc", default="docs/diagnose_eval.md")
+    p.add_argument("--from-json", action="store_true", help="re-render the doc from the saved JSON (no diagnoses)")
+    a = p.parse_args()
+    data = Path(a.data)
+    doc = Path(a.doc)
+    if a.from_json:
+        saved = json.loads(doc.with_suffix(".json").read_text())
+        key = json.loads((data / "answer_key.json").read_text())
+        write_doc(metrics(saved["records"], key), saved["records"], key, doc, saved["command"], saved["wall_s"],
+                  a.jobs)
+        return
+    manifest = json.loads((data / "manifest.json").read_text())
+    jobs = [(m["id"], str(data / m["record"]), str(data / m["rig"]), m["mode"]) for m in manifest]
+    t0 = time.time()
+    results = []
+    from tqdm import tqdm
+
+    with ProcessPoolExecutor(max_workers=a.jobs) as ex:
+        for r in tqdm(ex.map(run_one, jobs), total=len(jobs), file=sys.stderr, desc="diagnose"):
+            results.append(r)
+    wall = time.time() - t0
+    key = json.loads((data / "answer_key.json").read_text())  # read only now, after every diagnosis
+    m = metrics(results, key)
+    cmd = (f"python tests/diagnose_eval/generate.py --out {a.data}\n"
+           f"python tests/diagnose_eval/evaluate.py --data {a.data} --jobs {a.jobs}")
+    write_doc(m, results, key, doc, cmd, wall, a.jobs)
+    doc.with_suffix(".json").write_text(json.dumps({"metrics": m, "records": results, "command": cmd,
+                                                    "wall_s": wall}, indent=1, default=str))
+    print(f"wrote {doc} ({wall:.0f} s)")
+
+
+if __name__ == "__main__":
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    main()

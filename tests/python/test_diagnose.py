@@ -1,0 +1,157 @@
+"""Diagnose: the contract (API, CLI, files, JSON) and hidden-effect cases end to end.
+
+Records are made by the independent plain-Python simulator of the evaluation
+(tests/diagnose_eval/independent_plant.py), not by the core the workflow uses,
+with measurement noise; the workflow sees only the record, mode and nominal rig.
+The full evaluation (many records, graded strengths, other forms) is
+tests/diagnose_eval/evaluate.py, reported in docs/diagnose_eval.md.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import servohydraulics as sh
+from servohydraulics.cli import main
+from servohydraulics.diagnose import NAMES
+from servohydraulics.records import Record
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "diagnose_eval"))
+import independent_plant as ip  # noqa: E402
+
+DT = 5e-4
+
+
+def _noisy(ch: dict, snr_db: float, seed: int, free: bool = False) -> dict:
+    rng = np.random.default_rng(seed)
+    rec = {"time": ch["time"], "command": ch["command"]}
+    for c in ("displacement", "force"):
+        y = ch[c]
+        rms = float(np.sqrt(np.mean(y ** 2)))
+        rec[c] = y + (0 if (free and c == "force") else rng.normal(0, rms * 10 ** (-snr_db / 20), y.size))
+    return rec
+
+
+def _free_rig() -> sh.Rig:
+    rig = sh.zhao2003(actuator_attached=False)
+    rig.effects.coulomb_friction = False
+    return rig
+
+
+def _linear_rig() -> sh.Rig:
+    rig = sh.zhao2003()
+    for e in ("coulomb_friction", "spring_softening", "load_pressure", "flow_nonlinearity"):
+        setattr(rig.effects, e, False)
+    return rig
+
+
+def _free_record(F_c: float, seed: int = 1) -> dict:
+    n = int(3.0 / DT) + 1
+    tr = replace(ip.Truth(c=1.1e3), friction="coulomb" if F_c > 0 else "none", F_c=F_c)
+    ch = ip.simulate(tr, "free", np.zeros(n), DT, x0=0.013, substeps=4)
+    return _noisy(ch, 30, seed, free=True)
+
+
+def _displacement_record(seed: int = 2, **truth) -> dict:
+    t = np.arange(int(2.0 / DT) + 1) * DT
+    u = np.minimum(t / 0.25, 1) * (0.02 * np.sin(2 * np.pi * 0.8 * t) + 0.004 * np.sin(2 * np.pi * (1 + t) * t))
+    ch = ip.simulate(replace(ip.Truth(), **truth), "displacement", u, DT, substeps=4)
+    return _noisy(ch, 30, seed)
+
+
+@pytest.fixture(scope="module")
+def free_friction(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("rec") / "free.csv"
+    sh.write_record(path, _free_record(95.7))
+    return path
+
+
+def test_free_vibration_friction_is_named_and_fitted(free_friction: Path, tmp_path: Path) -> None:
+    """Fig 2(b): free vibration from 1.3 cm, friction 95.7 N hidden; the model
+    has only viscous damping.  coulomb_friction must be named, F_c within 20 %,
+    the gap must close to near the noise floor, and the files must follow the contract."""
+    d = sh.diagnose([free_friction], _free_rig(), mode="free", progress=False)
+    assert d.verdict == "effect_found"
+    assert d.effects[0]["name"] == "coulomb_friction"
+    p = d.effects[0]["parameters"]["F_c"]
+    assert p["unit"] == "N"
+    assert abs(p["value"] - 95.7) / 95.7 < 0.2
+    assert p["interval_95"][0] < p["value"] < p["interval_95"][1]
+    assert p["interval_95"][0] > 0.0  # excludes "absent"
+    assert d.gap_after["displacement"] < 0.5 * d.gap_before["displacement"]
+    assert d.gap_after["displacement"] < 1.3 * d.noise_floor["displacement"]
+    assert d.rig.effects.coulomb_friction and abs(d.rig.F_c - p["value"]) < 1e-9
+
+    d.write(tmp_path)
+    js = json.loads((tmp_path / "diagnosis.json").read_text())
+    for k in ("verdict", "effects", "gap_before", "gap_after", "candidates"):
+        assert k in js
+    assert {c["name"] for c in js["candidates"]} == set(NAMES)
+    for c in js["candidates"]:
+        assert "score" in c and "rejection" in c
+        assert c["accepted"] == (c["rejection"] is None)
+    assert js["effects"][0]["parameters"]["F_c"]["interval_95"][0] is not None
+    rig = sh.load_rig(tmp_path / "rig_updated.toml")
+    assert rig.effects.coulomb_friction and rig.F_c == pytest.approx(p["value"])
+    report = (tmp_path / "report.md").read_text()
+    assert "coulomb_friction" in report
+    for png in ("residual_before_after.png", "signature.png", "gap_closing.png"):
+        assert (tmp_path / png).stat().st_size > 1000
+
+
+def test_flow_gain_nonlinearity_hidden_in_displacement_record() -> None:
+    """A rational flow curve with b = 1.5 hidden (the model's flow gain is linear)."""
+    rec = Record({k: np.asarray(v) for k, v in _displacement_record(flow="rational", b=1.5).items()})
+    d = sh.diagnose(rec, _linear_rig(), mode="displacement", progress=False)
+    assert d.verdict == "effect_found"
+    assert d.effects[0]["name"] == "flow_gain_nonlinearity"
+    assert abs(d.effects[0]["parameters"]["b"]["value"] - 1.5) / 1.5 < 0.2
+    assert d.gap_after["force"] < 0.5 * d.gap_before["force"]
+
+
+def test_no_effect_record_gives_no_effect() -> None:
+    rec = Record({k: np.asarray(v) for k, v in _displacement_record(seed=5).items()})
+    d = sh.diagnose(rec, _linear_rig(), mode="displacement", progress=False)
+    assert d.verdict == "no_effect"
+    assert d.effects == []
+    assert d.gap_after == d.gap_before
+
+
+def test_cli_end_to_end(free_friction: Path, tmp_path: Path, capsys) -> None:
+    rig = tmp_path / "nominal.toml"
+    sh.save_rig(_free_rig(), rig)
+    out = tmp_path / "out"
+    rc = main(["diagnose", str(free_friction), "--rig", str(rig), "--mode", "free", "--out", str(out), "--quiet"])
+    assert rc == 0
+    assert "coulomb_friction" in capsys.readouterr().out
+    js = json.loads((out / "diagnosis.json").read_text())
+    assert js["verdict"] == "effect_found" and js["effects"][0]["name"] == "coulomb_friction"
+
+
+def test_csv_errors(tmp_path: Path, capsys) -> None:
+    rig = tmp_path / "nominal.toml"
+    sh.save_rig(_free_rig(), rig)
+    bad = tmp_path / "nonuniform.csv"
+    bad.write_text("time,command,displacement,force\n0,0,0.01,0\n0.0005,0,0.01,0\n0.0015,0,0.01,0\n"
+                   "0.002,0,0.01,0\n")
+    rc = main(["diagnose", str(bad), "--rig", str(rig), "--mode", "free", "--out", str(tmp_path / "o"), "--quiet"])
+    assert rc == 2
+    assert "uniform" in capsys.readouterr().err
+    missing = tmp_path / "missing.csv"
+    missing.write_text("time,command,displacement\n0,0,0\n0.0005,0,0\n")
+    with pytest.raises(ValueError, match="force"):
+        sh.diagnose([missing], _free_rig(), mode="free", progress=False)
+    with pytest.raises(FileNotFoundError):
+        sh.diagnose([tmp_path / "nope.csv"], _free_rig(), mode="free", progress=False)
+    ok = tmp_path / "ok.csv"
+    sh.write_record(ok, _free_record(0.0))
+    with pytest.raises(ValueError, match="mode"):
+        sh.diagnose([ok], _free_rig(), mode="velocity", progress=False)
+    with pytest.raises(ValueError, match="candidate"):
+        sh.diagnose([ok], _free_rig(), mode="free", candidates=["magic"], progress=False)
