@@ -46,6 +46,7 @@ void expose_plant(py::module_& m) {
       .def_readwrite("max_steps_per_sample", &SolverOptions::max_steps_per_sample)
       .def_readwrite("max_internal_step", &SolverOptions::max_internal_step)
       .def_readwrite("rk4_substeps", &SolverOptions::rk4_substeps)
+      .def_readwrite("rk4_h_rho", &SolverOptions::rk4_h_rho)
       .def("validate", &SolverOptions::validate);
 
   py::class_<Status> st(m, "Status");
@@ -114,6 +115,7 @@ void expose_plant(py::module_& m) {
              return o;
            })
       .def_property_readonly("time", &Plant::time)
+      .def_property_readonly("rk4_substeps", &Plant::rk4_substeps)
       .def_property_readonly("dt", &Plant::dt)
       .def_property_readonly("state", &Plant::state)
       .def_property_readonly("dynamics", &Plant::dynamics, py::return_value_policy::reference_internal)

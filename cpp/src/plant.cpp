@@ -8,6 +8,8 @@
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -32,7 +34,9 @@ void SolverOptions::validate() const {
   require(max_steps_per_sample >= 1, "max_steps_per_sample", static_cast<double>(max_steps_per_sample), "must be >= 1");
   require(std::isfinite(max_internal_step) && max_internal_step >= 0.0, "max_internal_step", max_internal_step,
           "must be finite and >= 0 (0 = no limit)");
-  require(rk4_substeps >= 1, "rk4_substeps", rk4_substeps, "must be >= 1");
+  require(rk4_substeps >= 0, "rk4_substeps", rk4_substeps, "must be >= 1, or 0 for automatic");
+  require(std::isfinite(rk4_h_rho) && rk4_h_rho > 0.0 && rk4_h_rho <= 2.5, "rk4_h_rho", rk4_h_rho,
+          "must be in (0, 2.5] (RK4 is unstable past |h lambda| ~ 2.8)");
 }
 
 namespace {
@@ -78,6 +82,7 @@ struct Plant::Impl {
     require(std::isfinite(dt) && dt > 0.0, "dt", dt, "controller sample time must be finite and > 0 [s]");
     opt.validate();
     if (opt.method == SolverOptions::Method::CvodeBdf) setup_cvode();
+    else if (opt.rk4_substeps == 0) opt.rk4_substeps = automatic_substeps();
   }
   ~Impl() { free_cvode(); }
 
@@ -118,6 +123,21 @@ struct Plant::Impl {
     check_flag(CVodeSetStopTime(cvode, dt), "CVodeSetStopTime");
     sunrealtype tret = 0.0;
     check_flag(CVode(cvode, dt, nv, &tret, CV_ONE_STEP), "CVode (priming step)");
+  }
+  // Fewest RK4 substeps that keep h * rho(J) within the bound at the equilibrium,
+  // where the regularised friction is steepest (the slope of tanh peaks at v = 0).
+  int automatic_substeps() const {
+    const State y0 = dyn.equilibrium(0.0);
+    Jacobian J;
+    dyn.jacobian(y0.data(), {}, J);
+    Eigen::Matrix<double, kNumStates, kNumStates> A;
+    for (int i = 0; i < kNumStates; ++i)
+      for (int j = 0; j < kNumStates; ++j) A(i, j) = J[i][j];
+    const double rho = A.eigenvalues().cwiseAbs().maxCoeff();
+    const double n = std::ceil(dt * rho / opt.rk4_h_rho);
+    require(std::isfinite(n) && n <= 100000.0, "rk4_substeps (automatic)", n,
+            "the plant is too stiff for a fixed-step integrator at this dt: use CVODE");
+    return std::max(1, static_cast<int>(n));
   }
   void free_cvode() {
     if (cvode) CVodeFree(&cvode);
@@ -291,6 +311,9 @@ double Plant::dt() const noexcept { return impl_->dt; }
 const State& Plant::state() const noexcept { return impl_->y; }
 const Dynamics& Plant::dynamics() const noexcept { return impl_->dyn; }
 const SolverOptions& Plant::options() const noexcept { return impl_->opt; }
+int Plant::rk4_substeps() const noexcept {
+  return impl_->opt.method == SolverOptions::Method::Rk4 ? impl_->opt.rk4_substeps : 0;
+}
 
 long Plant::total_internal_steps() const noexcept {
   long ns = 0;

@@ -592,7 +592,7 @@ def section_eft(ctx: Context) -> None:
     """Effective force testing with the test-method loop (methods.run_eft): Figs 3(b), 4(a-c) and
     the EFT delay-compensation statements (p. 1782)."""
     rig = ctx.rig
-    f_n = an.natural_frequency(rig) / TWO_PI
+    f_n = an.natural_frequency(rig, an.moving_mass(rig)) / TWO_PI  # structure + piston, attached
     flow_linear = _with_effects(rig, flow_nonlinearity=False)
     lin = _with_effects(rig, flow_nonlinearity=False, load_pressure=False, coulomb_friction=False,
                         spring_softening=False)
@@ -753,7 +753,7 @@ def section_rpsd(ctx: Context) -> None:
     k = rig.k
     w_n = math.sqrt(k / M_M)
     z_model = C_M / (2.0 * math.sqrt(k * M_M))
-    ramp, hold, free, fit = 5.0, 1.0, 20.0, 4.0
+    ramp, hold, free, fit = 5.0, 1.0, 25.0, 4.0
     x_rel = 0.016  # release displacement of Fig 9 [m]
     pe = ex.ramp_and_release(k * x_rel, ramp, hold, free, dt=DT)
     i0 = ex.release_index(ramp, hold, dt=DT)
@@ -841,7 +841,9 @@ def section_rpsd(ctx: Context) -> None:
                          f"{100 * z_model:.2f} %", f"zeta = {100 * fv_a.damping_ratio:.3f} %, f_d = "
                          f"{fv_a.frequency:.4f} Hz; max |x_calc - exact| = {100 * e_calc:.4f} % of 16 mm",
                          "+-0.05 percentage point of c_m / (2 sqrt(k m_m))", 100 * fv_a.damping_ratio,
-                         100 * z_model - 0.05, 100 * z_model + 0.05, paper_value=100 * z_model))
+                         100 * z_model - 0.05, 100 * z_model + 0.05,
+                         "with calculated displacements the solver runs open loop, so this checks the loop's "
+                         "wiring and the central-difference solver against the closed form", 100 * z_model))
     amp_ratio = fv_meas.amplitude / fv_a.amplitude
     lag = ((np.angle(np.sum(res_a.calc_displacement[i0:i0 + 8000] * np.exp(-1j * 2 * math.pi * fv_a.frequency
                                                                               * ta[:8000])))
@@ -859,18 +861,21 @@ def section_rpsd(ctx: Context) -> None:
         s = (tr >= a) & (tr < b)
         return float(np.max(np.abs(x[s])))
 
-    def growth(res):
+    def growth(res, start=10.0):
         x = res.calc_displacement
-        return envelope(x, 15, 20) / envelope(x, 10, 15), envelope(x, 10, 20)
+        return envelope(x, start + 5, start + 10) / envelope(x, start, start + 5)
 
-    g_err, a_err = growth(runs["err"][0])
-    g_no, _ = growth(runs[T_LD][0])
-    g_zero_err, a_zero_err = growth(runs["zero_err"][0])
-    g_zero, _ = growth(runs["zero"][0])
+    g_err, g_no = growth(runs["err"][0]), growth(runs[T_LD][0])
+    g_zero_err, g_zero = growth(runs["zero_err"][0]), growth(runs["zero"][0])
+    g_late = growth(runs["zero_err"][0], 15.0)
+    a_late = envelope(runs["zero_err"][0].calc_displacement, 20.0, 25.0)
+    a_late_no = envelope(runs["zero"][0].calc_displacement, 20.0, 25.0)
     z_zero = runs["zero"][1].damping_ratio
     a_ss = 30.0 / (2 * max(z_zero, 1e-9) * k)
-    ctx.rows.append(_row("fig9b_error_11ms", "9b", "a restoring-force error 0.03 sin(w_n t - pi/2) kN (from release) "
-                         "makes the amplitude constant after 10 s, T_ld = 11.2 ms", "constant amplitude after 10 s",
+    a_10 = x_rel * math.exp(-z_zero * w_n * 10.0)
+    ctx.rows.append(_row("fig9b_error_11ms", "9b", "a restoring-force error 0.03 sin(w_n t - pi/2) kN makes the "
+                         "amplitude constant after 10 s (T_ld = 11.2 ms; t and the 10 s counted from release)",
+                         "constant amplitude after 10 s",
                          f"envelope ratio 15-20 s / 10-15 s after release = {g_err:.3g} with the error, "
                          f"{g_no:.3g} without: {'grows' if g_err > 1.25 else 'bounded'} "
                          f"({'; '.join(runs['err'][0].warnings[:1]) or 'no limits reached'})",
@@ -880,11 +885,16 @@ def section_rpsd(ctx: Context) -> None:
     ctx.rows.append(_row("fig9b_error_equivalent", "9b", "the same error with the delay compensation that gives "
                          f"our loop the paper's near-model damping (T_ld = {1e3 * T_zero:.1f} ms, zero residual "
                          "phase at 1.58 Hz)", "constant amplitude after 10 s",
-                         f"envelope ratio {g_zero_err:.3f} with the error, {g_zero:.3f} without (zeta "
-                         f"{100 * z_zero:+.2f} %); amplitude {1e3 * a_zero_err:.2f} mm vs steady state 30 N / "
-                         f"(2 zeta k) = {1e3 * a_ss:.2f} mm", "ratio within 0.8-1.25 (and < 0.8 without the error)",
-                         g_zero_err if g_zero < 0.8 else math.nan, 0.8, 1.25,
-                         "a resonant force error holds the amplitude at F/(2 zeta k), whatever its phase"))
+                         f"envelope ratio 15-20 s / 10-15 s = {g_zero_err:.2f} with the error ({g_zero:.2f} "
+                         f"without, zeta {100 * z_zero:+.2f} %); 20-25 s / 15-20 s = {g_late:.2f}, amplitude "
+                         f"{1e3 * a_late:.2f} mm at 20-25 s ({1e3 * a_late_no:.2f} mm without the error) vs "
+                         f"steady state 30 N / (2 zeta k) = {1e3 * a_ss:.2f} mm", "ratio within 0.8-1.25",
+                         g_zero_err, 0.8, 1.25,
+                         "the mechanism is confirmed (a force error at the structure's frequency sustains an "
+                         "amplitude of order F/(2 zeta k), whatever its phase) but not the timing: from 16 mm at zeta "
+                         f"{100 * z_zero:.2f} % the free decay is still {1e3 * a_10:.2f} mm at 10 s, above the "
+                         f"{1e3 * a_ss:.2f} mm the error sustains. The same holds for any zeta near the model's "
+                         "2.48 %; the paper's time origin in Fig 9b is not stated"))
 
     # Fig 10(a): load-cell force vs restoring force k x, calculated displacements (Fig 9a test).
     s = (tr >= 0) & (tr < fit)
@@ -1007,15 +1017,16 @@ def section_table1(ctx: Context) -> None:
                          "printed K_a needs 5.7x the swept volume: rejected (docs/calibration.md s. 1)"))
 
 
+#: sections in the table's order (the paper's figure order); each is independent of the others
 SECTIONS: dict[str, Callable[[Context], None]] = {
     "structure": section_structure,
     "force": section_force,
+    "eft": section_eft,
     "displacement": section_displacement,
     "gain_bound": section_gain_bound,
     "rpsd_linear": section_rpsd_linear,
-    "table1": section_table1,
-    "eft": section_eft,
     "rpsd": section_rpsd,
+    "table1": section_table1,
 }
 
 

@@ -73,7 +73,7 @@ class SimulationResult:
 
 
 def solver_options(method: str = "cvode", rtol: float = 1e-6, restart: str = "on_input_change",
-                   rk4_substeps: int = 4, max_steps_per_sample: int = 2000,
+                   rk4_substeps: int = 0, max_steps_per_sample: int = 2000,
                    max_order: int = 5) -> _core.SolverOptions:
     """Builds solver options; see ``SolverOptions`` in plant.hpp."""
     if method not in METHODS:

@@ -54,7 +54,7 @@ __all__ = ["summary_run", "sweep", "grid_points", "monte_carlo_points"]
 
 def summary_run(rig: Rig, mode: str = "displacement", command: np.ndarray | None = None,
                 amplitude: float = 0.01, frequency: float = 1.0, duration: float = 2.0, dt: float = 5e-4,
-                method: str = "cvode", rtol: float = 1e-6, rk4_substeps: int = 4,
+                method: str = "cvode", rtol: float = 1e-6, rk4_substeps: int = 0,
                 keep_record: bool = False) -> dict[str, Any]:
     """The default run of a sweep: simulates the rig and returns summary metrics.
 

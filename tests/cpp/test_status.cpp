@@ -191,8 +191,11 @@ void setup_errors() {
   o.max_steps_per_sample = 0;
   CHECK(contains(error_of([&] { Plant p(good, ControlMode::Displacement, kDt, o); }), "invalid max_steps_per_sample = 0"));
   o = SolverOptions{};
-  o.rk4_substeps = 0;
-  CHECK(contains(error_of([&] { Plant p(good, ControlMode::Displacement, kDt, o); }), "invalid rk4_substeps = 0"));
+  o.rk4_substeps = -1;
+  CHECK(contains(error_of([&] { Plant p(good, ControlMode::Displacement, kDt, o); }), "invalid rk4_substeps = -1"));
+  o = SolverOptions{};
+  o.rk4_h_rho = 3.0;
+  CHECK(contains(error_of([&] { Plant p(good, ControlMode::Displacement, kDt, o); }), "invalid rk4_h_rho = 3"));
   Rig gd = good;
   gd.G_d = 0.01;
   CHECK(contains(error_of([&] { Dynamics d(gd, ControlMode::Force); }), "invalid G_d = 0.01"));

@@ -118,7 +118,11 @@ struct SolverOptions {
   int max_order = 5;                  //!< BDF maximum order
   long max_steps_per_sample = 2000;   //!< cap on CVODE internal steps in one step(); then TooMuchWork
   double max_internal_step = 0.0;     //!< CVODE hmax [s], 0 = no limit
-  int rk4_substeps = 4;               //!< Rk4: substeps per controller sample
+  //! Rk4: substeps per controller sample; 0 = automatic: the fewest with
+  //! h * rho(J) <= rk4_h_rho, rho the spectral radius of the Jacobian at the
+  //! equilibrium (where friction is steepest), chosen at construction.
+  int rk4_substeps = 0;
+  double rk4_h_rho = 1.0;             //!< Rk4 automatic substeps: bound on h * rho(J) (stability limit ~2.8)
 
   void validate() const;
 };
@@ -172,6 +176,8 @@ class Plant {
   const State& state() const noexcept;
   const Dynamics& dynamics() const noexcept;
   const SolverOptions& options() const noexcept;
+  //! Rk4 substeps per sample in use (resolved if automatic); 0 for CVODE.
+  int rk4_substeps() const noexcept;
 
   //! Totals since construction/reset.
   long total_internal_steps() const noexcept;

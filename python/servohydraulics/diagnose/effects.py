@@ -29,6 +29,8 @@ class Param:
     unit: str
     rig_key: str  #: "section.key" in a rig file, or a note for non-rig parameters
     reciprocal: bool = False  #: fitted as 1/value, so that "absent" (an infinite value) is 0
+    #: its 95 % interval is tested against "absent" (False for shape parameters that mean nothing on their own)
+    tests_absent: bool = True
 
 
 @dataclass
@@ -71,6 +73,8 @@ class Candidate:
     exercised: Callable[[Context], str | None] = field(default=lambda ctx: None)
     #: True if the parameter is a delay applied to the command
     delays_command: bool = False
+    #: which parameters are fitted in this context (default all); the others stay at "absent"
+    active: Callable[[Context], tuple[bool, ...]] | None = None
 
 
 INTERACT_SPAN = 0.25  #: bounded re-fit of interacting nominal parameters: +-25 % of the current value
@@ -114,15 +118,37 @@ def _apply_load_pressure(rig: Rig, th: np.ndarray) -> Rig:
     return r
 
 
+#: openings of the table that represents a knee-rational flow curve: dense near the knee
+_FLOW_GRID = np.array([(i / 24) ** 2 for i in range(25)])
+
+
+def knee_flow_curve(g_1: float, x_k: float) -> tuple[list[float], list[float]]:
+    """The flow curve family of ``flow_gain_nonlinearity`` as a table (opening, flow):
+    linear g(x) = x up to the knee x_k (the paper's "constant initial gain" below
+    about 10 % opening, p. 1780), then bending rationally to the full-opening flow
+    ratio g(1) = g_1:  g(x) = x_k + (x - x_k) / (1 + beta (x - x_k)) with beta set by
+    g(1) = g_1.  x_k = 0 is the rational curve x / (1 + b x) with g_1 = 1 / (1 + b);
+    x_k = 0.1, g_1 = 0.56 is the preset's curve (zhao2003_flow_curve) within 0.005."""
+    x_k = float(min(max(x_k, 0.0), 0.5))
+    g_1 = float(min(max(g_1, x_k + 0.02), 1.0))
+    beta = ((1.0 - x_k) / (g_1 - x_k) - 1.0) / (1.0 - x_k)
+    s = x_k + (1.0 - x_k) * _FLOW_GRID
+    g = np.where(s <= x_k, s, x_k + (s - x_k) / (1.0 + beta * (s - x_k)))
+    opening = [0.0] + [float(v) for v in s if v > 0.0]
+    flow = [0.0] + [float(v) for v, o in zip(g, s) if o > 0.0]
+    return opening, flow
+
+
 def _apply_flow(rig: Rig, th: np.ndarray) -> Rig:
+    # theta = (g_1, x_k): full-opening flow ratio [-], knee (linear limit) [-]
     r = _copy(rig)
-    b = float(max(th[0], 0.0))
-    if b <= 0.0:
+    g_1, x_k = float(th[0]), float(th[1])
+    if g_1 >= 1.0 - 1e-12:
         r.effects.flow_nonlinearity = False
         return r
     fc = r.flow_curve
-    fc.kind = type(fc.kind).Rational
-    fc.b = b
+    fc.kind = type(fc.kind).Table
+    fc.opening, fc.flow = knee_flow_curve(g_1, x_k)
     r.flow_curve = fc
     r.effects.flow_nonlinearity = True
     return r
@@ -196,9 +222,18 @@ def _load_pressure_absent(ctx: Context) -> np.ndarray:
 
 
 def _flow_absent(ctx: Context) -> np.ndarray:
-    fc = ctx.rig.flow_curve
-    on = ctx.rig.effects.flow_nonlinearity and fc.kind == type(fc.kind).Rational
-    return _a(fc.b if on else 0.0)
+    # the current model's full-opening flow ratio (1: linear), knee 0 (the rational member)
+    on = ctx.rig.effects.flow_nonlinearity
+    return _a(float(ctx.rig.flow_curve.eval(1.0)) if on else 1.0, 0.0)
+
+
+def _flow_active(ctx: Context) -> tuple[bool, ...]:
+    # the knee is fitted only when the record opens the spool well beyond any plausible knee
+    # (2 x 7.5 %); below that a knee and a curvature cannot be told apart and x_k stays 0
+    return (True, ctx.peak_spool > FLOW_KNEE_MIN_OPENING)
+
+
+FLOW_KNEE_MIN_OPENING = 0.15  #: peak spool opening above which the knee x_k is fitted [-]
 
 
 def _spool_absent(ctx: Context) -> np.ndarray:
@@ -296,14 +331,16 @@ def build_library() -> dict[str, Candidate]:
                      "at low force and high velocity: load pressure acts on the first, the flow curve on the second",
         ),
         Candidate(
-            "flow_gain_nonlinearity", (Param("b", "-", "servovalve.flow_curve.b (rational, "
-                                                       "effects.flow_nonlinearity on)"),),
-            "flow gain falling with spool opening, g(x) = x/(1+b|x|) (the Fig 4a curve)",
+            "flow_gain_nonlinearity",
+            (Param("g_1", "-", "servovalve.flow_curve (table built from g_1 and x_k; effects.flow_nonlinearity on)"),
+             Param("x_k", "-", "servovalve.flow_curve: the knee (linear below it)", tests_absent=False)),
+            "flow gain falling with spool opening (the Fig 4a curve): linear up to the knee x_k, then bending "
+            "to the full-opening flow ratio g(1) = g_1 = Q(x_v = 1) / K_v",
             absent=_flow_absent,
-            bounds=lambda ctx: (_a(0.0), _a(20.0)),
-            probe=lambda ctx: _flow_absent(ctx) + max(0.5, 0.1 / max(ctx.peak_spool, 1e-3)),
+            bounds=lambda ctx: (_a(0.1, 0.0), _a(1.0, 0.3)),
+            probe=lambda ctx: _a(1.0 / (1.0 + max(0.5, 0.1 / max(ctx.peak_spool, 1e-3))), 0.1),
             apply=_apply_flow, interacts=(("K_v", "m^3/s"),), modes=("displacement", "force"),
-            exercised=_spool_exercised,
+            exercised=_spool_exercised, active=_flow_active,
             separate="a test at large spool opening with little load (fast, low force): the flow curve acts there, "
                      "load pressure does not",
         ),

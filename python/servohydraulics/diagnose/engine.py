@@ -268,21 +268,28 @@ class Space:
 
     def __post_init__(self) -> None:
         c = self.cand
-        self.n_main = len(c.params)
-        rec = [p.reciprocal for p in c.params] + [False] * len(self.interacting)
-        self.rec = np.array(rec)
+        mask = np.asarray(c.active(self.ctx) if c.active is not None else [True] * len(c.params), bool)
+        self.main_idx = np.flatnonzero(mask)
+        self.params = tuple(c.params[i] for i in self.main_idx)
+        self.full_absent = np.asarray(c.absent(self.ctx), float)  #: every own parameter, external units
+        self.n_main = len(self.params)
+        rec = [p.reciprocal for p in self.params] + [False] * len(self.interacting)
+        self.rec = np.array(rec, bool)
         lo, hi = c.bounds(self.ctx)
+        lo, hi = np.asarray(lo, float)[self.main_idx], np.asarray(hi, float)[self.main_idx]
         cur = np.array([getattr(self.ctx.rig, k) for k, _ in self.interacting], float)
         ext_lo = np.concatenate([lo, cur * (1 - INTERACT_SPAN)])
         ext_hi = np.concatenate([hi, cur * (1 + INTERACT_SPAN)])
         self.lo = np.where(self.rec, np.where(ext_hi >= 1e9, 0.0, 1.0 / ext_hi), ext_lo)
         self.hi = np.where(self.rec, 1.0 / np.maximum(ext_lo, 1e-300), ext_hi)
-        self.absent = self.to_internal(np.concatenate([c.absent(self.ctx), cur]))
-        probe = self.to_internal(np.concatenate([c.probe(self.ctx), cur]))
+        self.absent = self.to_internal(np.concatenate([self.full_absent[self.main_idx], cur]))
+        probe = self.to_internal(np.concatenate([np.asarray(c.probe(self.ctx), float)[self.main_idx], cur]))
         self.probe = np.clip(probe, self.lo, self.hi)
         step = np.abs(self.probe - self.absent)
         self.scale = np.where(np.arange(step.size) < self.n_main, np.maximum(step, 1e-12),
                               np.maximum(np.abs(cur) * 0.1, 1e-30) if cur.size else 1.0)
+        #: own parameters whose interval is tested against "absent"
+        self.tests_absent = np.array([p.tests_absent for p in self.params] + [False] * len(self.interacting), bool)
 
     def to_internal(self, ext: np.ndarray) -> np.ndarray:
         ext = np.asarray(ext, float)
@@ -296,7 +303,8 @@ class Space:
 
     def rig_and_tau(self, z: np.ndarray, base_tau: float) -> tuple[Rig, float]:
         ext = self.to_external(z)
-        main = ext[: self.n_main]
+        main = self.full_absent.copy()
+        main[self.main_idx] = ext[: self.n_main]
         if self.cand.delays_command:
             rig, tau = self.ctx.rig, base_tau + float(main[0])
         else:
@@ -387,19 +395,57 @@ def fit(space: Space, cases: list[Case], z0: np.ndarray, base_tau: float, which:
     return res.x, res
 
 
-def intervals(space: Space, res, stats: dict) -> tuple[np.ndarray, np.ndarray]:
-    """95 % intervals (fitting coordinates) from the Gauss-Newton covariance,
-    inflated by n / n_eff for autocorrelated residuals."""
+def series_lengths(cases: list[Case], which: str = "all") -> list[int]:
+    """Lengths of the (record, channel) series stacked by ``residuals``, in order."""
+    out = []
+    for case in cases:
+        m = {"all": case.t.size, "train": int(case.train.sum()), "test": int((~case.train).sum())}[which]
+        out += [m] * len(case.meas)
+    return out
+
+
+def bartlett_bandwidth(e: np.ndarray) -> int:
+    """Newey-West lag truncation for a series from the AR(1) plug-in rule of
+    Andrews (1991) for the Bartlett kernel: 1.1447 (alpha n)^(1/3), alpha =
+    4 rho^2 / ((1 - rho)^2 (1 + rho)^2), rho the lag-1 autocorrelation; at most n/2."""
+    n = e.size
+    e0 = e - e.mean()
+    den = float(e0 @ e0)
+    rho = float(e0[1:] @ e0[:-1] / den) if den > 0 else 0.0
+    rho = min(max(rho, 0.0), 0.999)
+    alpha = 4 * rho ** 2 / ((1 - rho) ** 2 * (1 + rho) ** 2)
+    return int(min(max(math.ceil(1.1447 * (alpha * n) ** (1 / 3)), 1), n // 2))
+
+
+def intervals(space: Space, res, lengths: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """95 % intervals (fitting coordinates) from the heteroscedasticity- and
+    autocorrelation-consistent (Newey-West) sandwich covariance of the
+    least-squares estimate: (J'J)^-1 Omega (J'J)^-1, Omega the long-run covariance
+    of the scores J_t r_t with Bartlett weights, summed over the (record,
+    channel) series (no lag crosses two series), bandwidth per series from
+    ``bartlett_bandwidth``.  J is the fit's finite-difference Jacobian of the
+    normalised residuals r."""
     J = res.jac
     r = res.fun
     n, p = J.shape
-    s2 = float(r @ r) / max(n - p, 1)
-    ne = sum(n_eff(stats).values())
-    infl = max(n / ne, 1.0)
     D = np.maximum(np.abs(space.scale), 1e-300)  # column scaling: parameters differ by 10 orders of magnitude
     Js = J * D
+    omega = np.zeros((p, p))
+    a = 0
+    for m in lengths:
+        S = Js[a:a + m] * r[a:a + m, None]
+        L = bartlett_bandwidth(r[a:a + m])
+        nfft = 1 << int(math.ceil(math.log2(2 * m)))
+        F = np.fft.rfft(S, n=nfft, axis=0)
+        # C[l, i, j] = sum_t S[t + l, i] S[t, j], every lag at once
+        C = np.fft.irfft(F[:, :, None] * np.conj(F[:, None, :]), n=nfft, axis=0)[: L + 1]
+        w = 1.0 - np.arange(1, L + 1) / (L + 1)
+        G = np.einsum("l,lij->ij", w, C[1:])
+        omega += C[0] + G + G.T
+        a += m
     try:
-        cov = np.linalg.pinv(Js.T @ Js, rcond=1e-12) * s2 * infl
+        B = np.linalg.pinv(Js.T @ Js, rcond=1e-12)
+        cov = B @ omega @ B
         sd = D * np.sqrt(np.maximum(np.diag(cov), 0.0))
     except np.linalg.LinAlgError:
         sd = np.full(p, np.inf)

@@ -22,7 +22,7 @@ from .effects import LIBRARY, Context, _copy, separating_experiment
 
 #: acceptance thresholds (documented in docs/diagnose.md)
 DELTA_BIC_MIN = 10.0  #: "very strong" evidence on the Kass-Raftery scale
-DELTA_BIC_AMBIGUOUS = 6.0  #: two passing candidates closer than this are "equally good"
+DELTA_FIT_AMBIGUOUS = 6.0  #: two passing candidates whose fits (-2 log L) differ by less are "equally good"
 HELDOUT_MIN = 0.02  #: held-out SSR must fall by at least 2 %
 KEEP = 3  #: candidates kept by screening for the full fit
 MAX_EFFECTS = 3
@@ -133,7 +133,7 @@ def _param_report(space: E.Space, z: np.ndarray, lo: np.ndarray, hi: np.ndarray)
     elo, ehi = space.to_external(lo), space.to_external(hi)
     absent = space.to_external(space.absent)
     out = {}
-    keys = [(p.key, p.unit, p.rig_key) for p in space.cand.params] + \
+    keys = [(p.key, p.unit, p.rig_key) for p in space.params] + \
            [(k, u, "re-fitted nominal parameter") for k, u in space.interacting]
     for i, (key, unit, where) in enumerate(keys):
         a, b = (ehi[i], elo[i]) if space.rec[i] else (elo[i], ehi[i])
@@ -145,6 +145,47 @@ def _param_report(space: E.Space, z: np.ndarray, lo: np.ndarray, hi: np.ndarray)
 
 def _num(v: float) -> float | None:
     return float(v) if math.isfinite(v) else None
+
+
+def _fit_space(space: E.Space, z0: np.ndarray, cases: list, stats: dict, base_test: dict, tau: float,
+               neff_ref: dict | None = None) -> dict:
+    """Train-segment fit (held-out improvement), then the fit on all data, its BIC
+    improvement over the current model and its HAC 95 % intervals."""
+    z_tr, _ = E.fit(space, cases, z0, tau, "train")
+    rig_tr, tau_tr = space.rig_and_tau(z_tr, tau)
+    test = E.channel_stats(E.simulate_all(rig_tr, cases, tau_tr), cases, "test")
+    held = 1.0 - sum(s["ssr"] for s in test.values()) / sum(s["ssr"] for s in base_test.values())
+    z, res = E.fit(space, cases, z_tr, tau, "all", max_nfev=12)
+    rig_c, tau_c = space.rig_and_tau(z, tau)
+    sims_c = E.simulate_all(rig_c, cases, tau_c)
+    st_c = E.channel_stats(sims_c, cases)
+    neff = neff_ref if neff_ref is not None else E.n_eff(st_c)
+    dbic = E.bic(stats, 0, neff) - E.bic(st_c, z.size, neff)
+    lo, hi = E.intervals(space, res, E.series_lengths(cases))
+    return {"space": space, "z": z, "z_tr": z_tr, "lo": lo, "hi": hi, "rig": rig_c, "tau": tau_c,
+            "sims": sims_c, "stats": st_c, "neff": neff, "dbic": dbic, "held": held}
+
+
+def _confirm(space: E.Space, z0: np.ndarray, cases: list, stats: dict, base_test: dict, tau: float, ctx: Context,
+             refit_interacting: bool, current: Rig) -> dict:
+    """Fits the candidate alone, then (if it has interacting nominal parameters and
+    ``refit_interacting``) with the bounded +-25 % re-fit of them, started from the
+    first fit; keeps the re-fit only if it improves the BIC (same effective sample
+    sizes for both)."""
+    alone = E.Space(space.cand, ctx, ())
+    a = _fit_space(alone, z0[: alone.n_main], cases, stats, base_test, tau)
+    a["refit"] = {"tried": False, "kept": False}
+    inter = space.interacting if refit_interacting else ()
+    if not inter:
+        return a
+    z1 = np.concatenate([a["z_tr"], space.absent[space.n_main:]])
+    b = _fit_space(space, z1, cases, stats, base_test, tau, neff_ref=a["neff"])
+    keep = b["dbic"] > a["dbic"]
+    info = {"tried": True, "kept": bool(keep), "parameters": [k for k, _ in inter],
+            "delta_bic_with": b["dbic"], "delta_bic_without": a["dbic"]}
+    out = b if keep else a
+    out["refit"] = info
+    return out
 
 
 def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = True,
@@ -162,8 +203,9 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
         keep: candidates kept by screening for the full simulation fit.
         max_effects: most effects added greedily.
         candidates: restrict the library (names); default all.
-        refit_interacting: allow a bounded (+-25 %) re-fit of the nominal
-            parameters each effect interacts with.
+        refit_interacting: try a bounded (+-25 %) re-fit of the nominal
+            parameters each effect interacts with; it is kept only if it
+            improves the BIC.
 
     Returns:
         A ``Diagnosis`` (``.write(dir)`` writes diagnosis.json, rig_updated.toml, report.md).
@@ -212,7 +254,6 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
                       peak_pressure=max(float(np.max(np.abs(s["pressure"]))) for s in sims),
                       peak_x=x_peak, rms_v=float(np.mean([c.derived["rms_v"] for c in cases])))
         r0 = E.residuals(sims, cases)
-        base_train = E.channel_stats(sims, cases, "train")
         base_test = E.channel_stats(sims, cases, "test")
         bar.set_description_str(f"round {rnd}: screening")
         screened = []
@@ -261,26 +302,15 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
             bar.set_description_str(f"round {rnd}: fitting {nme}")
             bar.update(1)
             t_fit = time.time()
-            z_tr, res_tr = E.fit(space, cases, sc["z0"], tau, "train")
-            rig_tr, tau_tr = space.rig_and_tau(z_tr, tau)
-            sims_tr = E.simulate_all(rig_tr, cases, tau_tr)
-            test = E.channel_stats(sims_tr, cases, "test")
-            ssr_test_base = sum(s["ssr"] for s in base_test.values())
-            ssr_test = sum(s["ssr"] for s in test.values())
-            held = 1.0 - ssr_test / ssr_test_base
-            z, res = E.fit(space, cases, z_tr, tau, "all", max_nfev=12)
-            rig_c, tau_c = space.rig_and_tau(z, tau)
-            sims_c = E.simulate_all(rig_c, cases, tau_c)
-            st_c = E.channel_stats(sims_c, cases)
-            neff = E.n_eff(st_c)
-            k = z.size
-            dbic = E.bic(stats, 0, neff) - E.bic(st_c, k, neff)
-            lo, hi = E.intervals(space, res, st_c)
+            c = _confirm(space, sc["z0"], cases, stats, base_test, tau, ctx, refit_interacting, current)
+            lo, hi, z, space = c["lo"], c["hi"], c["z"], c["space"]
+            dbic, held = c["dbic"], c["held"]
             nm = space.n_main
-            excludes = bool(np.any((space.absent[:nm] < lo[:nm]) | (space.absent[:nm] > hi[:nm])))
+            tested = space.tests_absent[:nm]
+            outside = (space.absent[:nm] < lo[:nm]) | (space.absent[:nm] > hi[:nm])
+            excludes = bool(np.any(outside & tested))
             entry.update({"score": dbic, "delta_bic": dbic, "heldout_improvement": held,
-                          "parameters": _param_report(space, z, lo, hi), "screening_refit_start": None})
-            entry.pop("screening_refit_start")
+                          "parameters": _param_report(space, z, lo, hi), "refit": c["refit"]})
             entry["fit_seconds"] = time.time() - t_fit
             reasons = []
             if dbic < DELTA_BIC_MIN:
@@ -292,10 +322,9 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
             if reasons:
                 entry["rejection"] = "; ".join(reasons)
             else:
-                passing.append({"name": nme, "space": space, "z": z, "lo": lo, "hi": hi, "rig": rig_c,
-                                "tau": tau_c, "sims": sims_c, "dbic": dbic, "entry": entry, "sc": sc,
-                                "stats": st_c, "held": held})
-            _ = base_train
+                passing.append({"name": nme, "space": space, "z": z, "lo": lo, "hi": hi, "rig": c["rig"],
+                                "tau": c["tau"], "sims": c["sims"], "dbic": dbic, "entry": entry, "sc": sc,
+                                "stats": c["stats"], "neff": c["neff"], "held": held})
         if not passing:
             summary = (f"round {rnd}: no candidate passed (BIC, held-out error and interval tests); "
                        + ("the residual is above the noise floor: the missing effect may not be in the library"
@@ -303,14 +332,21 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
             break
         passing.sort(key=lambda p: -p["dbic"])
         best = passing[0]
-        if len(passing) > 1 and best["dbic"] - passing[1]["dbic"] < DELTA_BIC_AMBIGUOUS:
+        # "equally well": the runner-up's misfit (-2 log likelihood on the best's effective sample
+        # sizes, without the parameter penalty) is within DELTA_FIT_AMBIGUOUS of the best's
+        fit_gap = None
+        if len(passing) > 1:
+            ne = best["neff"]
+            fit_gap = (E.bic(passing[1]["stats"], 0, ne) - E.bic(best["stats"], 0, ne))
+            best["entry"]["fit_gap_to_runner_up"] = fit_gap
+        if fit_gap is not None and fit_gap < DELTA_FIT_AMBIGUOUS:
             other = passing[1]
             amb = [best["name"], other["name"]]
             sep = separating_experiment(best["name"], other["name"])
             for p in passing[:2]:
                 p["entry"]["rejection"] = (f"ambiguous with {other['name'] if p is best else best['name']}: "
-                                           f"BIC differs by {best['dbic'] - other['dbic']:.1f} < "
-                                           f"{DELTA_BIC_AMBIGUOUS:g}")
+                                           f"their fits differ by {fit_gap:.1f} < {DELTA_FIT_AMBIGUOUS:g} "
+                                           "(-2 log likelihood)")
             for p in passing[2:]:
                 p["entry"]["rejection"] = f"passed, but BIC improvement {p['dbic']:.1f} below {best['name']}'s"
             verdict = "ambiguous"
