@@ -278,10 +278,9 @@ def markdown(r: dict) -> str:
         "the thread's CPU time for the step (CLOCK_THREAD_CPUTIME_ID), the step's own cost plus reading the "
         "clocks (which dominates for the sub-microsecond RK4 steps). The loops run from "
         "the ground acceleration; their errors are against the same loop at rtol 1e-10. The RPsD row uses the "
-        "restoring force from the calculated displacement (option a): in ad-hoc runs of `sh.run_rpsd` with the "
-        "measured displacement (b) or the measured force (c, d) and both leads, the loop grew without bound "
-        "under this record ((b) even with the record scaled to 0.03 g), which would time a diverged, "
-        "supply-limited run.",
+        "restoring force from the measured displacement (option b) with both leads, T_d = 68 ms and "
+        "T_ld = 20 ms: with the paper's 11.2 ms the calibrated model's loop has negative damping and grows "
+        "under this record (docs/methods.md: the residual delay after the 68 ms lead is 17.2 ms).",
         "",
         "| configuration | median [us] | p99 [us] | p99.9 [us] | max [us] | p99.9 / budget | p99.9 CPU [us] | "
         "CVODE steps per step (mean / max) | RHS evals per step | restarts | error x | error F | x real time |",
