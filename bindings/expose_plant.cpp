@@ -29,6 +29,7 @@ void expose_plant(py::module_& m) {
   m.attr("FLAG_SUPPLY_LIMITED") = static_cast<unsigned>(kSupplyLimited);
   m.attr("FLAG_SPOOL_SATURATED") = static_cast<unsigned>(kSpoolSaturated);
   m.attr("FLAG_DRIVE_SATURATED") = static_cast<unsigned>(kDriveSaturated);
+  m.attr("FLAG_STROKE_EXCEEDED") = static_cast<unsigned>(kStrokeExceeded);
 
   py::class_<SolverOptions> so(m, "SolverOptions");
   py::enum_<SolverOptions::Method>(so, "Method")

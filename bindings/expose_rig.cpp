@@ -46,6 +46,7 @@ void expose_rig(py::module_& m) {
       .def_readwrite("C_l", &Rig::C_l)
       .def_readwrite("p_s", &Rig::p_s)
       .def_readwrite("F_cap", &Rig::F_cap)
+      .def_readwrite("stroke", &Rig::stroke)
       .def_readwrite("K_v", &Rig::K_v)
       .def_readwrite("K_s", &Rig::K_s)
       .def_readwrite("f_v", &Rig::f_v)

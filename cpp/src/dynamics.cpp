@@ -231,6 +231,7 @@ void Dynamics::outputs(const double* y, const Input& in, Output& out, OutputGrad
     if (std::fabs(y[kP]) >= 0.98 * rig_.p_s) f |= kSupplyLimited;
     if (g.spool_sat) f |= kSpoolSaturated;
     if (g.drive_sat) f |= kDriveSaturated;
+    if (std::fabs(y[kX]) > rig_.stroke) f |= kStrokeExceeded;
   }
   out.flags = f;
 }

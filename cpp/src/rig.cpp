@@ -109,6 +109,7 @@ void Rig::validate() const {
   require(finite_positive(K_a), "K_a", K_a, "compressibility coefficient must be finite and > 0 [m^5/N]");
   require(finite_nonneg(C_l), "C_l", C_l, "leakage coefficient must be finite and >= 0 [m^3/(s Pa)]");
   require(finite_positive(p_s), "p_s", p_s, "supply pressure must be finite and > 0 [Pa]");
+  require(finite_positive(stroke), "stroke", stroke, "actuator half-stroke must be finite and > 0 [m]");
   require(finite_positive(F_cap), "F_cap", F_cap, "actuator capacity must be finite and > 0 [N]");
   require(finite_positive(K_v), "K_v", K_v, "flow gain must be finite and > 0 [m^3/s]");
   require(finite_positive(K_s), "K_s", K_s, "valve gain must be finite and > 0 [1/V]");

@@ -24,7 +24,7 @@ import numpy as np
 
 from . import _core
 from .rig import Rig
-from .simulate import SimulationResult, simulate, solver_options
+from .simulate import SimulationResult, limit_warnings, simulate, solver_options
 
 COMPENSATION = {"none": _core.VelocityFeedbackCompensator.Kind.None_,
                 "linear": _core.VelocityFeedbackCompensator.Kind.Linear,
@@ -99,20 +99,7 @@ def _summary(s: _core.RunSummary) -> dict:
 
 
 def _warnings(ch: dict, summ: dict, rig: Rig) -> list[str]:
-    out = []
-    fl = ch["flags"]
-    if np.any(fl & _core.FLAG_CAPACITY_EXCEEDED):
-        out.append(f"actuator capacity exceeded: peak force {summ['peak_force'] / 1e3:.1f} kN > "
-                   f"{rig.F_cap / 1e3:.0f} kN, first at t = {summ['first_capacity_time']:.3f} s")
-    if np.any(fl & _core.FLAG_SUPPLY_LIMITED):
-        t = ch["time"][np.argmax(fl & _core.FLAG_SUPPLY_LIMITED > 0)]
-        out.append(f"load pressure reached the supply pressure (p_s A = {rig.p_s * rig.A / 1e3:.1f} kN), "
-                   f"force limited, first at t = {t:.3f} s")
-    if np.any(fl & _core.FLAG_SPOOL_SATURATED):
-        out.append("servovalve spool saturated (fully open)")
-    if np.any(fl & _core.FLAG_DRIVE_SATURATED):
-        out.append("servovalve drive saturated")
-    return out
+    return limit_warnings(ch["flags"], ch["time"], summ, rig)
 
 
 def _array(name: str, a, n: int | None = None) -> np.ndarray:

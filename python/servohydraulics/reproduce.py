@@ -780,7 +780,8 @@ def section_rpsd(ctx: Context) -> None:
     ctx.rows.append(_row("sim_undercompensated_6ms", "8a", "6 ms delay compensation: negative damping, the response "
                          "becomes unstable (simulation of the full model, free vibration from 1.6 cm)", "unstable",
                          f"zeta = {100 * zeta[0.006]:+.2f} % (fit over {fit:g} s after release); "
-                         f"{'; '.join(runs[0.006][0].warnings[:1]) or 'no limit reached'}", "zeta < 0",
+                         f"{'; '.join(runs[0.006][0].warnings[:1]) or 'no limit reached'} (record time, released "
+                         f"at t = {ramp + hold:g} s)", "zeta < 0",
                          zeta[0.006], -math.inf, 0.0))
     why_delay = (f"the model's residual loop delay after the 68 ms lead is larger than the paper's 13 ms: zero "
                  f"residual phase at 1.58 Hz needs T_ld = {1e3 * T_zero:.1f} ms, which gives zeta = "
@@ -878,7 +879,8 @@ def section_rpsd(ctx: Context) -> None:
                          "constant amplitude after 10 s",
                          f"envelope ratio 15-20 s / 10-15 s after release = {g_err:.3g} with the error, "
                          f"{g_no:.3g} without: {'grows' if g_err > 1.25 else 'bounded'} "
-                         f"({'; '.join(runs['err'][0].warnings[:1]) or 'no limits reached'})",
+                         f"({'; '.join(runs['err'][0].warnings[:1]) or 'no limits reached'}; record time, "
+                         f"released at t = {ramp + hold:g} s)",
                          "ratio within 0.8-1.25", g_err, 0.8, 1.25,
                          f"at 11.2 ms our loop has negative net damping ({100 * zeta[T_LD]:+.2f} %), so the free "
                          "vibration grows with or without the error; see the delay rows and the next row"))

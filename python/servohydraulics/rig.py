@@ -54,6 +54,8 @@ PARAMETERS: tuple[Parameter, ...] = (
               "calibrated, docs/calibration.md"),
     Parameter("actuator", "p_s", "Pa", "supply pressure", "Table I: 1.7e4 kN/m^2"),
     Parameter("actuator", "F_cap", "N", "rated actuator capacity (reported when exceeded)", "p. 1777: 170 kN"),
+    Parameter("actuator", "stroke", "m", "half-stroke (reported when exceeded; no end stop modelled)",
+              "C_F = 78.74 V/m: 10 V at 127 mm"),
     Parameter("servovalve", "K_v", "m^3/s", "main-stage flow gain at null", "Table I: 1.6e-2 m^3/s"),
     Parameter("servovalve", "K_s", "1/V", "static valve gain 1/k_ev", "Table I: 0.1"),
     Parameter("servovalve", "f_v", "Hz", "servovalve natural frequency (Eq 2)",

@@ -57,19 +57,34 @@ class SimulationResult:
         """True if |p| reached 98 % of the supply pressure anywhere."""
         return bool(np.any(self.flags & _core.FLAG_SUPPLY_LIMITED))
 
-    def warnings(self) -> list[str]:
-        """Plain-language notes on limits the run hit."""
-        out = []
-        s = self.summary
-        if self.capacity_exceeded:
-            out.append(f"actuator capacity exceeded: peak force {s['peak_force'] / 1e3:.1f} kN, "
-                       f"first at t = {s['first_capacity_time']:.3f} s")
-        if self.supply_limited:
-            t = self.time[np.argmax(self.flags & _core.FLAG_SUPPLY_LIMITED > 0)]
-            out.append(f"load pressure reached the supply pressure (force limited) first at t = {t:.3f} s")
-        if np.any(self.flags & _core.FLAG_SPOOL_SATURATED):
-            out.append("servovalve spool saturated (fully open)")
-        return out
+    def warnings(self, rig: Rig | None = None) -> list[str]:
+        """Plain-language notes on the limits the run hit (``rig`` adds the limit values)."""
+        return limit_warnings(self.flags, self.time, self.summary, rig)
+
+
+def limit_warnings(flags: np.ndarray, time: np.ndarray, summary: dict, rig: Rig | None = None) -> list[str]:
+    """Notes on the physical limits a run hit, from its per-row OutputFlag bits."""
+    def first(bit: int) -> float:
+        return float(time[np.argmax((flags & bit) > 0)])
+
+    out = []
+    if np.any(flags & _core.FLAG_CAPACITY_EXCEEDED):
+        cap = f" > {rig.F_cap / 1e3:.0f} kN" if rig is not None else ""
+        out.append(f"actuator capacity exceeded: peak force {summary['peak_force'] / 1e3:.1f} kN{cap}, "
+                   f"first at t = {first(_core.FLAG_CAPACITY_EXCEEDED):.3f} s")
+    if np.any(flags & _core.FLAG_SUPPLY_LIMITED):
+        lim = f" (p_s A = {rig.p_s * rig.A / 1e3:.1f} kN)" if rig is not None else ""
+        out.append(f"load pressure reached the supply pressure{lim}, force limited, "
+                   f"first at t = {first(_core.FLAG_SUPPLY_LIMITED):.3f} s")
+    if np.any(flags & _core.FLAG_STROKE_EXCEEDED):
+        lim = f" (+-{rig.stroke * 1e3:.0f} mm)" if rig is not None else ""
+        out.append(f"displacement beyond the actuator stroke{lim} first at t = "
+                   f"{first(_core.FLAG_STROKE_EXCEEDED):.3f} s: a real actuator would hit its end stop")
+    if np.any(flags & _core.FLAG_SPOOL_SATURATED):
+        out.append(f"servovalve spool saturated (fully open) first at t = {first(_core.FLAG_SPOOL_SATURATED):.3f} s")
+    if np.any(flags & _core.FLAG_DRIVE_SATURATED):
+        out.append(f"servovalve drive saturated first at t = {first(_core.FLAG_DRIVE_SATURATED):.3f} s")
+    return out
 
 
 def solver_options(method: str = "cvode", rtol: float = 1e-6, restart: str = "on_input_change",

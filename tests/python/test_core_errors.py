@@ -169,3 +169,18 @@ def test_printed_table_one_runs_into_the_supply_pressure(make_rig, dt):
     ok = sh.simulate(make_rig(), mode="displacement", command=np.full(n, 1e-3), dt=dt)
     assert not ok.warnings()
     assert np.ptp(ok.displacement[ok.time > 0.5]) < 1e-5
+
+
+def test_stroke_exceeded_is_reported():
+    """A command past the +-127 mm stroke (10 V at C_F = 78.74 V/m) is flagged and warned about,
+    with the time the displacement first crossed the stroke; within the stroke nothing is."""
+    dt = 5e-4
+    t = np.arange(0, 4.0, dt)
+    ramp = 0.15 * np.minimum(t / 3.0, 1.0)  # 0 -> 150 mm, slow enough to track
+    rig = sh.zhao2003()
+    res = sh.simulate(rig, "displacement", ramp, dt)
+    crossed = res.time[np.argmax(np.abs(res.displacement) > rig.stroke)]
+    notes = [w for w in res.warnings(rig) if "stroke" in w]
+    assert len(notes) == 1 and "127 mm" in notes[0] and f"t = {crossed:.3f} s" in notes[0]
+    inside = sh.simulate(rig, "displacement", 0.1 / 0.15 * ramp, dt)
+    assert not any("stroke" in w for w in inside.warnings(rig))

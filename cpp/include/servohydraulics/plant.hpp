@@ -31,6 +31,7 @@ enum OutputFlag : std::uint32_t {
   kSupplyLimited = 1u << 1,     //!< |p| >= 0.98 p_s: the force demand is at the supply-pressure limit
   kSpoolSaturated = 1u << 2,    //!< |x_v| >= x_v_max
   kDriveSaturated = 1u << 3,    //!< |valve drive| >= v_max
+  kStrokeExceeded = 1u << 4,    //!< |x| > stroke: a real actuator would hit its end stop (not modelled)
 };
 
 //! Every channel of the plant at one instant.

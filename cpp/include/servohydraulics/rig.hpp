@@ -72,6 +72,7 @@ struct Rig {
   double C_l = 3.4e-11;     //!< total flow-pressure coefficient, valve null K_c0 + leakage [m^3/(s Pa)] (calibrated; printed 1e-12)
   double p_s = 1.7e7;       //!< supply pressure [Pa] (Table I)
   double F_cap = 170e3;     //!< rated actuator capacity [N] (p. 1777), reported when exceeded
+  double stroke = 0.127;    //!< actuator half-stroke [m] (C_F = 78.74 V/m: 10 V at 127 mm), reported when exceeded
 
   // --- Servovalve, Eqs (2), (3), (6), (7) ------------------------------------
   double K_v = 1.6e-2;      //!< main-stage flow gain at null [m^3/s per unit opening] (Table I)

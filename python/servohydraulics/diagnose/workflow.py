@@ -332,12 +332,18 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
             break
         passing.sort(key=lambda p: -p["dbic"])
         best = passing[0]
-        # "equally well": the runner-up's misfit (-2 log likelihood on the best's effective sample
-        # sizes, without the parameter penalty) is within DELTA_FIT_AMBIGUOUS of the best's
+        # "equally well": the two best fits' misfits (-2 log likelihood) differ by < DELTA_FIT_AMBIGUOUS on effective
+        # sizes common to both (per channel the smaller of the two), without the parameter penalty
         fit_gap = None
         if len(passing) > 1:
-            ne = best["neff"]
-            fit_gap = (E.bic(passing[1]["stats"], 0, ne) - E.bic(best["stats"], 0, ne))
+            a, b = passing[0], passing[1]
+            ne = {k: min(a["neff"][k], b["neff"][k]) for k in a["neff"]}
+            fa, fb = E.bic(a["stats"], 0, ne), E.bic(b["stats"], 0, ne)
+            ka, kb = a["z"].size, b["z"].size
+            if E.bic(b["stats"], kb, ne) < E.bic(a["stats"], ka, ne):  # on the common scale the runner-up wins
+                passing[0], passing[1] = b, a
+                best = b
+            fit_gap = abs(fb - fa)
             best["entry"]["fit_gap_to_runner_up"] = fit_gap
         if fit_gap is not None and fit_gap < DELTA_FIT_AMBIGUOUS:
             other = passing[1]
