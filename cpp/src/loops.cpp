@@ -151,15 +151,17 @@ Status RealTimePseudoDynamicTest::step(double ground_acceleration, double extern
 
 // -------------------------------------------------------------------- runners
 
-RunSummary run_eft(EffectiveForceTest& test, const double* ground_acceleration, std::size_t n,
-                   EftOutput* rows) noexcept {
+namespace {
+// The whole-record loop shared by both test methods: step_row(k) advances row k
+// and returns its status; plant_row(k) is the plant's output in that row.
+template <class StepRow, class PlantRow>
+RunSummary run_rows(const Plant& p, std::size_t n, StepRow&& step_row, PlantRow&& plant_row) noexcept {
   RunSummary sum;
-  const Plant& p = test.plant();
   const long ns0 = p.total_internal_steps(), nf0 = p.total_rhs_evals(), nr0 = p.total_restarts();
   const double F_cap = p.dynamics().rig().F_cap;
   for (std::size_t k = 0; k < n; ++k) {
-    const Status st = test.step(ground_acceleration[k], rows[k]);
-    account(sum, rows[k].plant, F_cap);
+    const Status st = step_row(k);
+    account(sum, plant_row(k), F_cap);
     sum.rows = k + 1;
     if (st.internal_steps > sum.max_internal_steps) sum.max_internal_steps = st.internal_steps;
     if (!st.ok()) {
@@ -172,31 +174,27 @@ RunSummary run_eft(EffectiveForceTest& test, const double* ground_acceleration, 
   sum.restarts = p.total_restarts() - nr0;
   return sum;
 }
+}  // namespace
+
+RunSummary run_eft(EffectiveForceTest& test, const double* ground_acceleration, std::size_t n,
+                   EftOutput* rows) noexcept {
+  return run_rows(
+      test.plant(), n, [&](std::size_t k) { return test.step(ground_acceleration[k], rows[k]); },
+      [&](std::size_t k) -> const Output& { return rows[k].plant; });
+}
 
 RunSummary run_rpsd(RealTimePseudoDynamicTest& test, const double* ground_acceleration,
                     const double* external_force, const double* restoring_force_error, std::size_t n,
                     RpsdOutput* rows) noexcept {
-  RunSummary sum;
-  const Plant& p = test.plant();
-  const long ns0 = p.total_internal_steps(), nf0 = p.total_rhs_evals(), nr0 = p.total_restarts();
-  const double F_cap = p.dynamics().rig().F_cap;
-  for (std::size_t k = 0; k < n; ++k) {
-    const double ag = ground_acceleration ? ground_acceleration[k] : 0.0;
-    const double pe = external_force ? external_force[k] : 0.0;
-    const double fe = restoring_force_error ? restoring_force_error[k] : 0.0;
-    const Status st = test.step(ag, pe, fe, rows[k]);
-    account(sum, rows[k].plant, F_cap);
-    sum.rows = k + 1;
-    if (st.internal_steps > sum.max_internal_steps) sum.max_internal_steps = st.internal_steps;
-    if (!st.ok()) {
-      sum.status = st;
-      break;
-    }
-  }
-  sum.internal_steps = p.total_internal_steps() - ns0;
-  sum.rhs_evals = p.total_rhs_evals() - nf0;
-  sum.restarts = p.total_restarts() - nr0;
-  return sum;
+  return run_rows(
+      test.plant(), n,
+      [&](std::size_t k) {
+        const double ag = ground_acceleration ? ground_acceleration[k] : 0.0;
+        const double pe = external_force ? external_force[k] : 0.0;
+        const double fe = restoring_force_error ? restoring_force_error[k] : 0.0;
+        return test.step(ag, pe, fe, rows[k]);
+      },
+      [&](std::size_t k) -> const Output& { return rows[k].plant; });
 }
 
 }  // namespace servohydraulics
