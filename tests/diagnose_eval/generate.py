@@ -1,6 +1,6 @@
 """Seeded generator of records with hidden effects for the diagnose evaluation.
 
-    python tests/diagnose_eval/generate.py --out build/diagnose_eval [--size default|quick] [--seed 2003]
+    python tests/diagnose_eval/generate.py --out build/diagnose_eval [--size default|quick] [--seed 2003] [--jobs 2]
 
 Writes OUT/records/*.csv (time, command, displacement, force), OUT/nominal_*.toml
 (the models the diagnosis is told to believe), OUT/manifest.json (record, mode,
@@ -13,6 +13,19 @@ at graded strengths, in forms the library does not have (Stribeck and LuGre
 friction, a tabulated flow curve, a delay made of a 2nd-order Bessel filter, a
 continuous-time delay of the held command), none at all, or two together, and
 white measurement noise on displacement and force at SNR 40, 30 and 20 dB.
+Records are made in parallel (``--jobs`` processes), each with its own seeded
+random stream (seed, record number), so the set does not depend on ``--jobs``.
+
+Truth of each answer (decided from the physics, before any diagnosis):
+in-library forms: the simulator's own parameter.  Stribeck and LuGre friction:
+the energy-equivalent Coulomb force F_eq = sum(F_fr v) / sum(|v|) over the
+record (the Coulomb level that dissipates the same energy over the record's
+motion, which is what a Coulomb model fitted to the record can be asked to
+find); their sliding Coulomb level F_c is kept as a second truth (``alt``).
+Flow curves: the full-opening flow ratio g(1) = Q(x_v = 1) / K_v (rational
+curve: 1 / (1 + b)); tabulated curves are run with a large force sweep (peak
+opening beyond 0.3) so that g(1) is within reach of the record.  Filter delay:
+the Bessel filter's DC group delay.
 """
 
 from __future__ import annotations
@@ -20,6 +33,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, replace
 from pathlib import Path
 
@@ -31,18 +45,13 @@ import independent_plant as ip  # noqa: E402
 DT = 5e-4  #: 2 kHz, the paper's DSP rate [s]
 SNRS = (40, 30, 20)  #: [dB]
 
-# A tabulated flow-spool curve with the Fig 4a shape (slope 1 at null, falling gain).
+# A tabulated flow-spool curve with the Fig 4a shape (slope 1 at null, falling gain from 2 % opening).
 TABLE_OPENING = [0.0, 0.02, 0.05, 0.1, 0.2, 0.4, 0.7, 1.0]
 TABLE_FLOW = [0.0, 0.02, 0.047, 0.085, 0.15, 0.26, 0.40, 0.52]
-
-
-def table_equivalent_b(max_opening: float) -> float:
-    """The rational shape factor b closest (least squares) to the table over [0, max_opening]."""
-    s = np.linspace(1e-4, max_opening, 400)
-    g = np.interp(s, TABLE_OPENING, TABLE_FLOW)
-    bs = np.linspace(0.0, 20.0, 20001)
-    err = [np.sum((s / (1 + b * s) - g) ** 2) for b in bs]
-    return float(bs[int(np.argmin(err))])
+# A curve of the preset's kind: linear below 10 % opening, g(1) = 0.56 (values typed from
+# docs/calibration.md "Flow curve"; the simulator interpolates them itself)
+KNEE_OPENING = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.7, 1.0]
+KNEE_FLOW = [0.0, 0.1, 0.19, 0.265, 0.33, 0.385, 0.47, 0.56]
 
 
 def command(mode: str, kind: str, duration: float, rng: np.random.Generator) -> tuple[np.ndarray, float]:
@@ -57,6 +66,9 @@ def command(mode: str, kind: str, duration: float, rng: np.random.Generator) -> 
     if mode == "displacement":
         big = 0.032 if kind == "std" else 0.02
         return ramp * (big * np.sin(2 * np.pi * f0 * t + ph[0]) + 0.004 * chirp), 0.0
+    if kind == "sweep":  # a large force sweep 0.5-3.5 Hz through f_n (opens the spool beyond 0.3)
+        sweep = np.sin(2 * np.pi * (0.5 * t + 0.5 * 3.0 / duration * t ** 2) + ph[0])
+        return ramp * 15e3 * sweep, 0.0
     big = 20e3 if kind == "std" else 12e3
     return ramp * (big * np.sin(2 * np.pi * f0 * t + ph[0]) + 3e3 * chirp), 0.0
 
@@ -87,10 +99,10 @@ def hidden(key: str, val: float, peak_spool: float) -> tuple[dict, str, dict, st
         return {"friction": "coulomb", "F_c": val}, "coulomb_friction", {"F_c": val}, "Coulomb (tanh)"
     if key == "stribeck":
         return ({"friction": "stribeck", "F_c": val, "F_s": 1.5 * val, "v_s": 0.01}, "coulomb_friction",
-                {"F_c": val}, "Stribeck, F_s = 1.5 F_c, v_s = 10 mm/s")
+                {"F_c": "energy"}, "Stribeck, F_s = 1.5 F_c, v_s = 10 mm/s")
     if key == "lugre":
         return ({"friction": "lugre", "F_c": val, "F_s": 1.3 * val, "v_s": 0.01, "sigma_0": 5e5},
-                "coulomb_friction", {"F_c": val}, "LuGre, sigma_0 = 5e5 N/m, F_s = 1.3 F_c")
+                "coulomb_friction", {"F_c": "energy"}, "LuGre, sigma_0 = 5e5 N/m, F_s = 1.3 F_c")
     if key == "viscous":
         return {"c": val}, "viscous_damping", {"c": val}, "viscous"
     if key == "spring":
@@ -98,11 +110,14 @@ def hidden(key: str, val: float, peak_spool: float) -> tuple[dict, str, dict, st
     if key == "load_pressure":
         return {"load_pressure": True, "p_s": val}, "load_pressure", {"p_s": val}, "Eq (3) square root"
     if key == "flow":
-        return {"flow": "rational", "b": val}, "flow_gain_nonlinearity", {"b": val}, "rational curve"
+        return ({"flow": "rational", "b": val}, "flow_gain_nonlinearity", {"g_1": 1 / (1 + val)},
+                f"rational curve b = {val:g}")
     if key == "flow_table":
-        b_eq = table_equivalent_b(min(1.0, 2 * peak_spool))
         return ({"flow": "table", "table_opening": TABLE_OPENING, "table_flow": TABLE_FLOW},
-                "flow_gain_nonlinearity", {"b": b_eq}, "tabulated curve (b: best rational fit)")
+                "flow_gain_nonlinearity", {"g_1": TABLE_FLOW[-1]}, "tabulated curve bending from 2 % opening")
+    if key == "flow_knee":
+        return ({"flow": "table", "table_opening": KNEE_OPENING, "table_flow": KNEE_FLOW},
+                "flow_gain_nonlinearity", {"g_1": KNEE_FLOW[-1]}, "tabulated curve of the preset's kind (knee 10 %)")
     if key == "delay":
         return {"delay": "pure", "tau": val}, "time_delay", {"tau": val}, "continuous-time delay of the ZOH command"
     if key == "delay_filter":
@@ -134,7 +149,8 @@ def plan(size: str) -> list[dict]:
         ("load_pressure", "displacement", [8e6, 12e6]),
         ("flow", "displacement", [0.6, 2.0]),
         ("flow", "force", [1.0]),
-        ("flow_table", "displacement", [0.0]),
+        ("flow_table", "force", [0.0]),
+        ("flow_knee", "force", [0.0]),
         ("delay", "displacement", [0.003, 0.008]),
         ("delay_filter", "displacement", [0.006]),
         ("valve", "displacement", [30.0, 45.0]),
@@ -155,7 +171,8 @@ def plan(size: str) -> list[dict]:
     for snr in snrs:
         for key, mode, strengths in singles:
             for v in strengths:
-                out.append({"kind": "single", "effects": [(key, v)], "mode": mode, "cmd": "std", "snr": snr})
+                cmd = "sweep" if key in ("flow_table", "flow_knee") else "std"
+                out.append({"kind": "single", "effects": [(key, v)], "mode": mode, "cmd": cmd, "snr": snr})
         for mode, cmd in nones:
             out.append({"kind": "none", "effects": [], "mode": mode, "cmd": cmd, "snr": snr})
         for a, b in pairs:
@@ -163,49 +180,73 @@ def plan(size: str) -> list[dict]:
     return out
 
 
-def generate(out: Path, size: str = "default", seed: int = 2003, duration: float = 4.0) -> None:
+IN_LIBRARY = {"coulomb", "viscous", "spring", "load_pressure", "flow", "delay", "valve", "leakage", "piston",
+              "spool"}  #: forms the library has exactly (the others are out-of-library forms)
+
+
+def make_record(args: tuple) -> tuple[dict, dict, dict]:
+    """One record (run in a worker process): (channels with noise, manifest entry, answer-key entry)."""
+    i, it, seed, duration = args
+    rng = np.random.default_rng([seed, i])
+    rid = f"r{i:03d}"
+    mode = it["mode"]
+    dur = it.get("duration", duration)
+    u, x0 = command(mode, it["cmd"], dur, rng)
+    tr = base_truth(mode)
+    peak = float(np.max(np.abs(ip.simulate(tr, mode, u, DT, x0, substeps=2)["spool"]))) \
+        if any(k == "spool" for k, _ in it["effects"]) else 0.0
+    answers, forms, over = [], [], {}
+    for k, v in it["effects"]:
+        o, name, par, form = hidden(k, v, peak)
+        over.update(o)
+        answers.append({"name": name, "parameters": par, "form": k, "in_library": k in IN_LIBRARY})
+        forms.append(f"{k}: {form}")
+    tr = replace(tr, **over)
+    ch = ip.simulate(tr, mode, u, DT, x0, substeps=SUBSTEPS)
+    v = ch["velocity"]
+    f_eq = float(np.sum(ch["friction"] * v) / max(np.sum(np.abs(v)), 1e-30))
+    for a in answers:
+        if a["parameters"].get("F_c") == "energy":
+            a["parameters"] = {"F_c": f_eq}
+            a["alt_parameters"] = {"F_c": tr.F_c}  # the sliding Coulomb level
+            a["truth_note"] = "F_c: energy-equivalent Coulomb force; alt: sliding Coulomb level"
+    rec = {"time": ch["time"], "command": ch["command"]}
+    for c in ("displacement", "force"):
+        y = ch[c]
+        rms = float(np.sqrt(np.mean(y ** 2)))
+        noise = rms * 10 ** (-it["snr"] / 20) if rms > 0 and not (c == "force" and mode == "free") else 0.0
+        rec[c] = y + rng.normal(0.0, noise, y.size) if noise > 0 else y.copy()
+    key = {"id": rid, "kind": it["kind"], "mode": mode, "snr": it["snr"], "answers": answers,
+           "forms": forms, "duration": dur, "runtime_check": it.get("runtime_check", False),
+           "peak_spool": float(np.max(np.abs(ch["spool"]))), "friction_energy_equivalent": f_eq,
+           "truth": {k: v for k, v in asdict(tr).items() if not isinstance(v, list)}}
+    return rec, {"id": rid, "mode": mode, "rig": f"nominal_{mode}.toml"}, key
+
+
+SUBSTEPS = 4  #: RK4 substeps a 0.5 ms sample in the generator (125 us: h times the fastest rate < 0.1)
+
+
+def generate(out: Path, size: str = "default", seed: int = 2003, duration: float = 4.0, jobs: int = 2) -> None:
     import servohydraulics as sh
 
     out.mkdir(parents=True, exist_ok=True)
     (out / "records").mkdir(exist_ok=True)
-    rng = np.random.default_rng(seed)
     for mode in ("displacement", "force", "free"):
         sh.save_rig(nominal_rig(mode), out / f"nominal_{mode}.toml")
-    manifest, key = [], []
     items = plan(size)
     # the 10 s, 2 kHz runtime record
     items.append({"kind": "single", "effects": [("coulomb", 300.0)], "mode": "displacement", "cmd": "std",
                   "snr": 30, "duration": 10.0, "runtime_check": True})
-    for i, it in enumerate(items):
-        rid = f"r{i:03d}"
-        mode = it["mode"]
-        dur = it.get("duration", duration)
-        u, x0 = command(mode, it["cmd"], dur, rng)
-        tr = base_truth(mode)
-        peak = float(np.max(np.abs(ip.simulate(tr, mode, u, DT, x0, substeps=2)["spool"]))) \
-            if any(k == "spool" or k == "flow_table" for k, _ in it["effects"]) else 0.0
-        answers, forms, over = [], [], {}
-        for k, v in it["effects"]:
-            o, name, par, form = hidden(k, v, peak)
-            over.update(o)
-            answers.append({"name": name, "parameters": par})
-            forms.append(f"{k}: {form}")
-        tr = replace(tr, **over)
-        ch = ip.simulate(tr, mode, u, DT, x0)
-        rec = {"time": ch["time"], "command": ch["command"]}
-        for c in ("displacement", "force"):
-            y = ch[c]
-            rms = float(np.sqrt(np.mean(y ** 2)))
-            noise = rms * 10 ** (-it["snr"] / 20) if rms > 0 and not (c == "force" and mode == "free") else 0.0
-            rec[c] = y + rng.normal(0.0, noise, y.size) if noise > 0 else y.copy()
-        path = out / "records" / f"{rid}.csv"
-        sh.write_record(path, rec)
-        manifest.append({"id": rid, "record": str(path.relative_to(out)), "mode": mode,
-                         "rig": f"nominal_{mode}.toml"})
-        key.append({"id": rid, "kind": it["kind"], "mode": mode, "snr": it["snr"], "answers": answers,
-                    "forms": forms, "duration": dur, "runtime_check": it.get("runtime_check", False),
-                    "truth": {k: v for k, v in asdict(tr).items() if not isinstance(v, list)}})
-        print(f"{rid} {mode:12s} snr {it['snr']} {it['kind']:6s} {', '.join(forms) or 'none'}", flush=True)
+    manifest, key = [], []
+    with ProcessPoolExecutor(max_workers=jobs) as ex:
+        for rec, man, k in ex.map(make_record, [(i, it, seed, duration) for i, it in enumerate(items)]):
+            path = out / "records" / f"{man['id']}.csv"
+            sh.write_record(path, rec)
+            man["record"] = str(path.relative_to(out))
+            manifest.append(man)
+            key.append(k)
+            print(f"{k['id']} {k['mode']:12s} snr {k['snr']} {k['kind']:6s} {', '.join(k['forms']) or 'none'}",
+                  flush=True)
     (out / "manifest.json").write_text(json.dumps(manifest, indent=1))
     (out / "answer_key.json").write_text(json.dumps(key, indent=1))
 
@@ -216,8 +257,9 @@ def main() -> None:
     p.add_argument("--size", choices=["default", "quick"], default="default")
     p.add_argument("--seed", type=int, default=2003)
     p.add_argument("--duration", type=float, default=4.0, help="record length [s]")
+    p.add_argument("--jobs", type=int, default=2, help="worker processes")
     a = p.parse_args()
-    generate(Path(a.out), a.size, a.seed, a.duration)
+    generate(Path(a.out), a.size, a.seed, a.duration, a.jobs)
 
 
 if __name__ == "__main__":

@@ -140,7 +140,8 @@ def simulate(tr: Truth, mode: str, u: np.ndarray, dt: float, x0: float = 0.0, su
         else:
             s0 = q
         y[3] = s0
-    out = {k: np.empty(n) for k in ("displacement", "velocity", "acceleration", "force", "pressure", "spool")}
+    out = {k: np.empty(n) for k in ("displacement", "velocity", "acceleration", "force", "pressure", "spool",
+                                    "friction")}
     h = dt / substeps
 
     def outputs(k: int, y: list, uc: float) -> None:
@@ -151,6 +152,7 @@ def simulate(tr: Truth, mode: str, u: np.ndarray, dt: float, x0: float = 0.0, su
         out["pressure"][k] = y[2] if actuator else 0.0
         out["spool"][k] = max(-tr.x_v_max, min(tr.x_v_max, y[3])) if actuator else 0.0
         out["force"][k] = (y[2] * tr.A - mp * d[1]) if actuator else uc
+        out["friction"][k] = friction(y[1], y[5], d[5])  # friction force on the structure [N]
 
     def held(t: float) -> float:
         # command seen by the controller at time t: the ZOH staircase, delayed by tau if "pure"
