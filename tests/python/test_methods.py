@@ -155,10 +155,12 @@ def test_rpsd_calculated_displacement_gives_modelled_damping():
 
 def test_rpsd_delay_compensation_sets_damping():
     """Fig 8: damping ratio identified against T_ld (measured: 6 ms -4.2 %, 11.2 ms -0.8 %,
-    16 ms +1.3 %).  6 ms: negative damping, the free vibration grows.  Damping rises with T_ld.
-    The paper's 16 ms over-damping is NOT reproduced by the calibrated preset (see docs)."""
+    16 ms +1.3 %, 20 ms +3.05 %; the solver's model has 2.48 %).  6 ms: negative damping, the free
+    vibration grows (Fig 8a).  Damping rises with T_ld, and over-compensation over-damps (Fig 8b),
+    but at 20 ms, not at the paper's 16 ms: the model's residual delay after the 68 ms lead is
+    17.2 ms, not the paper's 13 ms estimate (docs/methods.md)."""
     z = {}
-    for T in (6e-3, 11.2e-3, 16e-3):
+    for T in (6e-3, 11.2e-3, 16e-3, 20e-3):
         fv, res, i0 = free_vibration(delay_T=T)
         z[T] = fv.damping_ratio
         if T == 6e-3:
@@ -167,6 +169,9 @@ def test_rpsd_delay_compensation_sets_damping():
     assert z[6e-3] < -0.03
     assert z[6e-3] < z[11.2e-3] < z[16e-3]
     assert z[16e-3] > -0.01
+    assert z[16e-3] < z[20e-3]
+    zeta_m = 3.5e3 / (2 * np.sqrt(sh.zhao2003().k * 7084.0))
+    assert z[20e-3] > zeta_m  # over-compensation adds damping beyond the modelled 2.48 %
 
 
 def test_rpsd_measured_force_shifts_frequency_less_at_two_percent_mass():
