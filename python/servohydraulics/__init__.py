@@ -15,11 +15,16 @@ import os as _os
 if _os.environ.get("SERVOHYDRAULICS_CORE_DIR"):
     __path__.insert(0, _os.environ["SERVOHYDRAULICS_CORE_DIR"])
 
-from . import (  # noqa: E402
-    _core,  # noqa: E402
-    analysis,
-    identify,
-)
+try:
+    from . import _core  # noqa: E402
+except ImportError as e:  # pragma: no cover - only without a built core
+    raise ImportError(
+        "the servohydraulics C++ core (_core) is not built here: install the package "
+        "(pip install . or bash scripts/run.sh test), or point SERVOHYDRAULICS_CORE_DIR at a "
+        f"build directory made by scripts/dev-build.sh ({e})"
+    ) from e
+
+from . import analysis, identify  # noqa: E402
 from ._core import ControlMode, Dynamics, FlowCurve, Plant, SolverOptions, linearize
 from .diagnose import Diagnosis, diagnose  # the function shadows the subpackage name
 from .methods import MethodResult, TestMethodError, run_eft, run_rpsd, run_tracking

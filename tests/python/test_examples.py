@@ -115,8 +115,9 @@ def test_cpp_controller_rejects_bad_arguments(controller):
 
 
 def run_example(name: str, *args: str) -> str:
+    # The same servohydraulics this test process imports: the installed package,
+    # or a dev build through the caller's PYTHONPATH / SERVOHYDRAULICS_CORE_DIR.
     env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([str(ROOT / "python"), env.get("PYTHONPATH", "")])
     env["MPLBACKEND"] = "Agg"
     return _run([sys.executable, str(EXAMPLES / "python" / name), *args], env=env, timeout=120).stdout
 
