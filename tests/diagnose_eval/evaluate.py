@@ -191,7 +191,9 @@ def write_doc(m: dict, per: list[dict], key: list[dict], doc: Path, cmd: str, wa
           "diagnosis): Stribeck and LuGre friction -> the energy-equivalent Coulomb force "
           "F_eq = sum(F_fr v) / sum(|v|) over the record (second truth, reported above: their sliding Coulomb "
           "level F_c); flow curves -> the full-opening flow ratio g_1 = g(1) (rational: 1 / (1 + b); tables: their "
-          "last entry; table records are large force sweeps that open the spool beyond 0.3); filter delay -> the "
+          "last entry; table records are force sweeps 0.5-3.5 Hz through f_n: 15 kN for the table bending from 2 % "
+          "opening (peak opening about 0.07), 75 kN for the preset's kind, linear below 10 % opening (peak about "
+          "0.35, beyond the knee as in Fig 4b)); filter delay -> the "
           "Bessel filter's DC group delay."]
     L += ["", "## By noise level", "",
           "| SNR | single: right first | right anywhere | ambiguous | false positives | param within 20 % | "

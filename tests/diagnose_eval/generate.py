@@ -66,9 +66,10 @@ def command(mode: str, kind: str, duration: float, rng: np.random.Generator) -> 
     if mode == "displacement":
         big = 0.032 if kind == "std" else 0.02
         return ramp * (big * np.sin(2 * np.pi * f0 * t + ph[0]) + 0.004 * chirp), 0.0
-    if kind == "sweep":  # a large force sweep 0.5-3.5 Hz through f_n (opens the spool beyond 0.3)
+    if kind in ("sweep", "bigsweep"):  # a force sweep 0.5-3.5 Hz through f_n
+        # 15 kN opens the spool to about 0.07; 75 kN to about 0.35 (beyond a 10 % knee, like Fig 4b's 0.32)
         sweep = np.sin(2 * np.pi * (0.5 * t + 0.5 * 3.0 / duration * t ** 2) + ph[0])
-        return ramp * 15e3 * sweep, 0.0
+        return ramp * (75e3 if kind == "bigsweep" else 15e3) * sweep, 0.0
     big = 20e3 if kind == "std" else 12e3
     return ramp * (big * np.sin(2 * np.pi * f0 * t + ph[0]) + 3e3 * chirp), 0.0
 
@@ -171,7 +172,8 @@ def plan(size: str) -> list[dict]:
     for snr in snrs:
         for key, mode, strengths in singles:
             for v in strengths:
-                cmd = "sweep" if key in ("flow_table", "flow_knee") else "std"
+                # the preset-kind curve is linear below 10 % opening: its record must open the spool beyond that
+                cmd = {"flow_table": "sweep", "flow_knee": "bigsweep"}.get(key, "std")
                 out.append({"kind": "single", "effects": [(key, v)], "mode": mode, "cmd": cmd, "snr": snr})
         for mode, cmd in nones:
             out.append({"kind": "none", "effects": [], "mode": mode, "cmd": cmd, "snr": snr})

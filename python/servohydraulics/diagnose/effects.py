@@ -75,6 +75,11 @@ class Candidate:
     delays_command: bool = False
     #: which parameters are fitted in this context (default all); the others stay at "absent"
     active: Callable[[Context], tuple[bool, ...]] | None = None
+    #: starting values of its first parameter to scan before the least-squares fit (external units), for
+    #: effects whose error is not smooth in the parameter (a hard clip engages abruptly); None: no scan
+    scan: Callable[[Context], np.ndarray] | None = None
+    #: candidates that explain similar residuals: when this one ranks first in screening, they are confirmed too
+    look_alikes: tuple[str, ...] = ()
 
 
 INTERACT_SPAN = 0.25  #: bounded re-fit of interacting nominal parameters: +-25 % of the current value
@@ -295,7 +300,7 @@ def build_library() -> dict[str, Candidate]:
             bounds=lambda ctx: (_a(0.0), _a(5e3)),
             probe=lambda ctx: _coulomb_absent(ctx) + max(20.0, 0.004 * ctx.rig.k * max(ctx.peak_x, 1e-3)),
             apply=_apply_coulomb, interacts=(("c", "N s/m"),),
-            structural_signature=_sig_coulomb,
+            structural_signature=_sig_coulomb, look_alikes=("viscous_damping",),
             separate="repeat the test at two amplitudes (or a free vibration): Coulomb friction's share of the "
                      "response falls with amplitude and makes the decay linear, viscous damping's does not",
         ),
@@ -306,7 +311,7 @@ def build_library() -> dict[str, Candidate]:
             bounds=lambda ctx: (_a(0.0), _a(max(20 * ctx.rig.c, 0.2 * 2 * math.sqrt(ctx.rig.k * ctx.rig.m)))),
             probe=lambda ctx: _a(ctx.rig.c * 1.5 + 0.005 * 2 * math.sqrt(ctx.rig.k * ctx.rig.m)),
             apply=_apply_viscous, interacts=(("F_c", "N"),),
-            structural_signature=_sig_viscous,
+            structural_signature=_sig_viscous, look_alikes=("coulomb_friction",),
             separate="repeat at two amplitudes: viscous damping gives the same decay ratio at every amplitude",
         ),
         Candidate(
@@ -340,7 +345,7 @@ def build_library() -> dict[str, Candidate]:
             bounds=lambda ctx: (_a(0.1, 0.0), _a(1.0, 0.3)),
             probe=lambda ctx: _a(1.0 / (1.0 + max(0.5, 0.1 / max(ctx.peak_spool, 1e-3))), 0.1),
             apply=_apply_flow, interacts=(("K_v", "m^3/s"),), modes=("displacement", "force"),
-            exercised=_spool_exercised, active=_flow_active,
+            exercised=_spool_exercised, active=_flow_active, look_alikes=("spool_saturation", "load_pressure"),
             separate="a test at large spool opening with little load (fast, low force): the flow curve acts there, "
                      "load pressure does not",
         ),
@@ -352,6 +357,7 @@ def build_library() -> dict[str, Candidate]:
             bounds=lambda ctx: (_a(0.0), _a(0.05)),
             probe=lambda ctx: _a(0.002),
             apply=_apply_delay, delays_command=True, modes=("displacement", "force"),
+            look_alikes=("servovalve_dynamics",),
             separate="a sine sweep to higher frequency: a delay's phase lag grows linearly with frequency without "
                      "amplitude loss, the servovalve's saturates and costs amplitude",
         ),
@@ -363,7 +369,7 @@ def build_library() -> dict[str, Candidate]:
             else _a(math.inf, ctx.rig.zeta_v),
             bounds=lambda ctx: (_a(3.0, 0.1), _a(1000.0, 5.0)),
             probe=lambda ctx: _a(0.7 * min(ctx.rig.f_v, 1000.0), ctx.rig.zeta_v * 0.6),
-            apply=_apply_valve, modes=("displacement", "force"),
+            apply=_apply_valve, modes=("displacement", "force"), look_alikes=("time_delay",),
             separate="a sine sweep to 50-100 Hz: the valve's amplitude roll-off and phase saturation separate it "
                      "from a pure delay",
         ),
@@ -393,6 +399,8 @@ def build_library() -> dict[str, Candidate]:
             bounds=lambda ctx: (_a(max(0.01 * ctx.peak_spool, 1e-4)), _a(max(ctx.peak_spool, 2e-4))),
             probe=lambda ctx: _a(0.7 * ctx.peak_spool),
             apply=_apply_spool, modes=("displacement", "force"), exercised=_spool_exercised,
+            scan=lambda ctx: _spool_absent(ctx)[0] * np.array([0.4, 0.5, 0.6, 0.7, 0.8, 0.9]),
+            look_alikes=("flow_gain_nonlinearity",),
             separate="a fast ramp: saturation caps the velocity at a constant, a flow curve only bends it",
         ),
         Candidate(

@@ -151,19 +151,48 @@ def _fit_space(space: E.Space, z0: np.ndarray, cases: list, stats: dict, base_te
                neff_ref: dict | None = None) -> dict:
     """Train-segment fit (held-out improvement), then the fit on all data, its BIC
     improvement over the current model and its HAC 95 % intervals."""
-    z_tr, _ = E.fit(space, cases, z0, tau, "train")
+    z_tr, res_tr = E.fit(space, cases, z0, tau, "train")
     rig_tr, tau_tr = space.rig_and_tau(z_tr, tau)
+    old = E.with_x0(cases, res_tr.x0)
     test = E.channel_stats(E.simulate_all(rig_tr, cases, tau_tr), cases, "test")
+    E.with_x0(cases, old)
     held = 1.0 - sum(s["ssr"] for s in test.values()) / sum(s["ssr"] for s in base_test.values())
     z, res = E.fit(space, cases, z_tr, tau, "all", max_nfev=12)
     rig_c, tau_c = space.rig_and_tau(z, tau)
+    old = E.with_x0(cases, res.x0)
     sims_c = E.simulate_all(rig_c, cases, tau_c)
+    E.with_x0(cases, old)
     st_c = E.channel_stats(sims_c, cases)
     neff = neff_ref if neff_ref is not None else E.n_eff(st_c)
     dbic = E.bic(stats, 0, neff) - E.bic(st_c, z.size, neff)
-    lo, hi = E.intervals(space, res, E.series_lengths(cases))
+    lengths = E.series_lengths(cases)
+    lo, hi = E.intervals(space, res, lengths)
+    nm = space.n_main
+    tested = np.concatenate([space.tests_absent[:nm], np.zeros(z.size - nm, bool)])
+    joint, pval = E.joint_excludes_absent(space, res, lengths, tested)
     return {"space": space, "z": z, "z_tr": z_tr, "lo": lo, "hi": hi, "rig": rig_c, "tau": tau_c,
+            "joint_excludes": joint, "joint_p": pval,
             "sims": sims_c, "stats": st_c, "neff": neff, "dbic": dbic, "held": held}
+
+
+def _scan_start(space: E.Space, z0: np.ndarray, cases: list, tau: float, ctx: Context) -> np.ndarray:
+    """The start of the fit: the better (training-segment error) of the screening
+    estimate (a linear extrapolation of the signature, which can land far off for
+    a strongly nonlinear parameter such as K_a) and the probe value, and for an
+    effect whose error is not smooth in its first parameter (``Candidate.scan``)
+    the values of a coarse scan of it (a least-squares fit started where a hard
+    clip barely engages stops there)."""
+    starts = [np.asarray(z0, float), np.asarray(space.probe[: space.n_main], float)]
+    for v in (np.asarray(space.cand.scan(ctx), float) if space.cand.scan is not None else ()):
+        z = np.asarray(z0, float).copy()
+        z[0] = np.clip(space.to_internal(np.concatenate([[v], space.to_external(z)[1:]]))[0], space.lo[0], space.hi[0])
+        starts.append(z)
+    cost = []
+    for z in starts:
+        rig, t = space.rig_and_tau(z, tau)
+        r = E.residuals(E.simulate_all(rig, cases, t), cases, "train")
+        cost.append(float(r @ r))
+    return starts[int(np.argmin(cost))]
 
 
 def _confirm(space: E.Space, z0: np.ndarray, cases: list, stats: dict, base_test: dict, tau: float, ctx: Context,
@@ -173,7 +202,8 @@ def _confirm(space: E.Space, z0: np.ndarray, cases: list, stats: dict, base_test
     first fit; keeps the re-fit only if it improves the BIC (same effective sample
     sizes for both)."""
     alone = E.Space(space.cand, ctx, ())
-    a = _fit_space(alone, z0[: alone.n_main], cases, stats, base_test, tau)
+    z0 = _scan_start(alone, z0[: alone.n_main], cases, tau, ctx)
+    a = _fit_space(alone, z0, cases, stats, base_test, tau)
     a["refit"] = {"tried": False, "kept": False}
     inter = space.interacting if refit_interacting else ()
     if not inter:
@@ -286,6 +316,14 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
             screened.append((nme, space, sc, entry))
         screened.sort(key=lambda s: -s[2]["score"])
         survivors = screened[:keep]
+        # the look-alikes of the best-screened candidate are confirmed too: screening by a linearised
+        # signature cannot rank effects that differ only far from "absent" (a 30 Hz valve vs a delay)
+        if screened:
+            have = {s[0] for s in survivors}
+            for la in LIBRARY[screened[0][0]].look_alikes:
+                extra = [s for s in screened if s[0] == la and s[0] not in have]
+                survivors += extra
+                have |= {s[0] for s in extra}
         # the best structural candidate of the balance-equation screen also goes on
         structural = [s for s in screened if s[3]["balance_score"] is not None]
         if structural:
@@ -308,7 +346,10 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
             nm = space.n_main
             tested = space.tests_absent[:nm]
             outside = (space.absent[:nm] < lo[:nm]) | (space.absent[:nm] > hi[:nm])
-            excludes = bool(np.any(outside & tested))
+            # present if one tested parameter's interval excludes "absent", or (parameters that trade against
+            # each other) their joint 95 % region does
+            excludes = bool(np.any(outside & tested)) or bool(c["joint_excludes"])
+            entry["joint_p_absent"] = c["joint_p"]
             entry.update({"score": dbic, "delta_bic": dbic, "heldout_improvement": held,
                           "parameters": _param_report(space, z, lo, hi), "refit": c["refit"]})
             entry["fit_seconds"] = time.time() - t_fit
@@ -318,7 +359,7 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
             if held < HELDOUT_MIN:
                 reasons.append(f"held-out error improves by {100 * held:.1f} % < {100 * HELDOUT_MIN:g} %")
             if not excludes:
-                reasons.append("95 % interval includes 'absent'")
+                reasons.append("95 % interval (and joint region) includes 'absent'")
             if reasons:
                 entry["rejection"] = "; ".join(reasons)
             else:
