@@ -92,6 +92,7 @@ void expose_plant(py::module_& m) {
       .def("equilibrium", &Dynamics::equilibrium, py::arg("x0"))
       .def("spring_force", &Dynamics::spring_force)
       .def("friction_force", &Dynamics::friction_force)
+      .def("friction_level", &Dynamics::friction_level)
       .def("flow_gain", &Dynamics::flow_gain)
       .def("pressure_factor", &Dynamics::pressure_factor)
       .def_property_readonly("moving_mass", &Dynamics::moving_mass)

@@ -29,7 +29,8 @@ void expose_rig(py::module_& m) {
       .def_readwrite("spring_softening", &Effects::spring_softening)
       .def_readwrite("piston_mass", &Effects::piston_mass)
       .def_readwrite("drive_saturation", &Effects::drive_saturation)
-      .def_readwrite("spool_saturation", &Effects::spool_saturation);
+      .def_readwrite("spool_saturation", &Effects::spool_saturation)
+      .def_readwrite("lugre_friction", &Effects::lugre_friction);
 
   py::class_<Rig>(m, "Rig", "Parameters of the rig, SI units, named after the paper's symbols")
       .def(py::init<>())
@@ -40,6 +41,10 @@ void expose_rig(py::module_& m) {
       .def_readwrite("x_contact", &Rig::x_contact)
       .def_readwrite("F_c", &Rig::F_c)
       .def_readwrite("v_stick", &Rig::v_stick)
+      .def_readwrite("stribeck_ratio", &Rig::stribeck_ratio)
+      .def_readwrite("v_s", &Rig::v_s)
+      .def_readwrite("sigma_0", &Rig::sigma_0)
+      .def_readwrite("sigma_1", &Rig::sigma_1)
       .def_readwrite("m_p", &Rig::m_p)
       .def_readwrite("A", &Rig::A)
       .def_readwrite("K_a", &Rig::K_a)

@@ -47,6 +47,7 @@ Dynamics::Dynamics(const Rig& rig, ControlMode mode) : rig_(rig), mode_(mode) {
   M_ = rig_.m + mp_;
   CF_ = mode == ControlMode::Force ? rig_.C_F_force : rig_.C_F_disp;
   wv_ = 2.0 * kPi * rig_.f_v;
+  lugre_ = rig_.effects.coulomb_friction && rig_.effects.lugre_friction && rig_.F_c > 0.0;
 }
 
 double Dynamics::spring_force(double x) const noexcept {
@@ -58,14 +59,24 @@ double Dynamics::spring_stiffness(double x) const noexcept {
   if (!rig_.effects.spring_softening || std::fabs(x) <= rig_.x_contact) return rig_.k;
   return rig_.k_2;
 }
+double Dynamics::friction_level(double v) const noexcept {
+  if (rig_.stribeck_ratio == 1.0) return rig_.F_c;
+  const double q = v / rig_.v_s;
+  return rig_.F_c * (1.0 + (rig_.stribeck_ratio - 1.0) * std::exp(-q * q));
+}
+double Dynamics::friction_level_slope(double v) const noexcept {
+  if (rig_.stribeck_ratio == 1.0) return 0.0;
+  const double q = v / rig_.v_s;
+  return rig_.F_c * (rig_.stribeck_ratio - 1.0) * std::exp(-q * q) * (-2.0 * q / rig_.v_s);
+}
 double Dynamics::friction_force(double v) const noexcept {
   if (!rig_.effects.coulomb_friction || rig_.F_c == 0.0) return 0.0;
-  return rig_.F_c * std::tanh(v / rig_.v_stick);
+  return friction_level(v) * std::tanh(v / rig_.v_stick);
 }
 double Dynamics::friction_slope(double v) const noexcept {
   if (!rig_.effects.coulomb_friction || rig_.F_c == 0.0) return 0.0;
   const double t = std::tanh(v / rig_.v_stick);
-  return rig_.F_c * (1.0 - t * t) / rig_.v_stick;
+  return friction_level_slope(v) * t + friction_level(v) * (1.0 - t * t) / rig_.v_stick;
 }
 double Dynamics::flow_gain(double s) const noexcept {
   return rig_.effects.flow_nonlinearity ? rig_.flow_curve.eval(s) : s;
@@ -94,6 +105,7 @@ struct Dynamics::Algebra {
   double Q = 0, dQ[kNG] = {};          // valve flow
   double pdot = 0, dpdot[kNG] = {};
   double xvdd = 0, dxvdd[kNG] = {};
+  double zdot = 0, dzdot[kNG] = {};    // LuGre bristle rate
   bool drive_sat = false, spool_sat = false;
 };
 
@@ -102,11 +114,28 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
   const bool actuator = mode_ != ControlMode::Free;
   const double x = y[kX], v = y[kV], p = y[kP];
 
-  // Structure, Eq (5) with the piston riding along: M a = pA - F_c(v) - c v - f_s(x).
+  // Friction: the static law g(v) tanh(v / v_stick), or LuGre (Canudas de Wit et al. 1995):
+  // z' = v - sigma_0 |v| z / g(v),  F_f = sigma_0 z + sigma_1 z'  (its sigma_2 v is c v).
+  double Ff, dFf_dv, dFf_dz = 0.0;
+  if (lugre_) {
+    const double z = y[kZ], gv = friction_level(v), av = std::fabs(v);
+    g.zdot = v - r.sigma_0 * av * z / gv;
+    g.dzdot[kV] = 1.0 - r.sigma_0 * z * (sgn(v) * gv - av * friction_level_slope(v)) / (gv * gv);
+    g.dzdot[kZ] = -r.sigma_0 * av / gv;
+    Ff = r.sigma_0 * z + r.sigma_1 * g.zdot;
+    dFf_dv = r.sigma_1 * g.dzdot[kV];
+    dFf_dz = r.sigma_0 + r.sigma_1 * g.dzdot[kZ];
+  } else {
+    Ff = friction_force(v);
+    dFf_dv = friction_slope(v);
+  }
+
+  // Structure, Eq (5) with the piston riding along: M a = pA - F_f - c v - f_s(x).
   const double applied = actuator ? p * r.A : in.u;  // Free: the command is an ideal force
-  g.a = (applied - friction_force(v) - r.c * v - spring_force(x)) / M_;
+  g.a = (applied - Ff - r.c * v - spring_force(x)) / M_;
   g.da[kX] = -spring_stiffness(x) / M_;
-  g.da[kV] = -(friction_slope(v) + r.c) / M_;
+  g.da[kV] = -(dFf_dv + r.c) / M_;
+  g.da[kZ] = -dFf_dz / M_;
   g.da[kP] = actuator ? r.A / M_ : 0.0;
   g.da[kU] = actuator ? 0.0 : 1.0 / M_;
   if (!actuator) {
@@ -179,6 +208,7 @@ void Dynamics::rhs(const double* y, const Input& in, double* ydot) const noexcep
   const bool valve = actuator && rig_.effects.servovalve_dynamics;
   ydot[kXv] = valve ? y[kXvDot] : 0.0;
   ydot[kXvDot] = valve ? g.xvdd : 0.0;
+  ydot[kZ] = lugre_ ? g.zdot : 0.0;
 }
 
 void Dynamics::jacobian(const double* y, const Input& in, Jacobian& J, State* B) const noexcept {
@@ -189,6 +219,8 @@ void Dynamics::jacobian(const double* y, const Input& in, Jacobian& J, State* B)
   J[kX][kV] = 1.0;
   for (int j = 0; j < kNumStates; ++j) J[kV][j] = g.da[j];
   if (B) (*B)[kV] = g.da[kU];
+  if (lugre_)
+    for (int j = 0; j < kNumStates; ++j) J[kZ][j] = g.dzdot[j];
   if (mode_ == ControlMode::Free) return;
   for (int j = 0; j < kNumStates; ++j) J[kP][j] = g.dpdot[j];
   if (B) (*B)[kP] = g.dpdot[kU];

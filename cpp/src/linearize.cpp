@@ -21,7 +21,7 @@ LinearModel linearize(const Dynamics& dyn, const State& y0, double u0) {
   }
   const bool actuator = dyn.mode() != ControlMode::Free;
   const bool valve = actuator && dyn.rig().effects.servovalve_dynamics;
-  lm.active = {true, true, actuator, valve, valve};
+  lm.active = {true, true, actuator, valve, valve, dyn.lugre()};
   return lm;
 }
 

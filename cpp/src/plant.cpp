@@ -133,7 +133,14 @@ struct Plant::Impl {
     Eigen::Matrix<double, kNumStates, kNumStates> A;
     for (int i = 0; i < kNumStates; ++i)
       for (int j = 0; j < kNumStates; ++j) A(i, j) = J[i][j];
-    const double rho = A.eigenvalues().cwiseAbs().maxCoeff();
+    double rho = A.eigenvalues().cwiseAbs().maxCoeff();
+    // LuGre: the bristle rate sigma_0 |v| / g(v) is 0 at rest and grows with the sliding speed.  Bound
+    // |v| by the no-load actuator speed K_v g(x_v_max) / A (1 m/s in free mode, no actuator).
+    if (dyn.lugre()) {
+      const Rig& r = dyn.rig();
+      const double v_ref = dyn.mode() == ControlMode::Free ? 1.0 : r.K_v * dyn.flow_gain(std::min(r.x_v_max, 1.0)) / r.A;
+      rho = std::max(rho, r.sigma_0 * v_ref / r.F_c);
+    }
     const double n = std::ceil(dt * rho / opt.rk4_h_rho);
     require(std::isfinite(n) && n <= 100000.0, "rk4_substeps (automatic)", n,
             "the plant is too stiff for a fixed-step integrator at this dt: use CVODE");

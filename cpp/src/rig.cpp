@@ -104,6 +104,11 @@ void Rig::validate() const {
   require(finite_positive(x_contact), "x_contact", x_contact, "contact displacement must be finite and > 0 [m]");
   require(finite_nonneg(F_c), "F_c", F_c, "Coulomb friction must be finite and >= 0 [N]");
   require(finite_positive(v_stick), "v_stick", v_stick, "friction regularisation velocity must be finite and > 0 [m/s]");
+  require(std::isfinite(stribeck_ratio) && stribeck_ratio >= 1.0, "stribeck_ratio", stribeck_ratio,
+          "static to sliding friction ratio F_s / F_c must be finite and >= 1");
+  require(finite_positive(v_s), "v_s", v_s, "Stribeck velocity must be finite and > 0 [m/s]");
+  require(finite_positive(sigma_0), "sigma_0", sigma_0, "LuGre bristle stiffness must be finite and > 0 [N/m]");
+  require(finite_nonneg(sigma_1), "sigma_1", sigma_1, "LuGre bristle damping must be finite and >= 0 [N s/m]");
   require(finite_nonneg(m_p), "m_p", m_p, "piston mass must be finite and >= 0 [kg]");
   require(finite_positive(A), "A", A, "piston area must be finite and > 0 [m^2]");
   require(finite_positive(K_a), "K_a", K_a, "compressibility coefficient must be finite and > 0 [m^5/N]");

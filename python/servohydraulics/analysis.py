@@ -45,7 +45,7 @@ ALPHA = 0.1  #: constant of the paper's phase-lead networks (Table I) [-]
 OUTPUTS = ("displacement", "velocity", "acceleration", "force", "pressure", "spool", "drive", "flow")
 OUTPUT_UNITS = {"displacement": "m", "velocity": "m/s", "acceleration": "m/s^2", "force": "N",
                 "pressure": "Pa", "spool": "-", "drive": "V", "flow": "m^3/s"}
-STATES = ("x", "v", "p", "x_v", "x_v_dot")
+STATES = ("x", "v", "p", "x_v", "x_v_dot", "z")
 FRICTION_TREATMENTS = ("off", "equivalent", "tangent")
 
 

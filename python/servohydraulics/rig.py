@@ -44,8 +44,15 @@ PARAMETERS: tuple[Parameter, ...] = (
     Parameter("structure", "k_2", "N/m", "stiffness beyond +-x_contact", "p. 1777: 350.4 kN/m"),
     Parameter("structure", "x_contact", "m", "displacement where a spring pair loses contact", "p. 1777: 2.5 cm"),
     Parameter("structure", "F_c", "N", "Coulomb friction", "Table I: 31.6 N attached, 95.7 N free"),
-    Parameter("structure", "v_stick", "m/s", "friction regularisation: F = F_c tanh(v/v_stick)",
+    Parameter("structure", "v_stick", "m/s", "friction regularisation: F = g(v) tanh(v/v_stick)",
               "modelling choice, docs/model.md"),
+    Parameter("structure", "stribeck_ratio", "-", "static to sliding friction F_s/F_c (Stribeck peak; 1: none)",
+              "not in the paper: 1"),
+    Parameter("structure", "v_s", "m/s", "Stribeck velocity", "not in the paper: 0.01 m/s"),
+    Parameter("structure", "sigma_0", "N/m", "LuGre bristle (presliding) stiffness (effects.lugre_friction)",
+              "not in the paper: 1e6 N/m"),
+    Parameter("structure", "sigma_1", "N s/m", "LuGre bristle damping (effects.lugre_friction)",
+              "not in the paper: 0"),
     Parameter("structure", "m_p", "kg", "actuator piston mass", "p. 1782: 54 kg"),
     Parameter("actuator", "A", "m^2", "piston area", "Table I: 82.1 cm^2"),
     Parameter("actuator", "K_a", "m^5/N", "compressibility coefficient V_t/(4 beta_e)",
@@ -79,6 +86,7 @@ EFFECTS: tuple[str, ...] = (
     "piston_mass",
     "drive_saturation",
     "spool_saturation",
+    "lugre_friction",
 )
 
 FLOW_CURVE_KEYS = ("kind", "b", "opening", "flow")

@@ -1,7 +1,7 @@
 // Analytic Jacobian df/dy, input gradient df/du and the linearised output
 // matrices (C, D) against central finite differences of Dynamics::rhs and
 // Dynamics::outputs, at many fixed-seed random states, in every control mode
-// and for every combination of the eight effect switches.
+// and for every combination of the nine effect switches.
 //
 // States are drawn away from the model's kinks (where the derivative is not
 // defined or the finite difference straddles a switch): spring contact
@@ -34,7 +34,7 @@ using namespace servohydraulics;
 
 namespace {
 
-constexpr double kScale[kNumStates] = {1e-2, 1e-1, 1e6, 1e-1, 1e1};  // x [m], v [m/s], p [Pa], x_v [-], x_v' [1/s]
+constexpr double kScale[kNumStates] = {1e-2, 1e-1, 1e6, 1e-1, 1e1, 1e-4};  // x [m], v [m/s], p [Pa], x_v [-], x_v' [1/s], z [m]
 constexpr double kRelStep = 1e-6;
 constexpr double kScaledTol = 1e-6;
 constexpr double kElementTol = 1e-5;
@@ -50,6 +50,7 @@ void set_effects(Effects& e, unsigned mask) {
   e.piston_mass = mask & 32u;
   e.drive_saturation = mask & 64u;
   e.spool_saturation = mask & 128u;
+  e.lugre_friction = mask & 256u;
 }
 
 struct Draw {
@@ -63,6 +64,7 @@ bool away_from_kinks(const Dynamics& dyn, const Draw& d) {
   const double* y = d.y.data();
   const double margin_x = 1e-5, margin_v = 1e-3, margin_s = 1e-4;
   if (r.effects.spring_softening && std::fabs(std::fabs(y[kX]) - r.x_contact) < margin_x) return false;
+  if (dyn.lugre() && std::fabs(y[kV]) < 1e-6) return false;  // |v| in the bristle equation
   if (dyn.mode() == ControlMode::Free) return true;
   Output o;
   dyn.outputs(y, d.in, o);
@@ -94,6 +96,7 @@ Draw draw(sh_test::Randomizer& rnd, const Dynamics& dyn) {
   d.y[kP] = rnd.signed_uniform(0.0, 0.9 * r.p_s);
   d.y[kXv] = rnd.signed_uniform(0.0, 1.3 * r.x_v_max);
   d.y[kXvDot] = rnd.signed_uniform(0.0, 50.0);
+  d.y[kZ] = rnd.signed_uniform(0.0, 1.5 * r.stribeck_ratio * r.F_c / r.sigma_0);  // bristle deflection [m]
   if (dyn.mode() == ControlMode::Displacement) {
     d.in.u = rnd.signed_uniform(0.0, 0.06);
     d.in.u_rate = rnd.signed_uniform(0.0, 0.5);
@@ -261,8 +264,8 @@ int main() {
     worst = std::max(worst, st.worst_scaled);
   };
 
-  // Every combination of the eight effect switches, calibrated preset.
-  for (unsigned mask = 0; mask < 256; ++mask)
+  // Every combination of the nine effect switches, calibrated preset.
+  for (unsigned mask = 0; mask < 512; ++mask)
     for (ControlMode mode : modes) {
       Rig rig = zhao2003();
       set_effects(rig.effects, mask);
@@ -277,6 +280,18 @@ int main() {
     table.flow_curve.opening = {0.0, 0.1, 0.4, 0.7, 1.0};
     table.flow_curve.flow = {0.0, 0.1, 0.33, 0.5, 0.6};
     run(table, mode, 100, "tabulated flow curve");
+  }
+  for (ControlMode mode : modes) {
+    Rig lugre = zhao2003();
+    lugre.effects.lugre_friction = true;
+    lugre.F_c = 250.0;
+    lugre.stribeck_ratio = 1.5;
+    lugre.sigma_0 = 5e5;
+    lugre.sigma_1 = 400.0;
+    run(lugre, mode, 200, "LuGre with a Stribeck peak and bristle damping");
+    Rig stribeck = lugre;
+    stribeck.effects.lugre_friction = false;
+    run(stribeck, mode, 100, "static friction law with a Stribeck peak");
   }
   Rig derivative = zhao2003();
   derivative.G_d = 0.02;  // derivative term of Eq (1), displacement control only

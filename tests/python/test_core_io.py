@@ -38,7 +38,7 @@ def _every_field_changed() -> sh.Rig:
     field that save/load dropped would fall back to the preset and show."""
     rig = sh.zhao2003()
     for i, p in enumerate(PARAMETERS):
-        setattr(rig, p.key, getattr(rig, p.key) * (1.0 + 0.01 * (i + 1)) + (0.125 if p.key == "G_d" else 0.0))
+        setattr(rig, p.key, getattr(rig, p.key) * (1.0 + 0.01 * (i + 1)) + (0.125 if p.key in ("G_d", "sigma_1") else 0.0))
     for name in EFFECTS:
         setattr(rig.effects, name, not getattr(rig.effects, name))
     curve = sh.FlowCurve()
@@ -80,7 +80,8 @@ def test_partial_rig_file_keeps_the_preset(tmp_path):
 
 _positive = st.floats(min_value=1e-9, max_value=1e9, allow_nan=False, allow_infinity=False)
 _nonneg = st.one_of(st.just(0.0), _positive)
-_NONNEG_KEYS = {"c", "k_2", "F_c", "m_p", "C_l", "G_p", "G_d"}
+_NONNEG_KEYS = {"c", "k_2", "F_c", "m_p", "C_l", "G_p", "G_d", "sigma_1"}
+_AT_LEAST_ONE_KEYS = {"stribeck_ratio"}  # F_s / F_c >= 1
 
 
 @st.composite
@@ -103,7 +104,10 @@ def _flow_curves(draw) -> sh.FlowCurve:
 def _rigs(draw) -> sh.Rig:
     rig = sh.Rig()
     for p in PARAMETERS:
-        setattr(rig, p.key, draw(_nonneg if p.key in _NONNEG_KEYS else _positive))
+        if p.key in _AT_LEAST_ONE_KEYS:
+            setattr(rig, p.key, 1.0 + draw(_nonneg))
+        else:
+            setattr(rig, p.key, draw(_nonneg if p.key in _NONNEG_KEYS else _positive))
     for name in EFFECTS:
         setattr(rig.effects, name, draw(st.booleans()))
     rig.flow_curve = draw(_flow_curves())

@@ -21,7 +21,8 @@ enum class ControlMode {
 const char* to_string(ControlMode mode) noexcept;
 
 //! Indices of the state vector.
-enum StateIndex : int { kX = 0, kV = 1, kP = 2, kXv = 3, kXvDot = 4, kNumStates = 5 };
+//! kZ is the LuGre bristle deflection [m] (held at 0 unless effects.lugre_friction).
+enum StateIndex : int { kX = 0, kV = 1, kP = 2, kXv = 3, kXvDot = 4, kZ = 5, kNumStates = 6 };
 using State = std::array<double, kNumStates>;
 using Jacobian = std::array<std::array<double, kNumStates>, kNumStates>;  //!< J[row][col] = d f_row / d y_col
 
@@ -82,8 +83,11 @@ class Dynamics {
   // Pieces of the model, exposed for compensators and tests.
   double spring_force(double x) const noexcept;         //!< f_s(x) [N]
   double spring_stiffness(double x) const noexcept;     //!< df_s/dx [N/m]
-  double friction_force(double v) const noexcept;       //!< Coulomb friction, regularised [N]
+  double friction_force(double v) const noexcept;       //!< static friction law g(v) tanh(v / v_stick) [N]
   double friction_slope(double v) const noexcept;       //!< its derivative [N s/m]
+  double friction_level(double v) const noexcept;       //!< sliding level g(v) with the Stribeck peak [N]
+  double friction_level_slope(double v) const noexcept; //!< g'(v) [N s/m]
+  bool lugre() const noexcept { return lugre_; }        //!< friction is the LuGre model (state kZ active)
   double flow_gain(double s) const noexcept;            //!< g(s) with the effect switches applied
   double flow_gain_slope(double s) const noexcept;      //!< g'(s)
   double pressure_factor(double s, double p) const noexcept;        //!< the square-root term of Eq (3)
@@ -97,6 +101,7 @@ class Dynamics {
   ControlMode mode_;
   double M_;        // moving mass [kg]
   double mp_;       // piston mass seen by the load cell [kg]
+  bool lugre_;      // LuGre friction on (coulomb_friction && lugre_friction && F_c > 0)
   double CF_;       // conversion factor of the mode [V/m or V/N]
   double wv_;       // valve natural frequency [rad/s]
 };
@@ -114,14 +119,16 @@ struct SolverOptions {
   Method method = Method::CvodeBdf;
   Restart restart = Restart::OnInputChange;
   double rtol = 1e-6;                 //!< CVODE relative tolerance [-]
-  //! CVODE absolute tolerance = rtol * atol_scale[i]: [m, m/s, Pa, -, 1/s]
-  std::array<double, kNumStates> atol_scale{1e-3, 1e-2, 1e5, 1e-2, 1.0};
+  //! CVODE absolute tolerance = rtol * atol_scale[i]: [m, m/s, Pa, -, 1/s, m]
+  std::array<double, kNumStates> atol_scale{1e-3, 1e-2, 1e5, 1e-2, 1.0, 1e-6};
   int max_order = 5;                  //!< BDF maximum order
   long max_steps_per_sample = 2000;   //!< cap on CVODE internal steps in one step(); then TooMuchWork
   double max_internal_step = 0.0;     //!< CVODE hmax [s], 0 = no limit
   //! Rk4: substeps per controller sample; 0 = automatic: the fewest with
   //! h * rho(J) <= rk4_h_rho, rho the spectral radius of the Jacobian at the
-  //! equilibrium (where friction is steepest), chosen at construction.
+  //! equilibrium (where friction is steepest), chosen at construction; with
+  //! LuGre friction also h sigma_0 v_ref / F_c <= rk4_h_rho, v_ref the no-load
+  //! actuator speed K_v g(x_v_max) / A (1 m/s in free mode).
   int rk4_substeps = 0;
   double rk4_h_rho = 1.0;             //!< Rk4 automatic substeps: bound on h * rho(J) (stability limit ~2.8)
 

@@ -52,6 +52,10 @@ struct Effects {
   bool piston_mass = true;          //!< piston mass m_p moves with the structure, seen by the load cell
   bool drive_saturation = true;     //!< valve drive limited to +-v_max (controller output stage)
   bool spool_saturation = true;     //!< metering opening limited to [-x_v_max, x_v_max] (spool end stops)
+  //! friction is the LuGre model (bristle deflection z, presliding stiffness sigma_0) instead of the
+  //! static law g(v) tanh(v / v_stick); acts only with coulomb_friction on.  Off by default: Table I
+  //! gives no presliding data.
+  bool lugre_friction = false;
 };
 
 //! Parameters of the rig.  Field names follow the paper's symbols (Table I).
@@ -63,7 +67,11 @@ struct Rig {
   double k_2 = 350.4e3;     //!< stiffness beyond +-x_contact [N/m] (p. 1777: one pair loses contact)
   double x_contact = 0.025; //!< displacement where one spring pair loses contact [m] (2.5 cm precompression)
   double F_c = 31.6;        //!< Coulomb friction [N] (Table I, actuator attached)
-  double v_stick = 1e-4;    //!< friction regularisation velocity: F = F_c tanh(v / v_stick) [m/s]
+  double v_stick = 1e-4;    //!< friction regularisation velocity: F = g(v) tanh(v / v_stick) [m/s]
+  double stribeck_ratio = 1.0;  //!< static to sliding friction F_s / F_c >= 1; g(v) = F_c (1 + (ratio - 1) exp(-(v/v_s)^2)) [-]
+  double v_s = 0.01;        //!< Stribeck velocity [m/s]
+  double sigma_0 = 1e6;     //!< LuGre bristle (presliding) stiffness [N/m]
+  double sigma_1 = 0.0;     //!< LuGre bristle (micro-)damping [N s/m]
   double m_p = 54.0;        //!< actuator piston mass [kg] (p. 1782)
 
   // --- Actuator, Eq (4) ------------------------------------------------------
