@@ -17,15 +17,19 @@ Records are made in parallel (``--jobs`` processes), each with its own seeded
 random stream (seed, record number), so the set does not depend on ``--jobs``.
 
 Truth of each answer (decided from the physics, before any diagnosis):
-in-library forms: the simulator's own parameter.  Stribeck and LuGre friction:
-the energy-equivalent Coulomb force F_eq = sum(F_fr v) / sum(|v|) over the
-record (the Coulomb level that dissipates the same energy over the record's
-motion, which is what a Coulomb model fitted to the record can be asked to
-find); their sliding Coulomb level F_c is kept as a second truth (``alt``).
-Flow curves: the full-opening flow ratio g(1) = Q(x_v = 1) / K_v (rational
-curve: 1 / (1 + b)); tabulated curves are run with a large force sweep (peak
-opening beyond 0.3) so that g(1) is within reach of the record.  Filter delay:
-the Bessel filter's DC group delay.
+in-library forms: the simulator's own parameter.  Stribeck friction: the
+energy-equivalent Coulomb force F_eq = sum(F_fr v) / sum(|v|) over the record
+(the Coulomb level that dissipates the same energy over the record's motion,
+which is what a Coulomb model fitted to the record can be asked to find); the
+sliding Coulomb level F_c is kept as a second truth (``alt``).  LuGre friction
+(with a Stribeck peak F_s = 1.3 F_c the library's LuGre does not have): the name
+``lugre_friction``, its bristle stiffness sigma_0 and sliding level F_c.  Flow
+curves: the full-opening flow ratio g(1) = Q(x_v = 1) / K_v (rational curve:
+1 / (1 + b)); the tabulated curve bending from 2 % opening is run with a force
+sweep that opens the spool to about 7 % only, so its truth is g at the record's
+peak opening (g(1), outside the record, kept as ``alt``); the preset-kind table
+is run with a large sweep (peak opening beyond 0.3) so that g(1) is within reach.
+Filter delay: the Bessel filter's DC group delay.
 """
 
 from __future__ import annotations
@@ -101,9 +105,11 @@ def hidden(key: str, val: float, peak_spool: float) -> tuple[dict, str, dict, st
     if key == "stribeck":
         return ({"friction": "stribeck", "F_c": val, "F_s": 1.5 * val, "v_s": 0.01}, "coulomb_friction",
                 {"F_c": "energy"}, "Stribeck, F_s = 1.5 F_c, v_s = 10 mm/s")
-    if key == "lugre":
-        return ({"friction": "lugre", "F_c": val, "F_s": 1.3 * val, "v_s": 0.01, "sigma_0": 5e5},
-                "coulomb_friction", {"F_c": "energy"}, "LuGre, sigma_0 = 5e5 N/m, F_s = 1.3 F_c")
+    if key in ("lugre", "lugre_stiff"):
+        s0 = 5e5 if key == "lugre" else 2e6
+        return ({"friction": "lugre", "F_c": val, "F_s": 1.3 * val, "v_s": 0.01, "sigma_0": s0},
+                "lugre_friction", {"sigma_0": s0, "F_c": val},
+                f"LuGre, sigma_0 = {s0:.0e} N/m, F_s = 1.3 F_c (presliding {1e3 * val / s0:.2f} mm)")
     if key == "viscous":
         return {"c": val}, "viscous_damping", {"c": val}, "viscous"
     if key == "spring":
@@ -115,7 +121,7 @@ def hidden(key: str, val: float, peak_spool: float) -> tuple[dict, str, dict, st
                 f"rational curve b = {val:g}")
     if key == "flow_table":
         return ({"flow": "table", "table_opening": TABLE_OPENING, "table_flow": TABLE_FLOW},
-                "flow_gain_nonlinearity", {"g_1": TABLE_FLOW[-1]}, "tabulated curve bending from 2 % opening")
+                "flow_gain_nonlinearity", {"g_peak": "at_peak"}, "tabulated curve bending from 2 % opening")
     if key == "flow_knee":
         return ({"flow": "table", "table_opening": KNEE_OPENING, "table_flow": KNEE_FLOW},
                 "flow_gain_nonlinearity", {"g_1": KNEE_FLOW[-1]}, "tabulated curve of the preset's kind (knee 10 %)")
@@ -141,7 +147,8 @@ def plan(size: str) -> list[dict]:
         # (key, mode, strengths)
         ("coulomb", "displacement", [150.0, 400.0]),
         ("stribeck", "displacement", [250.0]),
-        ("lugre", "displacement", [250.0]),
+        ("lugre", "displacement", [250.0, 400.0]),
+        ("lugre_stiff", "displacement", [150.0]),
         ("coulomb", "free", [95.7]),
         ("stribeck", "free", [95.7]),
         ("viscous", "displacement", [5000.0, 9000.0]),
@@ -208,9 +215,18 @@ def make_record(args: tuple) -> tuple[dict, dict, dict]:
     v = ch["velocity"]
     f_eq = float(np.sum(ch["friction"] * v) / max(np.sum(np.abs(v)), 1e-30))
     for a in answers:
+        if a["parameters"].get("g_peak") == "at_peak":
+            # the record never opens the spool near 1: judge the curve where the record used it
+            xp = float(np.max(np.abs(ch["spool"])))
+            a["opening"] = xp
+            a["parameters"] = {"g_peak": float(np.interp(xp, TABLE_OPENING, TABLE_FLOW))}
+            a["alt_parameters"] = {"g_1": TABLE_FLOW[-1]}
+            a["alt_label"] = "full opening, not reached"
+            a["truth_note"] = "g_peak: g(x) at the record's peak opening x; alt: g(1), outside the record"
         if a["parameters"].get("F_c") == "energy":
             a["parameters"] = {"F_c": f_eq}
             a["alt_parameters"] = {"F_c": tr.F_c}  # the sliding Coulomb level
+            a["alt_label"] = "sliding level"
             a["truth_note"] = "F_c: energy-equivalent Coulomb force; alt: sliding Coulomb level"
     rec = {"time": ch["time"], "command": ch["command"]}
     for c in ("displacement", "force"):

@@ -73,7 +73,8 @@ def test_terminal_velocity_on_the_stribeck_curve(lugre: bool) -> None:
     # the 1 N/m spring holds back k x(t_end) (about 0.2 N) and the slow deceleration it causes m a:
     # solve F0 - k x - m a = c v + g(v) for v
     g_of = lambda v: F_c * (1.0 + (ratio - 1.0) * math.exp(-(v / v_s) ** 2))  # noqa: E731
-    v_star = brentq(lambda v: c * v + g_of(v) - (F0 - r.k * res.displacement[-1] - r.m * res.acceleration[-1]), 0.015, 0.025)
+    held_back = r.k * res.displacement[-1] + r.m * res.acceleration[-1]
+    v_star = brentq(lambda v: c * v + g_of(v) - (F0 - held_back), 0.015, 0.025)
     # closed-form sensitivity: the Stribeck term moves v* by (g - F_c) / (c + g'), about 0.25 mm/s here;
     # the simulated terminal velocity must match v* far more closely than that
     assert abs(v_end - v_star) < 1e-7, (v_end, v_star)

@@ -38,7 +38,8 @@ def _every_field_changed() -> sh.Rig:
     field that save/load dropped would fall back to the preset and show."""
     rig = sh.zhao2003()
     for i, p in enumerate(PARAMETERS):
-        setattr(rig, p.key, getattr(rig, p.key) * (1.0 + 0.01 * (i + 1)) + (0.125 if p.key in ("G_d", "sigma_1") else 0.0))
+        offset = 0.125 if p.key in ("G_d", "sigma_1") else 0.0  # defaults of 0 must change too
+        setattr(rig, p.key, getattr(rig, p.key) * (1.0 + 0.01 * (i + 1)) + offset)
     for name in EFFECTS:
         setattr(rig.effects, name, not getattr(rig.effects, name))
     curve = sh.FlowCurve()

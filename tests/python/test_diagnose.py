@@ -20,6 +20,7 @@ import pytest
 import servohydraulics as sh
 from servohydraulics.cli import main
 from servohydraulics.diagnose import NAMES
+from servohydraulics.diagnose import engine as E
 from servohydraulics.records import Record
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "diagnose_eval"))
@@ -58,11 +59,11 @@ def _free_record(F_c: float, seed: int = 1) -> dict:
     return _noisy(ch, 30, seed, free=True)
 
 
-def _displacement_record(seed: int = 2, **truth) -> dict:
-    t = np.arange(int(2.0 / DT) + 1) * DT
+def _displacement_record(seed: int = 2, snr: float = 30, duration: float = 2.0, **truth) -> dict:
+    t = np.arange(int(duration / DT) + 1) * DT
     u = np.minimum(t / 0.25, 1) * (0.02 * np.sin(2 * np.pi * 0.8 * t) + 0.004 * np.sin(2 * np.pi * (1 + t) * t))
     ch = ip.simulate(replace(ip.Truth(), **truth), "displacement", u, DT, substeps=4)
-    return _noisy(ch, 30, seed)
+    return _noisy(ch, snr, seed)
 
 
 @pytest.fixture(scope="module")
@@ -117,6 +118,51 @@ def test_flow_gain_nonlinearity_hidden_in_displacement_record() -> None:
     assert p["unit"] == "-"
     assert abs(p["value"] - 1 / 2.5) / 0.4 < 0.2
     assert d.gap_after["force"] < 0.5 * d.gap_before["force"]
+
+
+def test_lugre_friction_is_named_with_its_presliding_stiffness() -> None:
+    """LuGre friction (bristle stiffness 5e5 N/m: 0.5 mm of presliding travel, and a
+    Stribeck peak F_s = 1.3 F_c the library's LuGre does not have) hidden in a
+    displacement record: named lugre_friction, sigma_0 and the sliding level F_c
+    within 20 %.  The same record with Coulomb friction is named coulomb_friction:
+    lugre_friction nests it (sigma_0 -> infinity) and the BIC prefers the simpler
+    law, never "ambiguous"."""
+    rec = Record({k: np.asarray(v) for k, v in _displacement_record(
+        friction="lugre", F_c=250.0, F_s=325.0, v_s=0.01, sigma_0=5e5).items()})
+    d = sh.diagnose(rec, _linear_rig(), mode="displacement", progress=False)
+    assert d.verdict == "effect_found"
+    assert d.effects[0]["name"] == "lugre_friction"
+    p = d.effects[0]["parameters"]
+    assert p["sigma_0"]["unit"] == "N/m" and abs(p["sigma_0"]["value"] - 5e5) / 5e5 < 0.2
+    assert abs(p["F_c"]["value"] - 250.0) / 250.0 < 0.2
+    assert d.rig.effects.lugre_friction and d.rig.sigma_0 == pytest.approx(p["sigma_0"]["value"])
+
+    rec = Record({k: np.asarray(v) for k, v in _displacement_record(friction="coulomb", F_c=250.0).items()})
+    d = sh.diagnose(rec, _linear_rig(), mode="displacement", progress=False)
+    assert d.verdict == "effect_found"
+    assert d.effects[0]["name"] == "coulomb_friction"
+    assert not d.rig.effects.lugre_friction
+
+
+def test_weak_effect_under_the_noise_floor_is_found_at_20db() -> None:
+    """150 N of Coulomb friction at SNR 20 dB changes the force by less than the
+    noise floor's own uncertainty (the nominal residual passes the noise-floor test:
+    a square wave of 150 N under about 1.6 kN of noise), yet its structured signature
+    is significant (about n (F_c / sigma)^2 in -2 log L): named, F_c within 20 %.  The
+    same noise on a record with nothing hidden gives no_effect."""
+    rec = Record({k: np.asarray(v) for k, v in _displacement_record(
+        snr=20, duration=4.0, friction="coulomb", F_c=150.0).items()})
+    case = E.make_case(rec, "displacement", "weak")
+    stats = E.channel_stats(E.simulate_all(_linear_rig(), [case], 0.0), [case])
+    assert E.at_noise_floor(stats)  # the variance test alone cannot see it
+    d = sh.diagnose(rec, _linear_rig(), mode="displacement", progress=False)
+    assert d.verdict == "effect_found"
+    assert d.effects[0]["name"] == "coulomb_friction"
+    assert abs(d.effects[0]["parameters"]["F_c"]["value"] - 150.0) / 150.0 < 0.2
+
+    rec = Record({k: np.asarray(v) for k, v in _displacement_record(snr=20, duration=4.0, seed=9).items()})
+    d = sh.diagnose(rec, _linear_rig(), mode="displacement", progress=False)
+    assert d.verdict == "no_effect"
 
 
 def test_no_effect_record_gives_no_effect() -> None:

@@ -13,7 +13,7 @@ from scipy.optimize import least_squares
 from scipy.signal import savgol_filter
 
 from ..records import Record
-from ..rig import Rig
+from ..rig import Rig, rig_to_dict
 from ..simulate import SimulationError, simulate, solver_options
 from .effects import INTERACT_SPAN, Candidate, Context, _copy
 
@@ -137,13 +137,16 @@ def refine_x0(rig: Rig, cases: list[Case], tau: float) -> None:
 _RK4: dict = {}
 
 
-def _fastest_rate(rig: Rig, mode: str) -> float:
+def _fastest_rate(rig: Rig, mode: str, v_peak: float = 1.0) -> float:
     """A bound on the plant's fastest eigenvalue [1/s]: valve poles, friction
-    regularisation, leakage and oil-column rates (sets the RK4 substep)."""
+    regularisation, LuGre bristles at the record's peak velocity v_peak [m/s],
+    leakage and oil-column rates (sets the RK4 substep)."""
     M = rig.m + (rig.m_p if rig.effects.piston_mass and mode != "free" else 0.0)
     rates = [rig.c / M]
     if rig.effects.coulomb_friction:
         rates.append(rig.F_c / (rig.v_stick * M))
+        if rig.effects.lugre_friction and rig.F_c > 0:
+            rates.append(rig.sigma_0 * 1.5 * v_peak / rig.F_c)
     if mode != "free":
         wv = 2 * math.pi * rig.f_v
         z = rig.zeta_v
@@ -154,9 +157,9 @@ def _fastest_rate(rig: Rig, mode: str) -> float:
     return max(rates)
 
 
-def _options(rig: Rig, mode: str, dt: float):
+def _options(rig: Rig, mode: str, dt: float, v_peak: float = 1.0):
     """RK4 with enough substeps that h times the fastest rate stays below 1.2 (at least 4)."""
-    n = max(4, int(math.ceil(_fastest_rate(rig, mode) * dt / 1.2)))
+    n = max(4, int(math.ceil(_fastest_rate(rig, mode, v_peak) * dt / 1.2)))
     if n > 64:
         return None  # too stiff for RK4: CVODE
     if n not in _RK4:
@@ -177,7 +180,7 @@ def simulate_case(rig: Rig, case: Case, tau: float = 0.0) -> dict | None:
     """The model's channels for the record's command (None if the run fails).
     Fixed-step RK4 (4 substeps a sample) for speed; CVODE if RK4 fails."""
     u = delayed(case.u, case.dt, tau)
-    first = _options(rig, case.mode, case.dt)
+    first = _options(rig, case.mode, case.dt, float(np.max(np.abs(case.derived["velocity"]))))
     for opts in ((first, None) if first is not None else (None,)):
         try:
             r = simulate(rig, case.mode, u, case.dt, x0=case.x0, options=opts)
@@ -295,19 +298,21 @@ class Space:
         self.tests_absent = np.array([p.tests_absent for p in self.params] + [False] * len(self.interacting), bool)
 
     def to_internal(self, ext: np.ndarray) -> np.ndarray:
-        ext = np.asarray(ext, float)
-        with np.errstate(divide="ignore"):
-            return np.where(self.rec, np.where(np.isinf(ext), 0.0, 1.0 / np.where(ext == 0, np.inf, ext)), ext)
+        return _to_internal(self.rec, ext)
 
     def to_external(self, z: np.ndarray) -> np.ndarray:
-        z = np.asarray(z, float)
-        with np.errstate(divide="ignore"):
-            return np.where(self.rec, np.where(z <= 0, np.inf, 1.0 / np.where(z <= 0, 1.0, z)), z)
+        return _to_external(self.rec, z)
+
+    def own_parameters(self, ext_main: np.ndarray) -> np.ndarray:
+        """Every own parameter of the candidate (external units): the fitted
+        ones from ``ext_main``, the inactive ones at "absent"."""
+        main = self.full_absent.copy()
+        main[self.main_idx] = np.asarray(ext_main, float)[: self.n_main]
+        return main
 
     def rig_and_tau(self, z: np.ndarray, base_tau: float) -> tuple[Rig, float]:
         ext = self.to_external(z)
-        main = self.full_absent.copy()
-        main[self.main_idx] = ext[: self.n_main]
+        main = self.own_parameters(ext)
         if self.cand.delays_command:
             rig, tau = self.ctx.rig, base_tau + float(main[0])
         else:
@@ -317,6 +322,137 @@ class Space:
             for (key, _), v in zip(self.interacting, ext[self.n_main:]):
                 setattr(rig, key, float(v))
         return rig, tau
+
+
+def _to_internal(rec: np.ndarray, ext: np.ndarray) -> np.ndarray:
+    """External units -> fitting coordinates (1/value where ``rec``)."""
+    ext = np.asarray(ext, float)
+    with np.errstate(divide="ignore", over="ignore"):
+        return np.where(rec, np.where(np.isinf(ext), 0.0, 1.0 / np.where(ext == 0, np.inf, ext)), ext)
+
+
+def _to_external(rec: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """Fitting coordinates -> external units (a reciprocal <= 0 is an infinite value)."""
+    z = np.asarray(z, float)
+    with np.errstate(divide="ignore", over="ignore"):
+        return np.where(rec, np.where(z <= 0, np.inf, 1.0 / np.where(z <= 0, 1.0, z)), z)
+
+
+#: candidates whose ``apply`` also rescales another effect's rig key (stiffness_error scales k_2 with k):
+#: applied first in a joint fit so that the other effect's own value is set after it
+_APPLY_FIRST = ("stiffness_error",)
+
+
+class JointSpace:
+    """The parameters of several accepted effects fitted together (the joint
+    re-fit): first each effect's own (main) parameters, a block per effect in
+    its own fitting coordinates and bounds (the ``Space`` of the round that
+    accepted it), then the nominal parameters the effects' kept interacting
+    re-fits moved (each key once, with the bounds of the last effect that
+    re-fitted it; a key that is also an effect's own parameter is fitted as
+    that).  The effects are applied on top of ``base``, the model the greedy
+    rounds built, in the order given (``stiffness_error`` first: it rescales
+    k_2); a command delay adds to the base delay passed to ``rig_and_tau``.
+    Duck-types ``Space`` for ``fit``, ``covariance``, ``intervals`` and
+    ``joint_excludes_absent``."""
+
+    def __init__(self, spaces: list[Space], base: Rig) -> None:
+        self.spaces = list(spaces)
+        self.base = base
+        sizes = [sp.n_main for sp in self.spaces]
+        edges = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
+        #: slice of each effect's own parameters in the joint vector (order of ``spaces``)
+        self.blocks = [slice(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:])]
+        self.n_main = int(edges[-1])
+        own = {prm.key for sp in self.spaces for prm in sp.params}
+        last: dict[str, tuple[int, int]] = {}
+        for i, sp in enumerate(self.spaces):
+            for jj, (key, _) in enumerate(sp.interacting):
+                if key not in own:
+                    last[key] = (i, sp.n_main + jj)
+        #: (space index, index in that space's vector) of each re-fitted nominal parameter
+        self.inter_src = list(last.values())
+        self.interacting = tuple(self.spaces[i].interacting[j - self.spaces[i].n_main] for i, j in self.inter_src)
+
+        def cat(attr: str) -> np.ndarray:
+            return np.concatenate([getattr(sp, attr)[: sp.n_main] for sp in self.spaces]
+                                  + [np.asarray([getattr(self.spaces[i], attr)[j] for i, j in self.inter_src],
+                                                getattr(self.spaces[0], attr).dtype)])
+
+        self.params = tuple(prm for sp in self.spaces for prm in sp.params)
+        self.rec = cat("rec").astype(bool)
+        self.lo, self.hi, self.absent, self.probe, self.scale = (cat(a) for a in ("lo", "hi", "absent", "probe",
+                                                                                  "scale"))
+        self.tests_absent = cat("tests_absent").astype(bool)
+        first = [i for i, sp in enumerate(self.spaces) if sp.cand.name in _APPLY_FIRST]
+        self.order = first + [i for i in range(len(self.spaces)) if i not in first]
+
+    def index_of(self, key: str) -> int | None:
+        """Index of a rig key in the joint vector (an effect's own non-reciprocal
+        parameter or a re-fitted nominal parameter), or None."""
+        for (k, _), j in zip(self.interacting, range(self.n_main, self.n_main + len(self.interacting))):
+            if k == key:
+                return j
+        for sp, blk in zip(self.spaces, self.blocks):
+            for jj, prm in enumerate(sp.params):
+                if prm.key == key and not prm.reciprocal:
+                    return blk.start + jj
+        return None
+
+    def to_internal(self, ext: np.ndarray) -> np.ndarray:
+        return _to_internal(self.rec, ext)
+
+    def to_external(self, z: np.ndarray) -> np.ndarray:
+        return _to_external(self.rec, z)
+
+    def rig_and_tau(self, z: np.ndarray, base_tau: float) -> tuple[Rig, float]:
+        """The model with every effect at its block of ``z``, the re-fitted
+        nominal parameters at theirs, and the command delay (``base_tau`` plus
+        any fitted delay) [s]."""
+        ext = self.to_external(z)
+        rig, tau = self.base, base_tau
+        for i in self.order:
+            sp = self.spaces[i]
+            main = sp.own_parameters(ext[self.blocks[i]])
+            if sp.cand.delays_command:
+                tau += float(main[0])
+            else:
+                rig = sp.cand.apply(rig, main)
+        if self.interacting:
+            rig = _copy(rig) if rig is self.base else rig
+            for (key, _), v in zip(self.interacting, ext[self.n_main:]):
+                setattr(rig, key, float(v))
+        return rig, tau
+
+
+def _flat(d: dict, prefix: str = "") -> dict:
+    out = {}
+    for k, v in d.items():
+        if isinstance(v, dict):
+            out.update(_flat(v, f"{prefix}{k}."))
+        else:
+            out[prefix + k] = v
+    return out
+
+
+def same_rig(a: Rig, b: Rig, rtol: float = 1e-9) -> bool:
+    """True if two rigs have the same switches and parameters (numbers within ``rtol``)."""
+    fa, fb = _flat(rig_to_dict(a)), _flat(rig_to_dict(b))
+    if fa.keys() != fb.keys():
+        return False
+    for k, va in fa.items():
+        vb = fb[k]
+        if isinstance(va, bool) or isinstance(vb, bool) or isinstance(va, str) or isinstance(vb, str):
+            if va != vb:
+                return False
+        elif isinstance(va, (int, float)) and isinstance(vb, (int, float)):
+            if not math.isclose(va, vb, rel_tol=rtol, abs_tol=0.0):
+                return False
+        else:
+            xa, xb = np.asarray(va, float), np.asarray(vb, float)
+            if xa.shape != xb.shape or not np.allclose(xa, xb, rtol=rtol, atol=0.0):
+                return False
+    return True
 
 
 def simulate_all(rig: Rig, cases: list[Case], tau: float) -> list:
