@@ -64,7 +64,7 @@ class Dynamics {
   };
 
   //! Gradients of the 8 output channels (displacement, velocity, acceleration,
-  //! force, pressure, spool, drive, flow) by the 5 states and, last, by u.
+  //! force, pressure, spool, drive, flow) by the states and, last, by u.
   using OutputGradients = std::array<std::array<double, kNumStates + 1>, 8>;
 
   void rhs(const double* y, const Input& in, double* ydot) const noexcept;
