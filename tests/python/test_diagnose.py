@@ -165,6 +165,27 @@ def test_weak_effect_under_the_noise_floor_is_found_at_20db() -> None:
     assert d.verdict == "no_effect"
 
 
+def test_record_logged_one_sample_late_is_an_alignment_not_an_effect() -> None:
+    """A lab whose acquisition logs each response sample one sample later than the
+    record convention (row k sampled before command k is sent) makes the response
+    lead the command by dt.  Without a negative delay in the library that reads as
+    a valve, piston mass and friction together; it must be named time_delay with
+    tau = -dt and a note about the acquisition's alignment.  The opposite shift is a
+    plain +dt delay."""
+    base = _displacement_record(snr=40, duration=3.0, seed=4)
+    for shift in (1, -1):
+        rec = dict(base)
+        for c in ("displacement", "force"):
+            y = np.asarray(rec[c])
+            rec[c] = np.concatenate([y[1:], y[-1:]]) if shift == 1 else np.concatenate([y[:1], y[:-1]])
+        d = sh.diagnose(Record({k: np.asarray(v) for k, v in rec.items()}), _linear_rig(), mode="displacement",
+                        progress=False)
+        assert [e["name"] for e in d.effects] == ["time_delay"]
+        tau = d.effects[0]["parameters"]["tau"]["value"]
+        assert abs(tau - (-DT if shift == 1 else DT)) < 0.05 * DT
+        assert ("alignment" in d.effects[0]["note"]) == (shift == 1)
+
+
 def test_no_effect_record_gives_no_effect() -> None:
     rec = Record({k: np.asarray(v) for k, v in _displacement_record(seed=5).items()})
     d = sh.diagnose(rec, _linear_rig(), mode="displacement", progress=False)

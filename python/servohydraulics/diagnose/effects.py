@@ -44,6 +44,7 @@ class Context:
     peak_pressure: float  #: largest |load pressure| of the current model's simulation [Pa]
     peak_x: float  #: largest measured |displacement| [m]
     rms_v: float  #: rms measured velocity [m/s]
+    dt: float = 5e-4  #: the records' sample time (the shortest) [s]
 
 
 @dataclass
@@ -440,9 +441,10 @@ def build_library() -> dict[str, Candidate]:
         Candidate(
             "time_delay", (Param("tau", "s", "none: the record's command is delayed by tau (integer + fractional "
                                                "samples) before simulating"),),
-            "a pure delay of the command (controller, DSP or communication latency)",
+            "a pure delay of the command (controller, DSP or communication latency); down to -2 samples: a "
+            "record whose response rows lead the command (acquisition alignment, not physics)",
             absent=lambda ctx: _a(0.0),
-            bounds=lambda ctx: (_a(0.0), _a(0.05)),
+            bounds=lambda ctx: (_a(-2.0 * ctx.dt), _a(0.05)),
             probe=lambda ctx: _a(0.002),
             apply=_apply_delay, delays_command=True, modes=("displacement", "force"),
             look_alikes=("servovalve_dynamics",),

@@ -170,10 +170,10 @@ def _options(rig: Rig, mode: str, dt: float, v_peak: float = 1.0):
 def delayed(u: np.ndarray, dt: float, tau: float) -> np.ndarray:
     """The command delayed by tau [s]: integer + fractional samples by linear
     interpolation, holding the first value before the record starts."""
-    if tau <= 0.0:
+    if tau == 0.0:
         return u
-    k = np.arange(u.size) - tau / dt
-    return np.interp(k, np.arange(u.size), u, left=u[0])
+    k = np.arange(u.size) - tau / dt  # tau < 0 advances it (holding the last value past the end)
+    return np.interp(k, np.arange(u.size), u, left=u[0], right=u[-1])
 
 
 def simulate_case(rig: Rig, case: Case, tau: float = 0.0) -> dict | None:

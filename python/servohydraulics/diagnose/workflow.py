@@ -403,7 +403,8 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
         ctx = Context(rig=current, nominal=rig, mode=mode,
                       peak_spool=max(float(np.max(np.abs(s["spool"]))) for s in sims),
                       peak_pressure=max(float(np.max(np.abs(s["pressure"]))) for s in sims),
-                      peak_x=x_peak, rms_v=float(np.mean([c.derived["rms_v"] for c in cases])))
+                      peak_x=x_peak, rms_v=float(np.mean([c.derived["rms_v"] for c in cases])),
+                      dt=min(c.dt for c in cases))
         r0 = E.residuals(sims, cases)
         base_test = E.channel_stats(sims, cases, "test")
         bar.set_description_str(f"round {rnd}: screening")
@@ -554,6 +555,12 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
                 eff["gap_after"] = E.gap(sims, cases)
                 history.append(("joint re-fit", eff["gap_after"]))
     bar.close()
+    for eff in effects:
+        tv = eff["parameters"].get("tau", {}).get("value") if LIBRARY[eff["name"]].delays_command else None
+        if tv is not None and tv < 0.0:
+            eff["note"] += (f"; tau < 0: the response channels lead the command by {-1e3 * tv:.2f} ms, which no "
+                            "physical delay does: check the acquisition's alignment (row k must be sampled before "
+                            "the command of row k is sent)")
 
     gap_after = E.gap(sims, cases)
     closed = {}
