@@ -162,7 +162,7 @@ def _apply_load_pressure(rig: Rig, th: np.ndarray) -> Rig:
 
 #: openings of the table that represents a knee-rational flow curve: dense near the knee
 #: 97 points, quadratically dense near the knee: linear interpolation of the rational curve is within 2e-5 of
-#: it (2e-4 relative) at every opening (with 25 points, interpolation biased the fitted g_1 high by up to 2 %)
+#: it (2e-4 relative) at every opening (with 25 points, interpolation biased the fitted g_1 high, docs/diagnose.md)
 _FLOW_GRID = np.array([(i / 96) ** 2 for i in range(97)])
 
 
@@ -259,8 +259,10 @@ def _max_stable(rig: Rig, mode: str, key: str, upper: float) -> float:
         return bool(np.max(np.linalg.eigvals(np.asarray(lm.A)[np.ix_(keep, keep)]).real) < 0.0)
 
     cur = float(getattr(rig, key))
-    if stable(upper) or not stable(cur):
-        return upper if stable(upper) else cur
+    if stable(upper):
+        return upper
+    if not stable(cur):
+        return cur
     lo, hi = cur, upper
     for _ in range(30):
         mid = math.sqrt(lo * hi)
