@@ -69,9 +69,9 @@ int main() {
       Plant c(zhao2003(), mode, kDt, *opt);
       std::vector<double> x(kN), f(kN), t(kN);
       Channels ch;
-      ch.displacement = x.data();
-      ch.force = f.data();
-      ch.time = t.data();
+      ch[Channel::Displacement] = x.data();
+      ch[Channel::Force] = f.data();
+      ch[Channel::Time] = t.data();
       const RunSummary sum = run_record(c, u.data(), kN, ch);
       CHECK(sum.status.ok());
       CHECK(sum.rows == static_cast<std::size_t>(kN));
