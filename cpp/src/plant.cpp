@@ -38,6 +38,8 @@ struct Plant::Impl {
   SolverOptions opt;
   double dt;
   double t = 0.0;
+  double t0 = 0.0;  // time of the last reset [s]
+  long k = 0;       // samples since then: sample times are t0 + k dt, never an accumulated sum
   State y{};
   Dynamics::Input input{};
   double prev_u = 0.0;
@@ -73,6 +75,8 @@ void Plant::reset_state(const State& y0, double t0) noexcept {
   Impl& m = *impl_;
   m.y = y0;
   m.t = t0;
+  m.t0 = t0;
+  m.k = 0;
   m.input = {};
   m.have_prev_u = false;
   m.failed = false;
@@ -102,12 +106,13 @@ Status Plant::step(double command, Output& out) noexcept {
   m.prev_u = command;
   m.have_prev_u = true;
 
-  const double t_next = m.t + m.dt;
+  const double t_next = m.t0 + static_cast<double>(m.k + 1) * m.dt;
   Status st = std::visit([&](auto& integ) { return integ.advance(m.dyn, m.input, m.y, m.t, t_next); }, m.integ);
   if (st.ok() && !m.state_ok()) {
     st.code = Status::NonFinite;
   }
-  if (!st.ok()) m.failed = true;
+  if (st.ok()) ++m.k;
+  else m.failed = true;
   observe(out);
   return st;
 }

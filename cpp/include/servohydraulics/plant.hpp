@@ -38,7 +38,9 @@ class Plant {
   void reset_state(const State& y0, double t0 = 0.0) noexcept;
 
   //! Hold command u for one sample [m in displacement, N in force/free mode]
-  //! and integrate to t + dt.  Output is the state at the end of the sample.
+  //! and integrate to the next sample time t0 + (k + 1) dt (t0 of the last
+  //! reset, k samples since: the clock does not drift).  Output is the state
+  //! at the end of the sample.
   Status step(double command, Output& out) noexcept;
 
   //! The outputs at the current time without stepping.
