@@ -134,7 +134,7 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
   const bool actuator = mode_ != ControlMode::Free;
   const double x = y[kX], v = y[kV], p = y[kP];
 
-  // Friction (see friction()) and structure, Eq (5).
+  // Friction (the static law or LuGre, see friction()).
   const Friction f = friction(v, y[kZ]);
   const double Ff = f.F, dFf_dv = f.dF_dv, dFf_dz = f.dF_dz;
   if (lugre_) {
