@@ -4,7 +4,8 @@
 //    exists (the priming step fails from a non-finite state) frees all it made:
 //    allocations and frees balance (interposed counter, alloc_counter.hpp,
 //    which sees SUNDIALS' C allocations).  A normal construct/destroy balances
-//    too, and the counter sees the SUNDIALS objects being made.
+//    too, and the counter sees the SUNDIALS objects being made; so does a Plant
+//    whose RK4 integrator throws (too stiff for the automatic rule).
 // 2. The automatic RK4 rule is one function: the Plant, the Rk4Integrator and
 //    rk4_automatic_substeps agree; rk4_v_ref = 0 is the no-load actuator speed.
 #include <cmath>
@@ -69,6 +70,21 @@ void check_no_leak_on_success() {
   }
   CHECK(allocated >= 6);
   CHECK(allocated == freed);
+  // A Plant whose RK4 integrator refuses the rig (too many automatic substeps) frees the rest.
+  {
+    SolverOptions stiff;
+    stiff.method = SolverOptions::Method::Rk4;
+    stiff.rk4_h_rho = 1e-6;
+    bool threw = false;
+    sh_test::AllocationCounter counter;
+    try {
+      Plant p(zhao2003(), ControlMode::Displacement, kDt, stiff);
+    } catch (const Error&) {
+      threw = true;
+    }
+    CHECK(threw);
+    CHECK(counter.count() > 0 && counter.count() == counter.frees());
+  }
   // A whole Plant, CVODE and RK4, balances as well.
   for (auto method : {SolverOptions::Method::CvodeBdf, SolverOptions::Method::Rk4}) {
     SolverOptions opt;
