@@ -152,8 +152,8 @@ struct PlantSystem {
   void recover() { plant.reset_state(plant.state(), plant.time()); }
   void record(std::size_t n) {
     sh::Channels ch;
-    ch.displacement = chx.data();
-    ch.force = chF.data();
+    ch[sh::Channel::Displacement] = chx.data();
+    ch[sh::Channel::Force] = chF.data();
     sh::run_record(plant, u.data(), n, ch);
   }
 };

@@ -1,6 +1,8 @@
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "channels_py.hpp"
 #include "servohydraulics/plant.hpp"
 
 namespace py = pybind11;
@@ -12,18 +14,21 @@ void expose_plant(py::module_& m) {
       .value("Force", ControlMode::Force)
       .value("Free", ControlMode::Free);
 
-  py::class_<Output>(m, "Output")
-      .def(py::init<>())
-      .def_readonly("t", &Output::t)
-      .def_readonly("displacement", &Output::displacement)
-      .def_readonly("velocity", &Output::velocity)
-      .def_readonly("acceleration", &Output::acceleration)
-      .def_readonly("force", &Output::force)
-      .def_readonly("pressure", &Output::pressure)
-      .def_readonly("spool", &Output::spool)
-      .def_readonly("drive", &Output::drive)
-      .def_readonly("flow", &Output::flow)
-      .def_readonly("flags", &Output::flags);
+  // The state vector: StateIndex values named after kStates, and _core.STATES = ((name, unit), ...).
+  py::enum_<StateIndex> si(m, "StateIndex", "Indices of the plant's state vector");
+  py::tuple states(static_cast<std::size_t>(kNumStates));
+  for (int i = 0; i < kNumStates; ++i) {
+    si.value(kStates[i].name, static_cast<StateIndex>(i), kStates[i].doc);
+    states[i] = py::make_tuple(kStates[i].name, kStates[i].unit);
+  }
+  m.attr("STATES") = states;
+  m.attr("NUM_STATES") = static_cast<int>(kNumStates);
+
+  // Output: one read-only attribute per channel of kPlantChannels ("t" kept as an alias of "time").
+  py::class_<Output> output(m, "Output");
+  output.def(py::init<>()).def_readonly("t", &Output::t).def_readonly("flags", &Output::flags);
+  for (const ChannelInfo& c : kPlantChannels) output.def_readonly(c.name, c.member, c.doc);
+  m.attr("PLANT_CHANNELS") = sh_py::channel_units(kPlantChannels);
 
   m.attr("FLAG_CAPACITY_EXCEEDED") = static_cast<unsigned>(kCapacityExceeded);
   m.attr("FLAG_SUPPLY_LIMITED") = static_cast<unsigned>(kSupplyLimited);
@@ -48,6 +53,7 @@ void expose_plant(py::module_& m) {
       .def_readwrite("max_internal_step", &SolverOptions::max_internal_step)
       .def_readwrite("rk4_substeps", &SolverOptions::rk4_substeps)
       .def_readwrite("rk4_h_rho", &SolverOptions::rk4_h_rho)
+      .def_readwrite("rk4_v_ref", &SolverOptions::rk4_v_ref)
       .def("validate", &SolverOptions::validate);
 
   py::class_<Status> st(m, "Status");
@@ -90,6 +96,19 @@ void expose_plant(py::module_& m) {
            },
            py::arg("y"), py::arg("u"))
       .def("equilibrium", &Dynamics::equilibrium, py::arg("x0"))
+      .def("operating_point",
+           [](const Dynamics& d, double x0) {
+             const Dynamics::OperatingPoint op = d.operating_point(x0);
+             py::array_t<double> y0(kNumStates);
+             for (int i = 0; i < kNumStates; ++i) y0.mutable_data()[i] = op.y0[i];
+             return py::make_tuple(y0, op.u0);
+           },
+           py::arg("x0"),
+           "(y0, u0): the equilibrium state at displacement x0 [m] and the held command that keeps it at rest")
+      .def("structure_forces", py::vectorize(&Dynamics::structure_force), py::arg("x"), py::arg("v"),
+           py::arg("z") = 0.0,
+           "The structure's force against the applied one in Eq (5), f_s(x) + c v + F_f(v, z) [N]: "
+           "spring, damping and friction (Stribeck, LuGre with bristle deflection z [m]); vectorised")
       .def("spring_force", &Dynamics::spring_force)
       .def("friction_force", &Dynamics::friction_force)
       .def("friction_level", &Dynamics::friction_level)
@@ -97,6 +116,10 @@ void expose_plant(py::module_& m) {
       .def("pressure_factor", &Dynamics::pressure_factor)
       .def_property_readonly("moving_mass", &Dynamics::moving_mass)
       .def_property_readonly("mode", &Dynamics::mode);
+
+  m.def("rk4_automatic_substeps", &rk4_automatic_substeps, py::arg("dynamics"), py::arg("dt"),
+        py::arg("options") = SolverOptions{},
+        "RK4 substeps per sample of dt [s] that SolverOptions(rk4_substeps=0) would choose (the C++ rule)");
 
   py::class_<Plant>(m, "Plant", "The plant stepped at the controller rate (CVODE between samples)")
       .def(py::init<const Rig&, ControlMode, double, const SolverOptions&>(), py::arg("rig"), py::arg("mode"),

@@ -2,7 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "servohydraulics/plant.hpp"
+#include "servohydraulics/dynamics.hpp"
 
 namespace servohydraulics {
 
@@ -28,15 +28,6 @@ double ssqrt_slope(double r) noexcept {
 }
 double sgn(double v) noexcept { return v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0); }
 }  // namespace
-
-const char* to_string(ControlMode mode) noexcept {
-  switch (mode) {
-    case ControlMode::Displacement: return "displacement";
-    case ControlMode::Force: return "force";
-    case ControlMode::Free: return "free";
-  }
-  return "?";
-}
 
 Dynamics::Dynamics(const Rig& rig, ControlMode mode) : rig_(rig), mode_(mode) {
   rig_.validate();
@@ -109,25 +100,47 @@ struct Dynamics::Algebra {
   bool drive_sat = false, spool_sat = false;
 };
 
+struct Dynamics::Friction {
+  double F = 0, dF_dv = 0, dF_dz = 0;           // friction force and its gradient
+  double zdot = 0, dzdot_dv = 0, dzdot_dz = 0;  // LuGre bristle rate and its gradient
+};
+
+// Friction: the static law g(v) tanh(v / v_stick), or LuGre (Canudas de Wit et al. 1995):
+// z' = v - sigma_0 |v| z / g(v),  F_f = sigma_0 z + sigma_1 z'  (its sigma_2 v is c v).
+Dynamics::Friction Dynamics::friction(double v, double z) const noexcept {
+  const Rig& r = rig_;
+  Friction f;
+  if (lugre_) {
+    const double gv = friction_level(v), av = std::fabs(v);
+    f.zdot = v - r.sigma_0 * av * z / gv;
+    f.dzdot_dv = 1.0 - r.sigma_0 * z * (sgn(v) * gv - av * friction_level_slope(v)) / (gv * gv);
+    f.dzdot_dz = -r.sigma_0 * av / gv;
+    f.F = r.sigma_0 * z + r.sigma_1 * f.zdot;
+    f.dF_dv = r.sigma_1 * f.dzdot_dv;
+    f.dF_dz = r.sigma_0 + r.sigma_1 * f.dzdot_dz;
+  } else {
+    f.F = friction_force(v);
+    f.dF_dv = friction_slope(v);
+  }
+  return f;
+}
+
+double Dynamics::structure_force(double x, double v, double z) const noexcept {
+  return friction(v, z).F + rig_.c * v + spring_force(x);
+}
+
 void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noexcept {
   const Rig& r = rig_;
   const bool actuator = mode_ != ControlMode::Free;
   const double x = y[kX], v = y[kV], p = y[kP];
 
-  // Friction: the static law g(v) tanh(v / v_stick), or LuGre (Canudas de Wit et al. 1995):
-  // z' = v - sigma_0 |v| z / g(v),  F_f = sigma_0 z + sigma_1 z'  (its sigma_2 v is c v).
-  double Ff, dFf_dv, dFf_dz = 0.0;
+  // Friction (the static law or LuGre, see friction()).
+  const Friction f = friction(v, y[kZ]);
+  const double Ff = f.F, dFf_dv = f.dF_dv, dFf_dz = f.dF_dz;
   if (lugre_) {
-    const double z = y[kZ], gv = friction_level(v), av = std::fabs(v);
-    g.zdot = v - r.sigma_0 * av * z / gv;
-    g.dzdot[kV] = 1.0 - r.sigma_0 * z * (sgn(v) * gv - av * friction_level_slope(v)) / (gv * gv);
-    g.dzdot[kZ] = -r.sigma_0 * av / gv;
-    Ff = r.sigma_0 * z + r.sigma_1 * g.zdot;
-    dFf_dv = r.sigma_1 * g.dzdot[kV];
-    dFf_dz = r.sigma_0 + r.sigma_1 * g.dzdot[kZ];
-  } else {
-    Ff = friction_force(v);
-    dFf_dv = friction_slope(v);
+    g.zdot = f.zdot;
+    g.dzdot[kV] = f.dzdot_dv;
+    g.dzdot[kZ] = f.dzdot_dz;
   }
 
   // Structure, Eq (5) with the piston riding along: M a = pA - F_f - c v - f_s(x).
@@ -284,6 +297,39 @@ State Dynamics::equilibrium(double x0) const noexcept {
   }
   y[kXv] = rig_.effects.servovalve_dynamics ? s : 0.0;
   return y;
+}
+
+Dynamics::OperatingPoint Dynamics::operating_point(double x0) const noexcept {
+  OperatingPoint op;
+  op.y0 = equilibrium(x0);
+  if (mode_ == ControlMode::Free) {
+    op.u0 = spring_force(x0);  // the ideal force that holds the spring (friction is 0 at rest)
+    return op;
+  }
+  // The rate that u drives: the spool rate with valve dynamics, else the pressure rate.
+  const int idx = rig_.effects.servovalve_dynamics ? kXvDot : kP;
+  if (mode_ == ControlMode::Displacement) {
+    op.u0 = x0;
+  } else {
+    Output out;
+    outputs(op.y0.data(), {}, out);
+    op.u0 = out.force;
+  }
+  // That rate is affine in u (Eq 1 into Eq 2 or Eq 3) until the drive or the spool
+  // saturates: Newton steps with B = df/du from the analytic Jacobian make it exact.
+  Jacobian J;
+  State B, f;
+  // (A flow curve makes it piecewise affine: a few more steps cross its breakpoints.)
+  for (int it = 0; it < 8; ++it) {
+    const Input in{op.u0, 0.0};
+    rhs(op.y0.data(), in, f.data());
+    jacobian(op.y0.data(), in, J, &B);
+    if (B[idx] == 0.0 || f[idx] == 0.0) break;
+    const double u_next = op.u0 - f[idx] / B[idx];
+    if (u_next == op.u0) break;
+    op.u0 = u_next;
+  }
+  return op;
 }
 
 }  // namespace servohydraulics

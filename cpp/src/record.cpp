@@ -19,15 +19,7 @@ RunSummary run_record(Plant& plant, const double* command, std::size_t n, const 
   plant.observe(o);
   const double F_cap = plant.dynamics().rig().F_cap;
   for (std::size_t k = 0; k < n; ++k) {
-    put(out.time, k, o.t);
-    put(out.displacement, k, o.displacement);
-    put(out.velocity, k, o.velocity);
-    put(out.acceleration, k, o.acceleration);
-    put(out.force, k, o.force);
-    put(out.pressure, k, o.pressure);
-    put(out.spool, k, o.spool);
-    put(out.drive, k, o.drive);
-    put(out.flow, k, o.flow);
+    for (std::size_t i = 0; i < kNumPlantChannels; ++i) put(out.channel[i], k, o.*kPlantChannels[i].member);
     put(out.flags, k, o.flags);
     sum.flags_any |= o.flags;
     sum.peak_force = std::fmax(sum.peak_force, std::fabs(o.force));
@@ -60,20 +52,12 @@ Trace simulate(Plant& plant, const std::vector<double>& command) {
   const std::size_t n = command.size();
   Trace tr;
   tr.command = command;
-  for (auto* v : {&tr.time, &tr.displacement, &tr.velocity, &tr.acceleration, &tr.force, &tr.pressure, &tr.spool,
-                  &tr.drive, &tr.flow})
-    v->assign(n, 0.0);
-  tr.flags.assign(n, 0u);
   Channels ch;
-  ch.time = tr.time.data();
-  ch.displacement = tr.displacement.data();
-  ch.velocity = tr.velocity.data();
-  ch.acceleration = tr.acceleration.data();
-  ch.force = tr.force.data();
-  ch.pressure = tr.pressure.data();
-  ch.spool = tr.spool.data();
-  ch.drive = tr.drive.data();
-  ch.flow = tr.flow.data();
+  for (std::size_t i = 0; i < kNumPlantChannels; ++i) {
+    tr.channel[i].assign(n, 0.0);
+    ch.channel[i] = tr.channel[i].data();
+  }
+  tr.flags.assign(n, 0u);
   ch.flags = tr.flags.data();
   tr.summary = run_record(plant, command.data(), n, ch);
   return tr;

@@ -6,14 +6,6 @@
 
 namespace servohydraulics {
 
-void require(bool ok, const char* field, double value, const char* requirement) {
-  if (ok) return;
-  std::ostringstream s;
-  s.precision(10);
-  s << "invalid " << field << " = " << value << ": " << requirement;
-  throw Error(s.str());
-}
-
 namespace {
 bool finite_positive(double v) { return std::isfinite(v) && v > 0.0; }
 bool finite_nonneg(double v) { return std::isfinite(v) && v >= 0.0; }

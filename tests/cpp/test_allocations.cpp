@@ -39,20 +39,13 @@ void check_plant(ControlMode mode, const SolverOptions& opt) {
   Plant plant(zhao2003(), mode, kDt, opt);
   const int n = 3000;
   // run_record's destinations are allocated before counting.
-  std::vector<double> cmd(n), time(n), disp(n), vel(n), acc(n), force(n), pres(n), spool(n), drive(n), flow(n);
+  std::vector<double> cmd(n);
+  std::vector<std::vector<double>> columns(kNumPlantChannels, std::vector<double>(n));
   std::vector<std::uint32_t> flags(n);
   std::vector<int> steps(n), rhs(n);
   for (int k = 0; k < n; ++k) cmd[k] = command(mode, k);
   Channels ch;
-  ch.time = time.data();
-  ch.displacement = disp.data();
-  ch.velocity = vel.data();
-  ch.acceleration = acc.data();
-  ch.force = force.data();
-  ch.pressure = pres.data();
-  ch.spool = spool.data();
-  ch.drive = drive.data();
-  ch.flow = flow.data();
+  for (std::size_t i = 0; i < kNumPlantChannels; ++i) ch.channel[i] = columns[i].data();
   ch.flags = flags.data();
   ch.internal_steps = steps.data();
   ch.rhs_evals = rhs.data();

@@ -1,7 +1,9 @@
 // Determinism: two plants given the same inputs produce bit-identical outputs;
 // a whole-record run (run_record) equals the same samples stepped one by one;
 // reset() replays a run bit for bit.  CVODE (both restart policies) and RK4,
-// every control mode, with a command that holds, jumps and varies.
+// every control mode, with a command that holds, jumps and varies.  The clock
+// does not drift: after an hour of 2 kHz samples it reads t0 + k dt (an
+// accumulated t += dt read 3600.000000504 s).
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -34,7 +36,28 @@ std::vector<double> command(ControlMode mode) {
 }
 }  // namespace
 
+// One hour at 2 kHz (7.2 million samples) of the structure alone, RK4 with one substep.
+void check_clock() {
+  Rig rig = zhao2003();
+  rig.effects.coulomb_friction = false;
+  SolverOptions rk4;
+  rk4.method = SolverOptions::Method::Rk4;
+  Plant plant(rig, ControlMode::Free, kDt, rk4);
+  const double t0 = 10.0;
+  plant.reset(0.001, t0);
+  const long n = 7200000;
+  Output o;
+  bool ok = true;
+  for (long k = 0; k < n; ++k) ok = plant.step(0.0, o).ok() && ok;
+  CHECK(ok);
+  CHECK(plant.time() == t0 + static_cast<double>(n) * kDt);
+  CHECK(o.t == plant.time());
+  CHECK_NEAR(plant.time(), t0 + 3600.0, 1e-10);
+  std::printf("clock after %ld samples: %.12f s\n", n, plant.time() - t0);
+}
+
 int main() {
+  check_clock();
   SolverOptions cvode, never, rk4;
   never.restart = SolverOptions::Restart::Never;
   rk4.method = SolverOptions::Method::Rk4;
@@ -69,9 +92,9 @@ int main() {
       Plant c(zhao2003(), mode, kDt, *opt);
       std::vector<double> x(kN), f(kN), t(kN);
       Channels ch;
-      ch.displacement = x.data();
-      ch.force = f.data();
-      ch.time = t.data();
+      ch[Channel::Displacement] = x.data();
+      ch[Channel::Force] = f.data();
+      ch[Channel::Time] = t.data();
       const RunSummary sum = run_record(c, u.data(), kN, ch);
       CHECK(sum.status.ok());
       CHECK(sum.rows == static_cast<std::size_t>(kN));

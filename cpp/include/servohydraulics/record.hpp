@@ -5,28 +5,27 @@
 // next sample).  The last command is therefore held but not seen.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
+#include "servohydraulics/channels.hpp"
 #include "servohydraulics/plant.hpp"
 
 namespace servohydraulics {
 
 //! Destination arrays of a run, each of length n (or nullptr to skip a channel).
+//! channel[i] receives kPlantChannels[i] (channels.hpp); index it by Channel,
+//! e.g. ch[Channel::Force] = force.data().
 struct Channels {
-  double* time = nullptr;
-  double* displacement = nullptr;
-  double* velocity = nullptr;
-  double* acceleration = nullptr;
-  double* force = nullptr;
-  double* pressure = nullptr;
-  double* spool = nullptr;
-  double* drive = nullptr;
-  double* flow = nullptr;
+  std::array<double*, kNumPlantChannels> channel{};
   std::uint32_t* flags = nullptr;
   int* internal_steps = nullptr;  //!< CVODE internal steps of the sample that starts at row k
   int* rhs_evals = nullptr;
+
+  double*& operator[](Channel c) noexcept { return channel[static_cast<std::size_t>(c)]; }
+  double* operator[](Channel c) const noexcept { return channel[static_cast<std::size_t>(c)]; }
 };
 
 //! What a run did.
@@ -47,10 +46,14 @@ struct RunSummary {
 RunSummary run_record(Plant& plant, const double* command, std::size_t n, const Channels& out) noexcept;
 
 //! Every channel as vectors, for C++ users who want a convenient result.
+//! Row k holds the sensors at t_k, before command[k] (the convention above).
 struct Trace {
-  std::vector<double> time, command, displacement, velocity, acceleration, force, pressure, spool, drive, flow;
+  std::vector<double> command;
+  std::array<std::vector<double>, kNumPlantChannels> channel;  //!< indexed like kPlantChannels
   std::vector<std::uint32_t> flags;
   RunSummary summary;
+
+  const std::vector<double>& operator[](Channel c) const noexcept { return channel[static_cast<std::size_t>(c)]; }
 };
 
 //! Allocating convenience wrapper: validates the command (throws Error naming

@@ -1,0 +1,45 @@
+// The plant's state vector and the control mode that selects its equations.
+#pragma once
+
+#include <array>
+
+namespace servohydraulics {
+
+//! What the analog servo controller feeds back (Eq 1), or no actuator at all.
+enum class ControlMode {
+  Displacement,  //!< LVDT displacement; command in [m]
+  Force,         //!< load-cell force; command in [N]
+  Free,          //!< structure alone, no actuator; command is an ideal external force [N]
+};
+
+constexpr const char* to_string(ControlMode mode) noexcept {
+  switch (mode) {
+    case ControlMode::Displacement: return "displacement";
+    case ControlMode::Force: return "force";
+    case ControlMode::Free: return "free";
+  }
+  return "?";
+}
+
+//! Indices of the state vector.
+//! kZ is the LuGre bristle deflection [m] (held at 0 unless effects.lugre_friction).
+enum StateIndex : int { kX = 0, kV = 1, kP = 2, kXv = 3, kXvDot = 4, kZ = 5, kNumStates = 6 };
+using State = std::array<double, kNumStates>;
+using Jacobian = std::array<std::array<double, kNumStates>, kNumStates>;  //!< J[row][col] = d f_row / d y_col
+
+//! Name and unit of each state, indexed by StateIndex.
+struct StateInfo {
+  const char* name;
+  const char* unit;
+  const char* doc;
+};
+constexpr StateInfo kStates[kNumStates] = {
+    {"x", "m", "displacement of the structure and piston"},
+    {"v", "m/s", "velocity"},
+    {"p", "Pa", "load pressure (Eq 4)"},
+    {"x_v", "-", "spool opening (Eq 2; 0 with a static valve)"},
+    {"x_v_dot", "1/s", "spool rate"},
+    {"z", "m", "LuGre bristle deflection (0 unless lugre_friction)"},
+};
+
+}  // namespace servohydraulics

@@ -1,0 +1,149 @@
+#include "detail/cvode_integrator.hpp"
+
+#include <string>
+
+#include "servohydraulics/error.hpp"
+
+namespace servohydraulics::detail {
+
+namespace {
+int check_flag(int flag, const char* call) {
+  if (flag < 0) throw Error(std::string("SUNDIALS setup call ") + call + " failed with flag " + std::to_string(flag));
+  return flag;
+}
+template <class P>
+P check_ptr(P p, const char* call) {
+  if (p == nullptr) throw Error(std::string("SUNDIALS setup call ") + call + " returned NULL");
+  return p;
+}
+// CVODE prints its errors by default; the hot path must stay silent.  The
+// status carries the flag instead.
+void silent_error_handler(int, const char*, const char*, char*, void*) {}
+}  // namespace
+
+CvodeIntegrator::CvodeIntegrator(const Dynamics& dyn, double dt, const SolverOptions& opt, const State& y_prime)
+    : restart_(opt.restart), dyn_(&dyn) {
+  y_.reset(check_ptr(N_VNew_Serial(kNumStates, ctx_), "N_VNew_Serial"));
+  atol_.reset(check_ptr(N_VNew_Serial(kNumStates, ctx_), "N_VNew_Serial"));
+  for (int i = 0; i < kNumStates; ++i) NV_Ith_S(atol_.get(), i) = opt.rtol * opt.atol_scale[i];
+  for (int i = 0; i < kNumStates; ++i) NV_Ith_S(y_.get(), i) = 0.0;
+  mem_.reset(check_ptr(CVodeCreate(CV_BDF, ctx_), "CVodeCreate"));
+  void* cv = mem_.get();
+  check_flag(CVodeInit(cv, &CvodeIntegrator::rhs, 0.0, y_.get()), "CVodeInit");
+  check_flag(CVodeSetUserData(cv, this), "CVodeSetUserData");
+  check_flag(CVodeSetErrHandlerFn(cv, silent_error_handler, nullptr), "CVodeSetErrHandlerFn");
+  check_flag(CVodeSVtolerances(cv, opt.rtol, atol_.get()), "CVodeSVtolerances");
+  J_.reset(check_ptr(SUNDenseMatrix(kNumStates, kNumStates, ctx_), "SUNDenseMatrix"));
+  LS_.reset(check_ptr(SUNLinSol_Dense(y_.get(), J_.get(), ctx_), "SUNLinSol_Dense"));
+  check_flag(CVodeSetLinearSolver(cv, LS_.get(), J_.get()), "CVodeSetLinearSolver");
+  check_flag(CVodeSetJacFn(cv, &CvodeIntegrator::jac), "CVodeSetJacFn");
+  check_flag(CVodeSetMaxNumSteps(cv, opt.max_steps_per_sample), "CVodeSetMaxNumSteps");
+  check_flag(CVodeSetMaxOrd(cv, opt.max_order), "CVodeSetMaxOrd");
+  // A held command that jumps (a step input) makes the right-hand side
+  // discontinuous at the sample start; with Restart::Never the BDF history
+  // straddles it and CVODE's default of 7 error-test failures is not enough
+  // to cut h down to the jump (CV_ERR_FAILURE; tests/cpp/test_status.cpp).
+  check_flag(CVodeSetMaxErrTestFails(cv, 20), "CVodeSetMaxErrTestFails");
+  check_flag(CVodeSetMaxHnilWarns(cv, -1), "CVodeSetMaxHnilWarns");
+  if (opt.max_internal_step > 0.0) check_flag(CVodeSetMaxStep(cv, opt.max_internal_step), "CVodeSetMaxStep");
+  prime(y_prime, dt);
+}
+
+// CVODE allocates the linear solver's saved Jacobian (cvLsInitialize, a
+// SUNMatClone) in its first CVode() call, not in CVodeInit: take one
+// throw-away internal step here, at construction, so that advance() never
+// allocates (tests/cpp/test_allocations.cpp).  The caller resets afterwards
+// (CVodeReInit keeps that memory).
+void CvodeIntegrator::prime(const State& y_prime, double dt) {
+  in_ = {};
+  for (int i = 0; i < kNumStates; ++i) NV_Ith_S(y_.get(), i) = y_prime[i];
+  check_flag(CVodeReInit(mem_.get(), 0.0, y_.get()), "CVodeReInit");
+  check_flag(CVodeSetStopTime(mem_.get(), dt), "CVodeSetStopTime");
+  sunrealtype tret = 0.0;
+  check_flag(CVode(mem_.get(), dt, y_.get(), &tret, CV_ONE_STEP), "CVode (priming step)");
+}
+
+int CvodeIntegrator::rhs(sunrealtype, N_Vector yv, N_Vector ydot, void* user) {
+  auto* self = static_cast<CvodeIntegrator*>(user);
+  self->dyn_->rhs(N_VGetArrayPointer(yv), self->in_, N_VGetArrayPointer(ydot));
+  return 0;
+}
+
+int CvodeIntegrator::jac(sunrealtype, N_Vector yv, N_Vector, SUNMatrix Jm, void* user, N_Vector, N_Vector, N_Vector) {
+  auto* self = static_cast<CvodeIntegrator*>(user);
+  Jacobian Jl;
+  self->dyn_->jacobian(N_VGetArrayPointer(yv), self->in_, Jl);
+  for (int i = 0; i < kNumStates; ++i)
+    for (int j = 0; j < kNumStates; ++j) SM_ELEMENT_D(Jm, i, j) = Jl[i][j];
+  return 0;
+}
+
+void CvodeIntegrator::reset(const State& y, double t) noexcept {
+  steps_done_ = rhs_done_ = restarts_ = 0;
+  in_ = {};
+  // CVodeReInit also zeroes the counters of the current run, so that the totals restart.
+  for (int i = 0; i < kNumStates; ++i) NV_Ith_S(y_.get(), i) = y[i];
+  CVodeReInit(mem_.get(), t, y_.get());
+  need_reinit_ = false;
+}
+
+void CvodeIntegrator::accumulate_counters() noexcept {
+  long ns = 0, nf = 0;
+  CVodeGetNumSteps(mem_.get(), &ns);
+  CVodeGetNumRhsEvals(mem_.get(), &nf);
+  steps_done_ += ns;
+  rhs_done_ += nf;
+}
+
+Status CvodeIntegrator::advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t,
+                                double t_next) noexcept {
+  // A ZOH jump (the held command or its rate changed) is a discontinuity of the
+  // right-hand side at the sample start: restart the BDF history there.
+  const bool changed = in.u != in_.u || in.u_rate != in_.u_rate;
+  if (changed && restart_ == SolverOptions::Restart::OnInputChange) need_reinit_ = true;
+  dyn_ = &dyn;
+  in_ = in;
+  void* cv = mem_.get();
+  Status st;
+  if (need_reinit_) {
+    accumulate_counters();
+    for (int i = 0; i < kNumStates; ++i) NV_Ith_S(y_.get(), i) = y[i];
+    CVodeReInit(cv, t, y_.get());
+    need_reinit_ = false;
+    st.restarted = true;
+    ++restarts_;
+  }
+  long ns0 = 0, nf0 = 0;
+  CVodeGetNumSteps(cv, &ns0);
+  CVodeGetNumRhsEvals(cv, &nf0);
+  CVodeSetStopTime(cv, t_next);  // end exactly on the controller sample, never straddle it
+  sunrealtype tret = t;
+  const int flag = CVode(cv, t_next, y_.get(), &tret, CV_NORMAL);
+  long ns1 = 0, nf1 = 0;
+  CVodeGetNumSteps(cv, &ns1);
+  CVodeGetNumRhsEvals(cv, &nf1);
+  st.internal_steps = static_cast<int>(ns1 - ns0);
+  st.rhs_evals = static_cast<int>(nf1 - nf0);
+  for (int i = 0; i < kNumStates; ++i) y[i] = NV_Ith_S(y_.get(), i);
+  t = tret;
+  if (flag < 0) {
+    st.code = flag == CV_TOO_MUCH_WORK ? Status::TooMuchWork : Status::SolverFailure;
+    st.cvode_flag = flag;
+    need_reinit_ = true;
+  }
+  st.t = t;
+  return st;
+}
+
+long CvodeIntegrator::total_steps() const noexcept {
+  long ns = 0;
+  CVodeGetNumSteps(mem_.get(), &ns);
+  return steps_done_ + ns;
+}
+long CvodeIntegrator::total_rhs_evals() const noexcept {
+  long nf = 0;
+  CVodeGetNumRhsEvals(mem_.get(), &nf);
+  return rhs_done_ + nf;
+}
+
+}  // namespace servohydraulics::detail

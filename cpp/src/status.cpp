@@ -1,0 +1,16 @@
+#include "servohydraulics/status.hpp"
+
+namespace servohydraulics {
+
+const char* Status::message() const noexcept {
+  switch (code) {
+    case Ok: return "ok";
+    case SolverFailure: return "CVODE failed (see cvode_flag)";
+    case TooMuchWork: return "overrun: more CVODE internal steps than max_steps_per_sample in one sample";
+    case NonFinite: return "the state became NaN or infinite (the run diverged)";
+    case NotReady: return "step() called after a failure without reset()";
+  }
+  return "?";
+}
+
+}  // namespace servohydraulics
