@@ -153,7 +153,7 @@ def test_weak_effect_under_the_noise_floor_is_found_at_20db() -> None:
     rec = Record({k: np.asarray(v) for k, v in _displacement_record(
         snr=20, duration=4.0, friction="coulomb", F_c=150.0).items()})
     case = engine.make_case(rec, "displacement", "weak")
-    stats = engine.channel_stats(engine.simulate_all(_linear_rig(), [case], 0.0), [case])
+    stats = engine.channel_stats(engine.simulate_all(_linear_rig(), [case], 0.0, [case.x0_data]), [case])
     assert engine.at_noise_floor(stats)  # the variance test alone cannot see it
     d = sh.diagnose(rec, _linear_rig(), mode="displacement", progress=False)
     assert d.verdict == "effect_found"

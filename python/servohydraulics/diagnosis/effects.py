@@ -12,13 +12,14 @@ is simulated.
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
 
-from ..rig import Rig, rig_from_dict, rig_to_dict
+from ..rig import Rig
 
 
 @dataclass(frozen=True)
@@ -89,15 +90,10 @@ class Candidate:
 INTERACT_SPAN = 0.25  #: bounded re-fit of interacting nominal parameters: +-25 % of the current value
 
 
-def _copy(rig: Rig) -> Rig:
-    """An independent copy of a rig (through its rig-file dict)."""
-    return rig_from_dict(rig_to_dict(rig))
-
-
 # --- apply functions -----------------------------------------------------------------
 
 def _apply_coulomb(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     r.effects.coulomb_friction = True
     r.F_c = float(max(th[0], 0.0))
     return r
@@ -114,7 +110,7 @@ LUGRE_MIN_PRESLIDING = 1e-5
 
 def _apply_lugre(rig: Rig, th: np.ndarray) -> Rig:
     # theta = (sigma_0 [N/m], F_c [N]); sigma_0 beyond LUGRE_ABSENT_SIGMA_0 (or inf) is the static law
-    r = _copy(rig)
+    r = copy.copy(rig)
     r.effects.coulomb_friction = True
     r.F_c = float(max(th[1], 0.0))
     if (not math.isfinite(th[0]) or th[0] > LUGRE_ABSENT_SIGMA_0
@@ -137,13 +133,13 @@ def _lugre_scan(ctx: Context) -> np.ndarray:
 
 
 def _apply_viscous(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     r.c = float(max(th[0], 0.0))
     return r
 
 
 def _apply_softening(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     r.effects.spring_softening = True
     r.k_2 = float(th[0])
     return r
@@ -151,7 +147,7 @@ def _apply_softening(rig: Rig, th: np.ndarray) -> Rig:
 
 def _apply_load_pressure(rig: Rig, th: np.ndarray) -> Rig:
     # theta = p_s [Pa]; +inf (or beyond 1e12) means the effect is off.
-    r = _copy(rig)
+    r = copy.copy(rig)
     if not math.isfinite(th[0]) or th[0] > 1e12:
         r.effects.load_pressure = False
     else:
@@ -185,7 +181,7 @@ def knee_flow_curve(g_1: float, x_k: float) -> tuple[list[float], list[float]]:
 
 def _apply_flow(rig: Rig, th: np.ndarray) -> Rig:
     # theta = (g_1, x_k): full-opening flow ratio [-], knee (linear limit) [-]
-    r = _copy(rig)
+    r = copy.copy(rig)
     g_1, x_k = float(th[0]), float(th[1])
     if g_1 >= 1.0 - 1e-12:
         r.effects.flow_nonlinearity = False
@@ -203,7 +199,7 @@ def _apply_delay(rig: Rig, th: np.ndarray) -> Rig:
 
 
 def _apply_valve(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     if not math.isfinite(th[0]) or th[0] > 1e5:
         r.effects.servovalve_dynamics = False
         return r
@@ -214,27 +210,27 @@ def _apply_valve(rig: Rig, th: np.ndarray) -> Rig:
 
 
 def _apply_leakage(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     r.C_l = float(max(th[0], 0.0))
     return r
 
 
 def _apply_piston_mass(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     r.effects.piston_mass = True
     r.m_p = float(max(th[0], 0.0))
     return r
 
 
 def _apply_spool(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     r.effects.spool_saturation = True
     r.x_v_max = float(th[0])
     return r
 
 
 def _apply_stiffness(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     ratio = r.k_2 / r.k
     r.k = float(th[0])
     r.k_2 = float(th[0] * ratio)  # the softened branch keeps its ratio to k
@@ -278,7 +274,7 @@ def _compressibility_bounds(ctx: Context) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _apply_compressibility(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     r.K_a = float(th[0])
     return r
 

@@ -35,10 +35,7 @@ def write_outputs(d, out: Path) -> Path:
 
 
 def _plots(d, out: Path) -> dict:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     P = d.plots
     if not P:
@@ -47,7 +44,8 @@ def _plots(d, out: Path) -> dict:
     figs = {}
     chans = list(cases[0].meas)
     # 1. residual before/after
-    fig, axes = plt.subplots(len(chans), 1, figsize=(9, 2.2 * len(chans)), sharex=True, squeeze=False)
+    fig = Figure(figsize=(9, 2.2 * len(chans)))
+    axes = fig.subplots(len(chans), 1, sharex=True, squeeze=False)
     for ax, c in zip(axes[:, 0], chans):
         t0 = 0.0
         for case, sb, sa in zip(cases, before, after):
@@ -63,15 +61,15 @@ def _plots(d, out: Path) -> dict:
     axes[-1, 0].set_xlabel("time [s] (records end to end)")
     fig.tight_layout()
     fig.savefig(out / "residual_before_after.png", dpi=110)
-    plt.close(fig)
     figs["residual"] = "residual_before_after.png"
     # 2. the signature that named the effect (screening scores + signature vs residual)
-    first = [c for c in d.candidates if c["round"] == 1 and c["screening_score"] is not None]
+    first = [c for c in d.candidates if c.round == 1 and c.screening_score is not None]
     if first:
-        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 3.6), gridspec_kw={"width_ratios": [1, 1.6]})
-        names = [c["name"] for c in first]
-        a1.barh(names, [c["screening_score"] for c in first], color=[
-            "tab:green" if c["accepted"] else "tab:gray" for c in first])
+        fig = Figure(figsize=(11, 3.6))
+        a1, a2 = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.6]})
+        names = [c.name for c in first]
+        a1.barh(names, [c.screening_score for c in first], color=[
+            "tab:green" if c.accepted else "tab:gray" for c in first])
         a1.set_xlabel("share of the residual its signature explains (round 1)")
         a1.invert_yaxis()
         sig = P["signatures"].get(d.effects[0]["name"]) if d.effects else None
@@ -90,11 +88,11 @@ def _plots(d, out: Path) -> dict:
             a2.text(0.5, 0.5, "no effect named", ha="center", va="center")
         fig.tight_layout()
         fig.savefig(out / "signature.png", dpi=110)
-        plt.close(fig)
         figs["signature"] = "signature.png"
     # 3. the gap closing
     hist = P["history"]
-    fig, ax = plt.subplots(figsize=(7, 3.4))
+    fig = Figure(figsize=(7, 3.4))
+    ax = fig.subplots()
     w = 0.8 / (len(hist) + 1)
     for i, (label, g) in enumerate(hist):
         ax.bar(np.arange(len(chans)) + i * w, [100 * g[c] for c in chans], w,
@@ -107,7 +105,6 @@ def _plots(d, out: Path) -> dict:
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(out / "gap_closing.png", dpi=110)
-    plt.close(fig)
     figs["gap"] = "gap_closing.png"
     return figs
 
@@ -159,9 +156,9 @@ def _markdown(d, figs: dict) -> str:
     L += ["## Candidates", "", "| round | name | screening | balance eq. | ΔBIC | held-out | result |",
           "|---|---|---|---|---|---|---|"]
     for c in d.candidates:
-        L.append(f"| {c['round']} | {c['name']} | {_fmt(c['screening_score'])} | {_fmt(c['balance_score'])} | "
-                 f"{_fmt(c['delta_bic'])} | {_fmt(c['heldout_improvement'])} | "
-                 f"{'accepted' if c['accepted'] else c['rejection']} |")
+        L.append(f"| {c.round} | {c.name} | {_fmt(c.screening_score)} | {_fmt(c.balance_score)} | "
+                 f"{_fmt(c.delta_bic)} | {_fmt(c.heldout_improvement)} | "
+                 f"{'accepted' if c.accepted else c.rejection} |")
     L.append("")
     L += ["## Plots", ""]
     if "residual" in figs:
