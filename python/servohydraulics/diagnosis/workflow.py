@@ -153,7 +153,7 @@ class _Setup:
     keep: int
     refit_interacting: bool
     joint_refit: bool
-    bar: Any  #: the progress bar
+    bar: Any = None  #: the progress bar (set once the nominal model runs)
 
 
 @dataclass(eq=False)
@@ -213,12 +213,13 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
         A ``Diagnosis`` (``.write(dir)`` writes diagnosis.json, rig_updated.toml, report.md).
     """
     t_start = time.time()
-    setup = _prepare(records, rig, mode, candidates, keep, max_effects, refit_interacting, joint_refit, progress)
+    setup = _prepare(records, rig, mode, candidates, keep, refit_interacting, joint_refit)
     current = copy.copy(rig)
     x0 = engine.refine_x0(current, setup.cases, 0.0)
     sims0 = engine.simulate_all(current, setup.cases, 0.0, x0)
     if any(s is None for s in sims0):
         raise ValueError("the nominal rig's simulation fails on this record: check the rig and --mode")
+    setup = dataclasses.replace(setup, bar=_progress(max_effects * (len(setup.names) + keep), progress, "diagnose"))
     state = _State(rig=current, tau=0.0, x0=x0, sims=sims0, history=[("nominal", engine.gap(sims0, setup.cases))])
     last = None
     for rnd in range(1, max_effects + 1):
@@ -232,8 +233,8 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
     return _result(setup, state, sims0, last, time.time() - t_start)
 
 
-def _prepare(records, rig: Rig, mode: str, candidates: Sequence[str] | None, keep: int, max_effects: int,
-             refit_interacting: bool, joint_refit: bool, progress: bool) -> _Setup:
+def _prepare(records, rig: Rig, mode: str, candidates: Sequence[str] | None, keep: int, refit_interacting: bool,
+             joint_refit: bool) -> _Setup:
     """Checks the arguments and prepares the records (unique names)."""
     if mode not in MODES:
         raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(MODES)}")
@@ -248,8 +249,7 @@ def _prepare(records, rig: Rig, mode: str, candidates: Sequence[str] | None, kee
         path = getattr(r, "path", None)
         c = engine.make_case(r, mode, str(path) if path else f"record{i}")
         cases.append(dataclasses.replace(c, name=f"{c.name}#{i}") if any(c.name == o.name for o in cases) else c)
-    bar = _progress(max_effects * (len(names) + keep), progress, "diagnose")
-    return _Setup(rig, mode, cases, names, keep, refit_interacting, joint_refit, bar)
+    return _Setup(rig, mode, cases, names, keep, refit_interacting, joint_refit)
 
 
 def _context(setup: _Setup, state: _State) -> Context:
