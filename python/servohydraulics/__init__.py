@@ -26,7 +26,7 @@ except ImportError as e:  # pragma: no cover - only without a built core
 
 from . import analysis, identify  # noqa: E402
 from ._core import ControlMode, Dynamics, FlowCurve, Plant, SolverOptions, linearize
-from .diagnose import Diagnosis, diagnose  # the function shadows the subpackage name
+from .diagnosis import Diagnosis, diagnose
 from .methods import MethodResult, TestMethodError, run_eft, run_rpsd, run_tracking
 from .records import read_record, write_record
 from .reproduce import reproduce  # the function shadows the module name

@@ -45,7 +45,7 @@ def _reproduce(args: argparse.Namespace) -> int:
 
 
 def _diagnose(args: argparse.Namespace) -> int:
-    from .diagnose import diagnose
+    from .diagnosis import diagnose
     from .rig import load_rig
 
     d = diagnose(args.records, load_rig(args.rig), mode=args.mode, progress=not args.quiet)

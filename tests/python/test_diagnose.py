@@ -1,10 +1,10 @@
 """Diagnose: the contract (API, CLI, files, JSON) and hidden-effect cases end to end.
 
 Records are made by the independent plain-Python simulator of the evaluation
-(tests/diagnose_eval/independent_plant.py), not by the core the workflow uses,
+(benchmarks/diagnose_eval/independent_plant.py), not by the core the workflow uses,
 with measurement noise; the workflow sees only the record, mode and nominal rig.
 The full evaluation (many records, graded strengths, other forms) is
-tests/diagnose_eval/evaluate.py, reported in docs/diagnose_eval.md.
+benchmarks/diagnose_eval/evaluate.py, reported in docs/diagnose_eval.md.
 """
 
 from __future__ import annotations
@@ -19,11 +19,11 @@ import pytest
 
 import servohydraulics as sh
 from servohydraulics.cli import main
-from servohydraulics.diagnose import NAMES
-from servohydraulics.diagnose import engine as E
+from servohydraulics.diagnosis import NAMES
+from servohydraulics.diagnosis import engine
 from servohydraulics.records import Record
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "diagnose_eval"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks" / "diagnose_eval"))
 import independent_plant as ip  # noqa: E402
 
 DT = 5e-4
@@ -152,9 +152,9 @@ def test_weak_effect_under_the_noise_floor_is_found_at_20db() -> None:
     same noise on a record with nothing hidden gives no_effect."""
     rec = Record({k: np.asarray(v) for k, v in _displacement_record(
         snr=20, duration=4.0, friction="coulomb", F_c=150.0).items()})
-    case = E.make_case(rec, "displacement", "weak")
-    stats = E.channel_stats(E.simulate_all(_linear_rig(), [case], 0.0), [case])
-    assert E.at_noise_floor(stats)  # the variance test alone cannot see it
+    case = engine.make_case(rec, "displacement", "weak")
+    stats = engine.channel_stats(engine.simulate_all(_linear_rig(), [case], 0.0, [case.x0_data]), [case])
+    assert engine.at_noise_floor(stats)  # the variance test alone cannot see it
     d = sh.diagnose(rec, _linear_rig(), mode="displacement", progress=False)
     assert d.verdict == "effect_found"
     assert d.effects[0]["name"] == "coulomb_friction"

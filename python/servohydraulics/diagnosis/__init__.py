@@ -1,4 +1,4 @@
-"""Diagnose: find where simulation and measurement disagree, name the missing
+"""Diagnosis: find where simulation and measurement disagree, name the missing
 physical effect from a library, fit it, add it to the model, show the gap shrink.
 
     import servohydraulics as sh
@@ -10,6 +10,8 @@ See docs/diagnose.md.
 """
 
 from .effects import LIBRARY, NAMES, Candidate, Param, separating_experiment
+from .types import CandidateLog, JointRefit
 from .workflow import Diagnosis, diagnose
 
-__all__ = ["LIBRARY", "NAMES", "Candidate", "Diagnosis", "Param", "diagnose", "separating_experiment"]
+__all__ = ["LIBRARY", "NAMES", "Candidate", "CandidateLog", "Diagnosis", "JointRefit", "Param", "diagnose",
+           "separating_experiment"]

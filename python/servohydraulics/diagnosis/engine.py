@@ -5,17 +5,19 @@ simulation error, and the statistics (effective sample size, BIC, intervals).
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
 from scipy.signal import savgol_filter
 
-from ..records import Record
 from ..rig import Rig, rig_to_dict
 from ..simulate import SimulationError, simulate, solver_options
-from .effects import INTERACT_SPAN, Candidate, Context, _copy
+from .effects import INTERACT_SPAN, Candidate, Context
+from .types import Case, FitResult, Screening, Sim
 
 #: channels compared, in order of preference, per mode (those present in the record are used)
 CHANNELS = {
@@ -26,29 +28,6 @@ CHANNELS = {
 N_SEGMENTS = 6  #: held-out split: contiguous segments, even ones train, odd ones test
 
 
-@dataclass
-class Case:
-    """One record prepared for simulation and comparison."""
-
-    name: str
-    mode: str
-    dt: float
-    t: np.ndarray  #: time from 0 [s]
-    u: np.ndarray  #: the record's command [m or N]
-    x0: float  #: initial displacement [m]
-    meas: dict  #: channel -> measured samples (SI)
-    scale: dict  #: channel -> rms of the measured channel (normalisation)
-    sigma: dict  #: channel -> noise standard deviation estimated from the record itself
-    train: np.ndarray  #: boolean mask of the training samples
-    derived: dict  #: measured velocity/acceleration (Savitzky-Golay when not recorded)
-    x0_data: float = 0.0  #: initial displacement estimated from the record alone [m]
-    x0_sd: float = 0.0  #: its standard deviation [m]
-
-    @property
-    def channels(self) -> tuple[str, ...]:
-        return tuple(self.meas)
-
-
 def noise_sigma(y: np.ndarray) -> float:
     """Noise standard deviation of a record channel from its third differences
     (robust MAD; smooth signal content sampled well above its bandwidth cancels)."""
@@ -56,7 +35,8 @@ def noise_sigma(y: np.ndarray) -> float:
     return float(1.4826 * np.median(np.abs(d3 - np.median(d3))) / math.sqrt(20.0))
 
 
-def make_case(rec: Record, mode: str, name: str) -> Case:
+def make_case(rec: Any, mode: str, name: str) -> Case:
+    """A record (``read_record``'s result: ``.channels``, ``.dt``) prepared for the diagnosis."""
     ch = rec.channels
     t = ch["time"] - ch["time"][0]
     dt = rec.dt
@@ -93,8 +73,8 @@ def make_case(rec: Record, mode: str, name: str) -> Case:
     }
     derived["rms_v"] = float(np.sqrt(np.mean(derived["velocity"] ** 2)))
     x0, x0_sd = initial_displacement(t, x, sigma["displacement"])
-    return Case(name, mode, dt, t, np.asarray(ch["command"], float), x0, meas, scale, sigma, train, derived,
-                x0, x0_sd)
+    return Case(name, mode, dt, t, np.asarray(ch["command"], float), meas, scale, sigma, train, derived,
+                x0, x0_sd, float(np.max(np.abs(derived["velocity"]))))
 
 
 def initial_displacement(t: np.ndarray, x: np.ndarray, sigma: float) -> tuple[float, float]:
@@ -113,40 +93,45 @@ def initial_displacement(t: np.ndarray, x: np.ndarray, sigma: float) -> tuple[fl
     return float(coef[0]), sd
 
 
-def refine_x0(rig: Rig, cases: list[Case], tau: float) -> None:
-    """Fits each record's initial displacement (a nuisance state, not an effect)
-    by simulation error with the current model, within +-4 sd of the estimate
-    from the record alone (so that it cannot absorb a missing effect)."""
+def refine_x0(rig: Rig, cases: list[Case], tau: float) -> tuple[float, ...]:
+    """Each record's initial displacement (a nuisance state, not an effect)
+    fitted by simulation error with the current model, within +-4 sd of the
+    estimate from the record alone (so that it cannot absorb a missing effect)."""
+    out = []
     for case in cases:
         x0, sd = case.x0_data, max(case.x0_sd, 1e-8)
 
         def fun(z, case=case):
-            case.x0 = float(z[0])
-            return residuals([simulate_case(rig, case, tau)], [case])
+            return residuals([simulate_case(rig, case, tau, float(z[0]))], [case])
 
         try:
             res = least_squares(fun, [x0], bounds=([x0 - 4 * sd], [x0 + 4 * sd]), x_scale=[sd], diff_step=1e-3,
                                 max_nfev=10)
-            case.x0 = float(res.x[0])
+            out.append(float(res.x[0]))
         except ValueError:
-            case.x0 = x0
+            out.append(x0)
+    return tuple(out)
 
 
 # --- simulation ---------------------------------------------------------------------
 
-_RK4: dict = {}
+def rk4_options(rig: Rig, case: Case):
+    """The solver options of a diagnosis simulation: RK4 with enough substeps
+    that h times a bound on the plant's fastest eigenvalue stays below 1.2 (at
+    least 4), or None (CVODE) if that needs more than 64.  The bound: valve
+    poles, friction regularisation, LuGre bristles at the record's peak
+    velocity, leakage and oil-column rates.
 
-
-def _fastest_rate(rig: Rig, mode: str, v_peak: float = 1.0) -> float:
-    """A bound on the plant's fastest eigenvalue [1/s]: valve poles, friction
-    regularisation, LuGre bristles at the record's peak velocity v_peak [m/s],
-    leakage and oil-column rates (sets the RK4 substep)."""
+    The core's automatic rule (``solver_options(method="rk4")``, rk4_substeps = 0)
+    is the one home of this rule once it covers the LuGre bristle rate; this
+    function is the one place to swap."""
+    mode = case.mode
     M = rig.m + (rig.m_p if rig.effects.piston_mass and mode != "free" else 0.0)
     rates = [rig.c / M]
     if rig.effects.coulomb_friction:
         rates.append(rig.F_c / (rig.v_stick * M))
         if rig.effects.lugre_friction and rig.F_c > 0:
-            rates.append(rig.sigma_0 * 1.5 * v_peak / rig.F_c)
+            rates.append(rig.sigma_0 * 1.5 * case.v_peak / rig.F_c)
     if mode != "free":
         wv = 2 * math.pi * rig.f_v
         z = rig.zeta_v
@@ -154,17 +139,8 @@ def _fastest_rate(rig: Rig, mode: str, v_peak: float = 1.0) -> float:
             rates.append(wv * (z + math.sqrt(max(z * z - 1.0, 0.0))) if z >= 1 else wv)
         rates.append(rig.C_l / rig.K_a)
         rates.append(rig.A / math.sqrt(rig.K_a * M))
-    return max(rates)
-
-
-def _options(rig: Rig, mode: str, dt: float, v_peak: float = 1.0):
-    """RK4 with enough substeps that h times the fastest rate stays below 1.2 (at least 4)."""
-    n = max(4, int(math.ceil(_fastest_rate(rig, mode, v_peak) * dt / 1.2)))
-    if n > 64:
-        return None  # too stiff for RK4: CVODE
-    if n not in _RK4:
-        _RK4[n] = solver_options(method="rk4", rk4_substeps=n)
-    return _RK4[n]
+    n = max(4, int(math.ceil(max(rates) * case.dt / 1.2)))
+    return solver_options(method="rk4", rk4_substeps=n) if n <= 64 else None
 
 
 def delayed(u: np.ndarray, dt: float, tau: float) -> np.ndarray:
@@ -176,14 +152,15 @@ def delayed(u: np.ndarray, dt: float, tau: float) -> np.ndarray:
     return np.interp(k, np.arange(u.size), u, left=u[0], right=u[-1])
 
 
-def simulate_case(rig: Rig, case: Case, tau: float = 0.0) -> dict | None:
-    """The model's channels for the record's command (None if the run fails).
-    Fixed-step RK4 (4 substeps a sample) for speed; CVODE if RK4 fails."""
+def simulate_case(rig: Rig, case: Case, tau: float, x0: float) -> Sim:
+    """The model's channels for the record's command delayed by ``tau`` [s]
+    from the initial displacement ``x0`` [m] (None if the run fails).
+    Fixed-step RK4 (``rk4_options``) for speed; CVODE if RK4 fails."""
     u = delayed(case.u, case.dt, tau)
-    first = _options(rig, case.mode, case.dt, float(np.max(np.abs(case.derived["velocity"]))))
+    first = rk4_options(rig, case)
     for opts in ((first, None) if first is not None else (None,)):
         try:
-            r = simulate(rig, case.mode, u, case.dt, x0=case.x0, options=opts)
+            r = simulate(rig, case.mode, u, case.dt, x0=float(x0), options=opts)
         except (SimulationError, ValueError):
             continue
         return {c: getattr(r, c) for c in ("displacement", "force", "velocity", "acceleration", "pressure", "spool")}
@@ -208,14 +185,20 @@ def channel_stats(sims: list, cases: list[Case], which: str = "all") -> dict:
         mask = {"all": np.ones(case.t.size, bool), "train": case.train, "test": ~case.train}[which]
         for c, y in case.meas.items():
             e = ((y - sim[c]) / case.scale[c] if sim is not None else np.full(y.size, 10.0))[mask]
-            e0 = e - e.mean()
-            den = float(e0 @ e0)
-            rho = float(e0[1:] @ e0[:-1] / den) if den > 0 else 0.0
             out[(case.name, c)] = {
-                "ssr": float(e @ e), "n": int(e.size), "rho": max(min(rho, 0.999), 0.0),
+                "ssr": float(e @ e), "n": int(e.size), "rho": lag1_autocorrelation(e),
                 "floor": float(e.size * (case.sigma[c] / case.scale[c]) ** 2),
             }
     return out
+
+
+def lag1_autocorrelation(e: np.ndarray) -> float:
+    """Lag-1 autocorrelation of a residual series (mean removed), clipped to
+    [0, 0.999] (the effective-sample-size and bandwidth rules need rho >= 0)."""
+    e0 = e - e.mean()
+    den = float(e0 @ e0)
+    rho = float(e0[1:] @ e0[:-1] / den) if den > 0 else 0.0
+    return min(max(rho, 0.0), 0.999)
 
 
 def n_eff(stats: dict) -> dict:
@@ -318,7 +301,7 @@ class Space:
         else:
             rig, tau = self.cand.apply(self.ctx.rig, main), base_tau
         if self.interacting:
-            rig = _copy(rig) if rig is self.ctx.rig else rig
+            rig = copy.copy(rig) if rig is self.ctx.rig else rig
             for (key, _), v in zip(self.interacting, ext[self.n_main:]):
                 setattr(rig, key, float(v))
         return rig, tau
@@ -419,7 +402,7 @@ class JointSpace:
             else:
                 rig = sp.cand.apply(rig, main)
         if self.interacting:
-            rig = _copy(rig) if rig is self.base else rig
+            rig = copy.copy(rig) if rig is self.base else rig
             for (key, _), v in zip(self.interacting, ext[self.n_main:]):
                 setattr(rig, key, float(v))
         return rig, tau
@@ -436,7 +419,8 @@ def _flat(d: dict, prefix: str = "") -> dict:
 
 
 def same_rig(a: Rig, b: Rig, rtol: float = 1e-9) -> bool:
-    """True if two rigs have the same switches and parameters (numbers within ``rtol``)."""
+    """True if two rigs have the same switches and parameters (numbers within ``rtol``).
+    To be replaced by the binding's ``Rig.__eq__`` (``a == b``); this is the one place."""
     fa, fb = _flat(rig_to_dict(a)), _flat(rig_to_dict(b))
     if fa.keys() != fb.keys():
         return False
@@ -455,24 +439,26 @@ def same_rig(a: Rig, b: Rig, rtol: float = 1e-9) -> bool:
     return True
 
 
-def simulate_all(rig: Rig, cases: list[Case], tau: float) -> list:
-    return [simulate_case(rig, c, tau) for c in cases]
+def simulate_all(rig: Rig, cases: list[Case], tau: float, x0s) -> list[Sim]:
+    """``simulate_case`` of every record, each from its initial displacement in ``x0s`` [m]."""
+    return [simulate_case(rig, c, tau, x0) for c, x0 in zip(cases, x0s)]
 
 
 # --- screening ----------------------------------------------------------------------------
 
-def secant_screen(space: Space, cases: list[Case], sims0: list, r0: np.ndarray, base_tau: float) -> dict:
-    """Regress the current residual on the effect's signature: the change of the
-    simulated channels between "absent" and a probe value of each parameter.
-    Returns the explained fraction of the residual and the implied estimate."""
+def secant_screen(space: Space, cases: list[Case], x0s, r0: np.ndarray, base_tau: float) -> Screening:
+    """Regress the current residual ``r0`` on the effect's signature: the change
+    of the simulated channels (from the initial displacements ``x0s``) between
+    "absent" and a probe value of each parameter.  Returns the explained
+    fraction of the residual and the implied estimate."""
     cols = []
     for i in range(space.n_main):
         z = space.absent.copy()
         z[i] = space.probe[i]
         rig, tau = space.rig_and_tau(z, base_tau)
-        sims = simulate_all(rig, cases, tau)
+        sims = simulate_all(rig, cases, tau, x0s)
         if any(s is None for s in sims):
-            return {"score": 0.0, "z0": space.probe.copy(), "signature": None, "failed": True}
+            return Screening(0.0, space.probe.copy(), None, failed=True)
         cols.append(-(residuals(sims, cases) - r0))  # change of the normalised simulation
     D = np.column_stack(cols)
     alpha, *_ = np.linalg.lstsq(D, r0, rcond=None)
@@ -487,7 +473,24 @@ def secant_screen(space: Space, cases: list[Case], sims0: list, r0: np.ndarray, 
     rr = float(r0 @ r0)
     res = r0 - D @ alpha_c
     score = max(0.0, 1.0 - float(res @ res) / rr) if rr > 0 else 0.0
-    return {"score": score, "z0": z0, "signature": D @ alpha_c, "failed": False}
+    return Screening(score, z0, D @ alpha_c)
+
+
+def _structure_force(rig: Rig, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The structure's forces of Eq (5) but inertia, at displacement x [m] and
+    velocity v [m/s]: damping, spring (softening beyond x_contact) and Coulomb
+    friction (tanh regularisation) [N].
+
+    Eq (5) belongs to the core: this NumPy copy lacks the Stribeck level and
+    the LuGre bristle force (dynamics.cpp).  It is to be replaced by the core's
+    vectorised ``Dynamics.structure_forces(x, v, z=0)``; this is the one place."""
+    xc = rig.x_contact
+    if rig.effects.spring_softening:
+        fs = np.where(np.abs(x) <= xc, rig.k * x, np.sign(x) * (rig.k * xc + rig.k_2 * (np.abs(x) - xc)))
+    else:
+        fs = rig.k * x
+    fr = rig.F_c * np.tanh(v / rig.v_stick) if rig.effects.coulomb_friction else 0.0
+    return rig.c * v + fs + fr
 
 
 def balance_screen(rig: Rig, cases: list[Case], signature) -> float:
@@ -498,13 +501,7 @@ def balance_screen(rig: Rig, cases: list[Case], signature) -> float:
     for case in cases:
         d = case.derived
         x, v, a, F = d["displacement"], d["velocity"], d["acceleration"], d["force"]
-        xc = rig.x_contact
-        if rig.effects.spring_softening:
-            fs = np.where(np.abs(x) <= xc, rig.k * x, np.sign(x) * (rig.k * xc + rig.k_2 * (np.abs(x) - xc)))
-        else:
-            fs = rig.k * x
-        fr = rig.F_c * np.tanh(v / rig.v_stick) if rig.effects.coulomb_friction else 0.0
-        e = F - (rig.m * a + rig.c * v + fs + fr)
+        e = F - (rig.m * a + _structure_force(rig, x, v))
         s = signature(rig, {"displacement": x, "velocity": v, "acceleration": a, "rms_v": d["rms_v"]})
         n = x.size
         cut = slice(n // 50, n - n // 50)  # drop the filter's edge samples
@@ -519,48 +516,31 @@ def balance_screen(rig: Rig, cases: list[Case], signature) -> float:
 
 # --- fitting ----------------------------------------------------------------------------
 
-def fit(space: Space, cases: list[Case], z0: np.ndarray, base_tau: float, which: str,
-        max_nfev: int = 30) -> tuple[np.ndarray, object]:
+def fit(space: Space, cases: list[Case], z0: np.ndarray, base_tau: float, which: str, x0s,
+        max_nfev: int = 30) -> FitResult:
     """Bounded least-squares fit of the candidate's parameters by simulation error,
     with each record's initial displacement co-fitted as a nuisance parameter
-    (within +-4 sd of its estimate from the record alone): an initial state
-    refined against the model without the effect is biased towards hiding it
-    (in a free decay a 40 um offset is a third of F_c / k).  The cases' x0 are
-    left as they were; ``res.x0`` holds the fitted ones, ``res.jac`` and
-    ``res.nuisance_scale`` include their columns (for the intervals)."""
-    lo0, hi0 = space.lo, space.hi
-    x0_start = np.array([c.x0 for c in cases])
+    (started from ``x0s``, within +-4 sd of its estimate from the record alone):
+    an initial state refined against the model without the effect is biased
+    towards hiding it (in a free decay a 40 um offset is a third of F_c / k).
+    The result's ``jac`` and ``nuisance_scale`` include the x0 columns (for the
+    intervals)."""
     sd = np.array([max(c.x0_sd, 1e-8) for c in cases])
     cen = np.array([c.x0_data for c in cases])
-    lo = np.concatenate([lo0, cen - 4 * sd])
-    hi = np.concatenate([hi0, cen + 4 * sd])
+    lo = np.concatenate([space.lo, cen - 4 * sd])
+    hi = np.concatenate([space.hi, cen + 4 * sd])
     p = space.n_main + len(space.interacting)
-    zs = np.concatenate([np.asarray(z0, float), np.clip(x0_start, cen - 4 * sd, cen + 4 * sd)])
+    zs = np.concatenate([np.asarray(z0, float), np.clip(np.asarray(x0s, float), cen - 4 * sd, cen + 4 * sd)])
     zs = np.clip(zs, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
 
     def fun(z):
-        for c, v in zip(cases, z[p:]):
-            c.x0 = float(v)
         rig, tau = space.rig_and_tau(z[:p], base_tau)
-        return residuals(simulate_all(rig, cases, tau), cases, which)
+        return residuals(simulate_all(rig, cases, tau, z[p:]), cases, which)
 
-    try:
-        res = least_squares(fun, zs, bounds=(lo, hi), x_scale=np.concatenate([space.scale, sd]), diff_step=1e-3,
-                            max_nfev=max_nfev, method="trf", xtol=1e-6, ftol=1e-8)
-    finally:
-        for c, v in zip(cases, x0_start):
-            c.x0 = float(v)
-    res.x0 = res.x[p:].copy()
-    res.nuisance_scale = sd
-    return res.x[:p].copy(), res
-
-
-def with_x0(cases: list[Case], x0s) -> list[float]:
-    """Sets the cases' initial displacements; returns the previous ones."""
-    old = [c.x0 for c in cases]
-    for c, v in zip(cases, x0s):
-        c.x0 = float(v)
-    return old
+    res = least_squares(fun, zs, bounds=(lo, hi), x_scale=np.concatenate([space.scale, sd]), diff_step=1e-3,
+                        max_nfev=max_nfev, method="trf", xtol=1e-6, ftol=1e-8)
+    return FitResult(z=res.x[:p].copy(), x0=res.x[p:].copy(), jac=res.jac, fun=res.fun, nuisance_scale=sd,
+                     nfev=int(res.nfev))
 
 
 def series_lengths(cases: list[Case], which: str = "all") -> list[int]:
@@ -577,15 +557,12 @@ def bartlett_bandwidth(e: np.ndarray) -> int:
     Andrews (1991) for the Bartlett kernel: 1.1447 (alpha n)^(1/3), alpha =
     4 rho^2 / ((1 - rho)^2 (1 + rho)^2), rho the lag-1 autocorrelation; at most n/2."""
     n = e.size
-    e0 = e - e.mean()
-    den = float(e0 @ e0)
-    rho = float(e0[1:] @ e0[:-1] / den) if den > 0 else 0.0
-    rho = min(max(rho, 0.0), 0.999)
+    rho = lag1_autocorrelation(e)
     alpha = 4 * rho ** 2 / ((1 - rho) ** 2 * (1 + rho) ** 2)
     return int(min(max(math.ceil(1.1447 * (alpha * n) ** (1 / 3)), 1), n // 2))
 
 
-def covariance(space: Space, res, lengths: list[int]) -> np.ndarray:
+def covariance(space: Space, res: FitResult, lengths: list[int]) -> np.ndarray:
     """HAC (Newey-West) sandwich covariance of the least-squares estimate in
     fitting coordinates: (J'J)^-1 Omega (J'J)^-1, Omega the long-run covariance
     of the scores J_t r_t with Bartlett weights, summed over the (record,
@@ -596,7 +573,7 @@ def covariance(space: Space, res, lengths: list[int]) -> np.ndarray:
     J = res.jac
     r = res.fun
     n, p = J.shape
-    scale = np.concatenate([space.scale, getattr(res, "nuisance_scale", np.zeros(0))])[:p]
+    scale = np.concatenate([space.scale, res.nuisance_scale])[:p]
     D = np.maximum(np.abs(scale), 1e-300)  # column scaling: parameters differ by 10 orders of magnitude
     Js = J * D
     omega = np.zeros((p, p))
@@ -624,14 +601,14 @@ def covariance(space: Space, res, lengths: list[int]) -> np.ndarray:
     return cov[:q, :q]
 
 
-def intervals(space: Space, res, lengths: list[int]) -> tuple[np.ndarray, np.ndarray]:
+def intervals(space: Space, res: FitResult, lengths: list[int]) -> tuple[np.ndarray, np.ndarray]:
     """95 % intervals (fitting coordinates) from the HAC sandwich ``covariance``."""
     sd = np.sqrt(np.maximum(np.diag(covariance(space, res, lengths)), 0.0))
-    z = res.x[: sd.size]
+    z = res.z[: sd.size]
     return z - 1.96 * sd, z + 1.96 * sd
 
 
-def joint_excludes_absent(space: Space, res, lengths: list[int], tested: np.ndarray) -> tuple[bool, float]:
+def joint_excludes_absent(space: Space, res: FitResult, lengths: list[int], tested: np.ndarray) -> tuple[bool, float]:
     """Joint 95 % test that the effect is present: the Wald statistic of the
     tested own parameters against "absent", (z - z_0)' C^-1 (z - z_0) with C
     their HAC covariance, against the chi-square 95 % point with as many degrees
@@ -646,7 +623,7 @@ def joint_excludes_absent(space: Space, res, lengths: list[int], tested: np.ndar
     C = covariance(space, res, lengths)[np.ix_(idx, idx)]
     if not np.all(np.isfinite(C)):
         return False, 1.0
-    d = (res.x[: space.absent.size] - space.absent)[idx]
+    d = (res.z[: space.absent.size] - space.absent)[idx]
     w = float(d @ np.linalg.pinv(C, rcond=1e-12) @ d)
     pval = float(chi2.sf(w, idx.size))
     return pval < 0.05, pval

@@ -12,13 +12,14 @@ is simulated.
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
 
-from ..rig import Rig, rig_from_dict, rig_to_dict
+from ..rig import Rig
 
 
 @dataclass(frozen=True)
@@ -89,15 +90,10 @@ class Candidate:
 INTERACT_SPAN = 0.25  #: bounded re-fit of interacting nominal parameters: +-25 % of the current value
 
 
-def _copy(rig: Rig) -> Rig:
-    """An independent copy of a rig (through its rig-file dict)."""
-    return rig_from_dict(rig_to_dict(rig))
-
-
 # --- apply functions -----------------------------------------------------------------
 
 def _apply_coulomb(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     r.effects.coulomb_friction = True
     r.F_c = float(max(th[0], 0.0))
     return r
@@ -114,7 +110,7 @@ LUGRE_MIN_PRESLIDING = 1e-5
 
 def _apply_lugre(rig: Rig, th: np.ndarray) -> Rig:
     # theta = (sigma_0 [N/m], F_c [N]); sigma_0 beyond LUGRE_ABSENT_SIGMA_0 (or inf) is the static law
-    r = _copy(rig)
+    r = copy.copy(rig)
     r.effects.coulomb_friction = True
     r.F_c = float(max(th[1], 0.0))
     if (not math.isfinite(th[0]) or th[0] > LUGRE_ABSENT_SIGMA_0
@@ -137,13 +133,13 @@ def _lugre_scan(ctx: Context) -> np.ndarray:
 
 
 def _apply_viscous(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     r.c = float(max(th[0], 0.0))
     return r
 
 
 def _apply_softening(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     r.effects.spring_softening = True
     r.k_2 = float(th[0])
     return r
@@ -151,7 +147,7 @@ def _apply_softening(rig: Rig, th: np.ndarray) -> Rig:
 
 def _apply_load_pressure(rig: Rig, th: np.ndarray) -> Rig:
     # theta = p_s [Pa]; +inf (or beyond 1e12) means the effect is off.
-    r = _copy(rig)
+    r = copy.copy(rig)
     if not math.isfinite(th[0]) or th[0] > 1e12:
         r.effects.load_pressure = False
     else:
@@ -185,7 +181,7 @@ def knee_flow_curve(g_1: float, x_k: float) -> tuple[list[float], list[float]]:
 
 def _apply_flow(rig: Rig, th: np.ndarray) -> Rig:
     # theta = (g_1, x_k): full-opening flow ratio [-], knee (linear limit) [-]
-    r = _copy(rig)
+    r = copy.copy(rig)
     g_1, x_k = float(th[0]), float(th[1])
     if g_1 >= 1.0 - 1e-12:
         r.effects.flow_nonlinearity = False
@@ -203,7 +199,7 @@ def _apply_delay(rig: Rig, th: np.ndarray) -> Rig:
 
 
 def _apply_valve(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     if not math.isfinite(th[0]) or th[0] > 1e5:
         r.effects.servovalve_dynamics = False
         return r
@@ -214,27 +210,27 @@ def _apply_valve(rig: Rig, th: np.ndarray) -> Rig:
 
 
 def _apply_leakage(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     r.C_l = float(max(th[0], 0.0))
     return r
 
 
 def _apply_piston_mass(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     r.effects.piston_mass = True
     r.m_p = float(max(th[0], 0.0))
     return r
 
 
 def _apply_spool(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     r.effects.spool_saturation = True
     r.x_v_max = float(th[0])
     return r
 
 
 def _apply_stiffness(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     ratio = r.k_2 / r.k
     r.k = float(th[0])
     r.k_2 = float(th[0] * ratio)  # the softened branch keeps its ratio to k
@@ -278,7 +274,7 @@ def _compressibility_bounds(ctx: Context) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _apply_compressibility(rig: Rig, th: np.ndarray) -> Rig:
-    r = _copy(rig)
+    r = copy.copy(rig)
     r.K_a = float(th[0])
     return r
 
@@ -365,164 +361,162 @@ def _sig_mass(rig: Rig, s: dict) -> np.ndarray:
     return s["acceleration"]
 
 
-def build_library() -> dict[str, Candidate]:
-    """The candidate effects by name (the names used in reports)."""
-    c = [
-        Candidate(
-            "coulomb_friction", (Param("F_c", "N", "structure.F_c"),),
-            "Coulomb friction F_c sgn(v) in the structure, Eq (5) (effects.coulomb_friction on)",
-            absent=_coulomb_absent,
-            bounds=lambda ctx: (_a(0.0), _a(5e3)),
-            probe=lambda ctx: _coulomb_absent(ctx) + max(20.0, 0.004 * ctx.rig.k * max(ctx.peak_x, 1e-3)),
-            apply=_apply_coulomb, interacts=(("c", "N s/m"),),
-            structural_signature=_sig_coulomb, look_alikes=("viscous_damping", "lugre_friction"),
-            separate="repeat the test at two amplitudes (or a free vibration): Coulomb friction's share of the "
-                     "response falls with amplitude and makes the decay linear, viscous damping's does not",
-        ),
-        Candidate(
-            "lugre_friction",
-            (Param("sigma_0", "N/m", "structure.sigma_0 (effects.lugre_friction on)", reciprocal=True),
-             Param("F_c", "N", "structure.F_c")),
-            "friction with presliding (LuGre: bristle stiffness sigma_0, sliding level F_c; Canudas de Wit et al. "
-            "1995): below the presliding displacement F_c / sigma_0 friction acts as a spring, then as Coulomb "
-            "friction (added: seal friction in small-amplitude tests)",
-            absent=_lugre_absent,
-            bounds=lambda ctx: (_a(0.02 * ctx.rig.k, 0.0), _a(1e12, 5e3)),
-            probe=lambda ctx: _a(ctx.rig.k, _coulomb_absent(ctx)[0]
-                                 + max(20.0, 0.004 * ctx.rig.k * max(ctx.peak_x, 1e-3))),
-            apply=_apply_lugre, interacts=(("c", "N s/m"),), scan=_lugre_scan, nests=("coulomb_friction",),
-            look_alikes=("coulomb_friction", "viscous_damping"),
-            separate="a small-amplitude test (below the presliding displacement F_c / sigma_0): presliding friction "
-                     "stiffens the structure there, Coulomb friction locks it, viscous damping does neither",
-        ),
-        Candidate(
-            "viscous_damping", (Param("c", "N s/m", "structure.c"),),
-            "error in the viscous damping c of Eq (5)",
-            absent=lambda ctx: _a(ctx.rig.c),
-            bounds=lambda ctx: (_a(0.0), _a(max(20 * ctx.rig.c, 0.2 * 2 * math.sqrt(ctx.rig.k * ctx.rig.m)))),
-            probe=lambda ctx: _a(ctx.rig.c * 1.5 + 0.005 * 2 * math.sqrt(ctx.rig.k * ctx.rig.m)),
-            apply=_apply_viscous, interacts=(("F_c", "N"),),
-            structural_signature=_sig_viscous, look_alikes=("coulomb_friction", "lugre_friction"),
-            separate="repeat at two amplitudes: viscous damping gives the same decay ratio at every amplitude",
-        ),
-        Candidate(
-            "spring_softening", (Param("k_2", "N/m", "structure.k_2"),),
-            "stiffness k_2 beyond +-x_contact (effects.spring_softening on; x_contact kept)",
-            absent=_softening_absent,
-            bounds=lambda ctx: (_a(0.02 * ctx.rig.k), _a(2.0 * ctx.rig.k)),
-            probe=lambda ctx: _softening_absent(ctx) - 0.3 * ctx.rig.k,
-            apply=_apply_softening, interacts=(("x_contact", "m"),),
-            structural_signature=_sig_softening, exercised=_softening_exercised,
-            separate="a slow test with the amplitude stepped across x_contact: the stiffness changes only beyond it",
-        ),
-        Candidate(
-            "load_pressure", (Param("p_s", "Pa", "actuator.p_s (effects.load_pressure on)", reciprocal=True),),
-            "the load-pressure square-root term of Eq (3) with supply pressure p_s",
-            absent=_load_pressure_absent,
-            bounds=lambda ctx: (_a(max(1.02 * ctx.peak_pressure, 1e5)), _a(1e9)),
-            probe=lambda ctx: _a(max(1.6 * ctx.peak_pressure, 0.5 * min(ctx.rig.p_s, 1e9))),
-            apply=_apply_load_pressure, interacts=(("K_v", "m^3/s"),),
-            modes=("displacement", "force"),
-            separate="a test at high force and low velocity (large load pressure, small spool opening) versus one "
-                     "at low force and high velocity: load pressure acts on the first, the flow curve on the second",
-        ),
-        Candidate(
-            "flow_gain_nonlinearity",
-            (Param("g_1", "-", "servovalve.flow_curve (table built from g_1 and x_k; effects.flow_nonlinearity on)"),
-             Param("x_k", "-", "servovalve.flow_curve: the knee (linear below it)", tests_absent=False)),
-            "flow gain falling with spool opening (the Fig 4a curve): linear up to the knee x_k, then bending "
-            "to the full-opening flow ratio g(1) = g_1 = Q(x_v = 1) / K_v",
-            absent=_flow_absent,
-            bounds=lambda ctx: (_a(0.1, 0.0), _a(1.0, 0.3)),
-            probe=lambda ctx: _a(1.0 / (1.0 + max(0.5, 0.1 / max(ctx.peak_spool, 1e-3))), 0.1),
-            apply=_apply_flow, interacts=(("K_v", "m^3/s"),), modes=("displacement", "force"),
-            exercised=_spool_exercised, active=_flow_active, look_alikes=("spool_saturation", "load_pressure"),
-            separate="a test at large spool opening with little load (fast, low force): the flow curve acts there, "
-                     "load pressure does not",
-        ),
-        Candidate(
-            "time_delay", (Param("tau", "s", "none: the record's command is delayed by tau (integer + fractional "
-                                               "samples) before simulating"),),
-            "a pure delay of the command (controller, DSP or communication latency); down to -2 samples: a "
-            "record whose response rows lead the command (acquisition alignment, not physics)",
-            absent=lambda ctx: _a(0.0),
-            bounds=lambda ctx: (_a(-2.0 * ctx.dt), _a(0.05)),
-            probe=lambda ctx: _a(0.002),
-            apply=_apply_delay, delays_command=True, modes=("displacement", "force"),
-            look_alikes=("servovalve_dynamics",),
-            separate="a sine sweep to higher frequency: a delay's phase lag grows linearly with frequency without "
-                     "amplitude loss, the servovalve's saturates and costs amplitude",
-        ),
-        Candidate(
-            "servovalve_dynamics",
-            (Param("f_v", "Hz", "servovalve.f_v", reciprocal=True), Param("zeta_v", "-", "servovalve.zeta_v")),
-            "the servovalve's second-order dynamics, Eq (2) (natural frequency, damping)",
-            absent=lambda ctx: _a(ctx.rig.f_v, ctx.rig.zeta_v) if ctx.rig.effects.servovalve_dynamics
-            else _a(math.inf, ctx.rig.zeta_v),
-            bounds=lambda ctx: (_a(3.0, 0.1), _a(1000.0, 5.0)),
-            probe=lambda ctx: _a(0.7 * min(ctx.rig.f_v, 1000.0), ctx.rig.zeta_v * 0.6),
-            apply=_apply_valve, modes=("displacement", "force"), look_alikes=("time_delay",),
-            separate="a sine sweep to 50-100 Hz: the valve's amplitude roll-off and phase saturation separate it "
-                     "from a pure delay",
-        ),
-        Candidate(
-            "leakage", (Param("C_l", "m^3/(s Pa)", "actuator.C_l"),),
-            "leakage / flow-pressure coefficient C_l of Eq (4)",
-            absent=lambda ctx: _a(ctx.rig.C_l),
-            bounds=lambda ctx: (_a(0.0), _a(max(50 * ctx.rig.C_l, 1e-9))),
-            probe=lambda ctx: _a(ctx.rig.C_l * 1.5 + 1e-12),
-            apply=_apply_leakage, interacts=(("K_a", "m^5/N"),), modes=("displacement", "force"),
-            separate="hold a static force: leakage needs a steady spool offset (drive) to hold pressure",
-        ),
-        Candidate(
-            "piston_mass", (Param("m_p", "kg", "structure.m_p (effects.piston_mass on)"),),
-            "mass moving between the load cell and the structure (piston, fixtures)",
-            absent=_piston_absent,
-            bounds=lambda ctx: (_a(0.0), _a(0.3 * ctx.rig.m)),
-            probe=lambda ctx: _piston_absent(ctx) + max(100.0, 0.02 * ctx.rig.m),
-            apply=_apply_piston_mass, modes=("displacement", "force"),
-            structural_signature=None, look_alikes=("compressibility",),
-            separate="record the load pressure as well (or test with the specimen detached): the load cell then "
-                     "differs from p A by m_p a; a softer oil column (compressibility) lowers the oil-column "
-                     "frequency as the extra mass does, but leaves F = p A",
-        ),
-        Candidate(
-            "spool_saturation", (Param("x_v_max", "-", "servovalve.x_v_max (effects.spool_saturation on)"),),
-            "spool travel limited to +-x_v_max (end stops)",
-            absent=_spool_absent,
-            bounds=lambda ctx: (_a(max(0.01 * ctx.peak_spool, 1e-4)), _a(max(ctx.peak_spool, 2e-4))),
-            probe=lambda ctx: _a(0.7 * ctx.peak_spool),
-            apply=_apply_spool, modes=("displacement", "force"), exercised=_spool_exercised,
-            scan=lambda ctx: _spool_absent(ctx)[0] * np.array([0.4, 0.5, 0.6, 0.7, 0.8, 0.9]),
-            look_alikes=("flow_gain_nonlinearity",),
-            separate="a fast ramp: saturation caps the velocity at a constant, a flow curve only bends it",
-        ),
-        Candidate(
-            "stiffness_error", (Param("k", "N/m", "structure.k (k_2 scaled with it)"),),
-            "error in the initial stiffness k of Eq (5) (added: a mis-identified specimen)",
-            absent=lambda ctx: _a(ctx.rig.k),
-            bounds=lambda ctx: (_a(0.3 * ctx.rig.k), _a(3.0 * ctx.rig.k)),
-            probe=lambda ctx: _a(1.05 * ctx.rig.k),
-            apply=_apply_stiffness, structural_signature=_sig_stiffness,
-            separate="a quasi-static test: the stiffness is the force-displacement slope",
-        ),
-        Candidate(
-            "compressibility", (Param("K_a", "m^5/N", "actuator.K_a"),),
-            "oil compressibility K_a = V_t/(4 beta_e) of Eq (4) (added: entrained air, hoses)",
-            absent=lambda ctx: _a(ctx.rig.K_a),
-            bounds=_compressibility_bounds,
-            probe=lambda ctx: _a(1.6 * ctx.rig.K_a),
-            apply=_apply_compressibility, interacts=(("C_l", "m^3/(s Pa)"),), modes=("displacement", "force"),
-            look_alikes=("piston_mass",),
-            separate="a sweep through the oil-column resonance: compressibility moves it, leakage damps it; "
-                     "a piston mass moves it too (both set A^2 / (K_a M)) but shows as F = p A - m_p a "
-                     "when the load pressure is recorded",
-        ),
-    ]
-    return {cand.name: cand for cand in c}
+#: the candidate effects, in the order screened and reported (a table: one ``Candidate`` each)
+CANDIDATES: tuple[Candidate, ...] = (
+    Candidate(
+        "coulomb_friction", (Param("F_c", "N", "structure.F_c"),),
+        "Coulomb friction F_c sgn(v) in the structure, Eq (5) (effects.coulomb_friction on)",
+        absent=_coulomb_absent,
+        bounds=lambda ctx: (_a(0.0), _a(5e3)),
+        probe=lambda ctx: _coulomb_absent(ctx) + max(20.0, 0.004 * ctx.rig.k * max(ctx.peak_x, 1e-3)),
+        apply=_apply_coulomb, interacts=(("c", "N s/m"),),
+        structural_signature=_sig_coulomb, look_alikes=("viscous_damping", "lugre_friction"),
+        separate="repeat the test at two amplitudes (or a free vibration): Coulomb friction's share of the "
+                 "response falls with amplitude and makes the decay linear, viscous damping's does not",
+    ),
+    Candidate(
+        "lugre_friction",
+        (Param("sigma_0", "N/m", "structure.sigma_0 (effects.lugre_friction on)", reciprocal=True),
+         Param("F_c", "N", "structure.F_c")),
+        "friction with presliding (LuGre: bristle stiffness sigma_0, sliding level F_c; Canudas de Wit et al. "
+        "1995): below the presliding displacement F_c / sigma_0 friction acts as a spring, then as Coulomb "
+        "friction (added: seal friction in small-amplitude tests)",
+        absent=_lugre_absent,
+        bounds=lambda ctx: (_a(0.02 * ctx.rig.k, 0.0), _a(1e12, 5e3)),
+        probe=lambda ctx: _a(ctx.rig.k, _coulomb_absent(ctx)[0]
+                             + max(20.0, 0.004 * ctx.rig.k * max(ctx.peak_x, 1e-3))),
+        apply=_apply_lugre, interacts=(("c", "N s/m"),), scan=_lugre_scan, nests=("coulomb_friction",),
+        look_alikes=("coulomb_friction", "viscous_damping"),
+        separate="a small-amplitude test (below the presliding displacement F_c / sigma_0): presliding friction "
+                 "stiffens the structure there, Coulomb friction locks it, viscous damping does neither",
+    ),
+    Candidate(
+        "viscous_damping", (Param("c", "N s/m", "structure.c"),),
+        "error in the viscous damping c of Eq (5)",
+        absent=lambda ctx: _a(ctx.rig.c),
+        bounds=lambda ctx: (_a(0.0), _a(max(20 * ctx.rig.c, 0.2 * 2 * math.sqrt(ctx.rig.k * ctx.rig.m)))),
+        probe=lambda ctx: _a(ctx.rig.c * 1.5 + 0.005 * 2 * math.sqrt(ctx.rig.k * ctx.rig.m)),
+        apply=_apply_viscous, interacts=(("F_c", "N"),),
+        structural_signature=_sig_viscous, look_alikes=("coulomb_friction", "lugre_friction"),
+        separate="repeat at two amplitudes: viscous damping gives the same decay ratio at every amplitude",
+    ),
+    Candidate(
+        "spring_softening", (Param("k_2", "N/m", "structure.k_2"),),
+        "stiffness k_2 beyond +-x_contact (effects.spring_softening on; x_contact kept)",
+        absent=_softening_absent,
+        bounds=lambda ctx: (_a(0.02 * ctx.rig.k), _a(2.0 * ctx.rig.k)),
+        probe=lambda ctx: _softening_absent(ctx) - 0.3 * ctx.rig.k,
+        apply=_apply_softening, interacts=(("x_contact", "m"),),
+        structural_signature=_sig_softening, exercised=_softening_exercised,
+        separate="a slow test with the amplitude stepped across x_contact: the stiffness changes only beyond it",
+    ),
+    Candidate(
+        "load_pressure", (Param("p_s", "Pa", "actuator.p_s (effects.load_pressure on)", reciprocal=True),),
+        "the load-pressure square-root term of Eq (3) with supply pressure p_s",
+        absent=_load_pressure_absent,
+        bounds=lambda ctx: (_a(max(1.02 * ctx.peak_pressure, 1e5)), _a(1e9)),
+        probe=lambda ctx: _a(max(1.6 * ctx.peak_pressure, 0.5 * min(ctx.rig.p_s, 1e9))),
+        apply=_apply_load_pressure, interacts=(("K_v", "m^3/s"),),
+        modes=("displacement", "force"),
+        separate="a test at high force and low velocity (large load pressure, small spool opening) versus one "
+                 "at low force and high velocity: load pressure acts on the first, the flow curve on the second",
+    ),
+    Candidate(
+        "flow_gain_nonlinearity",
+        (Param("g_1", "-", "servovalve.flow_curve (table built from g_1 and x_k; effects.flow_nonlinearity on)"),
+         Param("x_k", "-", "servovalve.flow_curve: the knee (linear below it)", tests_absent=False)),
+        "flow gain falling with spool opening (the Fig 4a curve): linear up to the knee x_k, then bending "
+        "to the full-opening flow ratio g(1) = g_1 = Q(x_v = 1) / K_v",
+        absent=_flow_absent,
+        bounds=lambda ctx: (_a(0.1, 0.0), _a(1.0, 0.3)),
+        probe=lambda ctx: _a(1.0 / (1.0 + max(0.5, 0.1 / max(ctx.peak_spool, 1e-3))), 0.1),
+        apply=_apply_flow, interacts=(("K_v", "m^3/s"),), modes=("displacement", "force"),
+        exercised=_spool_exercised, active=_flow_active, look_alikes=("spool_saturation", "load_pressure"),
+        separate="a test at large spool opening with little load (fast, low force): the flow curve acts there, "
+                 "load pressure does not",
+    ),
+    Candidate(
+        "time_delay", (Param("tau", "s", "none: the record's command is delayed by tau (integer + fractional "
+                                           "samples) before simulating"),),
+        "a pure delay of the command (controller, DSP or communication latency); down to -2 samples: a "
+        "record whose response rows lead the command (acquisition alignment, not physics)",
+        absent=lambda ctx: _a(0.0),
+        bounds=lambda ctx: (_a(-2.0 * ctx.dt), _a(0.05)),
+        probe=lambda ctx: _a(0.002),
+        apply=_apply_delay, delays_command=True, modes=("displacement", "force"),
+        look_alikes=("servovalve_dynamics",),
+        separate="a sine sweep to higher frequency: a delay's phase lag grows linearly with frequency without "
+                 "amplitude loss, the servovalve's saturates and costs amplitude",
+    ),
+    Candidate(
+        "servovalve_dynamics",
+        (Param("f_v", "Hz", "servovalve.f_v", reciprocal=True), Param("zeta_v", "-", "servovalve.zeta_v")),
+        "the servovalve's second-order dynamics, Eq (2) (natural frequency, damping)",
+        absent=lambda ctx: _a(ctx.rig.f_v, ctx.rig.zeta_v) if ctx.rig.effects.servovalve_dynamics
+        else _a(math.inf, ctx.rig.zeta_v),
+        bounds=lambda ctx: (_a(3.0, 0.1), _a(1000.0, 5.0)),
+        probe=lambda ctx: _a(0.7 * min(ctx.rig.f_v, 1000.0), ctx.rig.zeta_v * 0.6),
+        apply=_apply_valve, modes=("displacement", "force"), look_alikes=("time_delay",),
+        separate="a sine sweep to 50-100 Hz: the valve's amplitude roll-off and phase saturation separate it "
+                 "from a pure delay",
+    ),
+    Candidate(
+        "leakage", (Param("C_l", "m^3/(s Pa)", "actuator.C_l"),),
+        "leakage / flow-pressure coefficient C_l of Eq (4)",
+        absent=lambda ctx: _a(ctx.rig.C_l),
+        bounds=lambda ctx: (_a(0.0), _a(max(50 * ctx.rig.C_l, 1e-9))),
+        probe=lambda ctx: _a(ctx.rig.C_l * 1.5 + 1e-12),
+        apply=_apply_leakage, interacts=(("K_a", "m^5/N"),), modes=("displacement", "force"),
+        separate="hold a static force: leakage needs a steady spool offset (drive) to hold pressure",
+    ),
+    Candidate(
+        "piston_mass", (Param("m_p", "kg", "structure.m_p (effects.piston_mass on)"),),
+        "mass moving between the load cell and the structure (piston, fixtures)",
+        absent=_piston_absent,
+        bounds=lambda ctx: (_a(0.0), _a(0.3 * ctx.rig.m)),
+        probe=lambda ctx: _piston_absent(ctx) + max(100.0, 0.02 * ctx.rig.m),
+        apply=_apply_piston_mass, modes=("displacement", "force"),
+        structural_signature=None, look_alikes=("compressibility",),
+        separate="record the load pressure as well (or test with the specimen detached): the load cell then "
+                 "differs from p A by m_p a; a softer oil column (compressibility) lowers the oil-column "
+                 "frequency as the extra mass does, but leaves F = p A",
+    ),
+    Candidate(
+        "spool_saturation", (Param("x_v_max", "-", "servovalve.x_v_max (effects.spool_saturation on)"),),
+        "spool travel limited to +-x_v_max (end stops)",
+        absent=_spool_absent,
+        bounds=lambda ctx: (_a(max(0.01 * ctx.peak_spool, 1e-4)), _a(max(ctx.peak_spool, 2e-4))),
+        probe=lambda ctx: _a(0.7 * ctx.peak_spool),
+        apply=_apply_spool, modes=("displacement", "force"), exercised=_spool_exercised,
+        scan=lambda ctx: _spool_absent(ctx)[0] * np.array([0.4, 0.5, 0.6, 0.7, 0.8, 0.9]),
+        look_alikes=("flow_gain_nonlinearity",),
+        separate="a fast ramp: saturation caps the velocity at a constant, a flow curve only bends it",
+    ),
+    Candidate(
+        "stiffness_error", (Param("k", "N/m", "structure.k (k_2 scaled with it)"),),
+        "error in the initial stiffness k of Eq (5) (added: a mis-identified specimen)",
+        absent=lambda ctx: _a(ctx.rig.k),
+        bounds=lambda ctx: (_a(0.3 * ctx.rig.k), _a(3.0 * ctx.rig.k)),
+        probe=lambda ctx: _a(1.05 * ctx.rig.k),
+        apply=_apply_stiffness, structural_signature=_sig_stiffness,
+        separate="a quasi-static test: the stiffness is the force-displacement slope",
+    ),
+    Candidate(
+        "compressibility", (Param("K_a", "m^5/N", "actuator.K_a"),),
+        "oil compressibility K_a = V_t/(4 beta_e) of Eq (4) (added: entrained air, hoses)",
+        absent=lambda ctx: _a(ctx.rig.K_a),
+        bounds=_compressibility_bounds,
+        probe=lambda ctx: _a(1.6 * ctx.rig.K_a),
+        apply=_apply_compressibility, interacts=(("C_l", "m^3/(s Pa)"),), modes=("displacement", "force"),
+        look_alikes=("piston_mass",),
+        separate="a sweep through the oil-column resonance: compressibility moves it, leakage damps it; "
+                 "a piston mass moves it too (both set A^2 / (K_a M)) but shows as F = p A - m_p a "
+                 "when the load pressure is recorded",
+    ),
+)
 
-
-LIBRARY: dict[str, Candidate] = build_library()
+#: the candidate effects by name (the names used in reports)
+LIBRARY: dict[str, Candidate] = {cand.name: cand for cand in CANDIDATES}
 NAMES: tuple[str, ...] = tuple(LIBRARY)
 
 

@@ -1,6 +1,6 @@
 """The worked examples of docs/diagnose.md, from the paper's own experiments.
 
-    python tests/diagnose_eval/worked_examples.py --out build/diagnose_examples
+    python benchmarks/diagnose_eval/worked_examples.py --out build/diagnose_examples
 
 1. Fig 2(b): free vibration from 1.3 cm of the structure alone; the nominal model
    has the identified viscous damping (0.8 %, c = 1.1 kN s/m) but no friction.  The
@@ -89,7 +89,7 @@ def fig4b(out: Path, rng) -> dict:
     if js["effects"] and js["effects"][0]["name"] == "flow_gain_nonlinearity":
         p = js["effects"][0]["parameters"]
         g1, xk = p["g_1"]["value"], p["x_k"]["value"] if "x_k" in p else 0.0
-        from servohydraulics.diagnose.effects import knee_flow_curve
+        from servohydraulics.diagnosis.effects import knee_flow_curve
 
         op, fl = knee_flow_curve(g1, xk)
         s = np.linspace(0.0, js["peak_spool"], 200)

@@ -1,13 +1,13 @@
 """Seeded generator of records with hidden effects for the diagnose evaluation.
 
-    python tests/diagnose_eval/generate.py --out build/diagnose_eval [--size default|quick] [--seed 2003] [--jobs 2]
+    python benchmarks/diagnose_eval/generate.py --out build/diagnose_eval [--size default|quick] [--seed 2003] [--jobs 2]
 
 Writes OUT/records/*.csv (time, command, displacement, force), OUT/nominal_*.toml
 (the models the diagnosis is told to believe), OUT/manifest.json (record, mode,
 nominal rig: what the workflow may see) and OUT/answer_key.json (what was hidden:
 read only by evaluate.py, never by the workflow).
 
-Records are made by tests/diagnose_eval/independent_plant.py, a plain-Python
+Records are made by benchmarks/diagnose_eval/independent_plant.py, a plain-Python
 RK4 simulator of Eqs (1)-(5) that shares no code with the C++ core, with effects
 at graded strengths, in forms the library does not have (Stribeck and LuGre
 friction, a tabulated flow curve, a delay made of a 2nd-order Bessel filter, a

@@ -1,7 +1,7 @@
 """Evaluation of the diagnose workflow on records with hidden effects.
 
-    python tests/diagnose_eval/generate.py --out build/diagnose_eval
-    python tests/diagnose_eval/evaluate.py --data build/diagnose_eval --jobs 2
+    python benchmarks/diagnose_eval/generate.py --out build/diagnose_eval
+    python benchmarks/diagnose_eval/evaluate.py --data build/diagnose_eval --jobs 2
 
 Runs ``sh.diagnose`` on every record of the manifest (the workflow sees only the
 record, the mode and the nominal rig), then, and only then, reads the answer key
@@ -48,7 +48,7 @@ def _fitted(params: dict, pk: str, answer: dict) -> dict:
     record never reaches) is derived from the fitted g_1 and knee x_k (no interval)."""
     if pk != "g_peak":
         return params[pk]
-    from servohydraulics.diagnose.effects import knee_flow_curve
+    from servohydraulics.diagnosis.effects import knee_flow_curve
 
     g_1 = params["g_1"]["value"]
     x_k = params.get("x_k", {"value": 0.0})["value"] or 0.0
@@ -178,7 +178,7 @@ def write_doc(m: dict, per: list[dict], key: list[dict], doc: Path, cmd: str, wa
          "Made by (every number below):", "", "```", cmd, "```", "",
          f"Wall time {wall:.0f} s with {jobs} worker processes. Records: 2 kHz, "
          f"{key[0]['duration']:g} s each (one extra 10 s record for the runtime check), made by "
-         "`tests/diagnose_eval/independent_plant.py` (plain-Python RK4 of Eqs 1-5, no code shared with the "
+         "`benchmarks/diagnose_eval/independent_plant.py` (plain-Python RK4 of Eqs 1-5, no code shared with the "
          "core) with white noise on displacement and force. The workflow sees the record, the mode and the "
          "nominal rig only; the answer key is read after all diagnoses are done.", "",
          "## Against the targets (SNR >= 30 dB)", "",
@@ -236,7 +236,7 @@ def write_doc(m: dict, per: list[dict], key: list[dict], doc: Path, cmd: str, wa
         unmet.append("95 % interval coverage on in-library forms below 90 % (HAC sandwich intervals do not "
                      "include the bias of an unconverged or bound-limited fit, nor the nuisance initial state)")
     L += ["", "Not met, or met only in part: " + ("; ".join(unmet) if unmet else "none") + "."]
-    L += ["", "Truth for forms outside the library (fixed in tests/diagnose_eval/generate.py before any "
+    L += ["", "Truth for forms outside the library (fixed in benchmarks/diagnose_eval/generate.py before any "
           "diagnosis): Stribeck friction -> the energy-equivalent Coulomb force "
           "F_eq = sum(F_fr v) / sum(|v|) over the record (second truth, reported above: the sliding Coulomb "
           "level F_c); LuGre friction (with a Stribeck peak F_s = 1.3 F_c that the library's LuGre does not "
@@ -317,8 +317,8 @@ def main() -> None:
     wall = time.time() - t0
     key = json.loads((data / "answer_key.json").read_text())  # read only now, after every diagnosis
     m = metrics(results, key)
-    cmd = (f"python tests/diagnose_eval/generate.py --out {a.data} --jobs {a.jobs}\n"
-           f"python tests/diagnose_eval/evaluate.py --data {a.data} --jobs {a.jobs}")
+    cmd = (f"python benchmarks/diagnose_eval/generate.py --out {a.data} --jobs {a.jobs}\n"
+           f"python benchmarks/diagnose_eval/evaluate.py --data {a.data} --jobs {a.jobs}")
     write_doc(m, results, key, doc, cmd, wall, a.jobs)
     doc.with_suffix(".json").write_text(json.dumps({"metrics": m, "records": results, "command": cmd,
                                                     "wall_s": wall}, indent=1, default=str))

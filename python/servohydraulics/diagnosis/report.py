@@ -35,19 +35,27 @@ def write_outputs(d, out: Path) -> Path:
 
 
 def _plots(d, out: Path) -> dict:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    P = d.plots
-    if not P:
+    """Draws the report's figures (``matplotlib.figure.Figure`` objects, saved
+    as PNG to ``out``); returns their file names by kind."""
+    if not d.plots:
         return {}
-    cases, before, after = P["cases"], P["sims_before"], P["sims_after"]
-    figs = {}
+    figs = {"residual": _residual_figure(d), "signature": _signature_figure(d), "gap": _gap_figure(d)}
+    names = {"residual": "residual_before_after.png", "signature": "signature.png", "gap": "gap_closing.png"}
+    for kind, fig in figs.items():
+        if fig is not None:
+            fig.tight_layout()
+            fig.savefig(out / names[kind], dpi=110)
+    return {kind: names[kind] for kind, fig in figs.items() if fig is not None}
+
+
+def _residual_figure(d):
+    """The normalised residual per channel before (nominal) and after (the effects added)."""
+    from matplotlib.figure import Figure
+
+    cases, before, after = d.plots["cases"], d.plots["sims_before"], d.plots["sims_after"]
     chans = list(cases[0].meas)
-    # 1. residual before/after
-    fig, axes = plt.subplots(len(chans), 1, figsize=(9, 2.2 * len(chans)), sharex=True, squeeze=False)
+    fig = Figure(figsize=(9, 2.2 * len(chans)))
+    axes = fig.subplots(len(chans), 1, sharex=True, squeeze=False)
     for ax, c in zip(axes[:, 0], chans):
         t0 = 0.0
         for case, sb, sa in zip(cases, before, after):
@@ -61,40 +69,48 @@ def _plots(d, out: Path) -> dict:
         ax.grid(alpha=0.3)
     axes[0, 0].legend(loc="upper right")
     axes[-1, 0].set_xlabel("time [s] (records end to end)")
-    fig.tight_layout()
-    fig.savefig(out / "residual_before_after.png", dpi=110)
-    plt.close(fig)
-    figs["residual"] = "residual_before_after.png"
-    # 2. the signature that named the effect (screening scores + signature vs residual)
-    first = [c for c in d.candidates if c["round"] == 1 and c["screening_score"] is not None]
-    if first:
-        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 3.6), gridspec_kw={"width_ratios": [1, 1.6]})
-        names = [c["name"] for c in first]
-        a1.barh(names, [c["screening_score"] for c in first], color=[
-            "tab:green" if c["accepted"] else "tab:gray" for c in first])
-        a1.set_xlabel("share of the residual its signature explains (round 1)")
-        a1.invert_yaxis()
-        sig = P["signatures"].get(d.effects[0]["name"]) if d.effects else None
-        if sig is not None:
-            n = cases[0].t.size
-            c0 = chans[0] if len(chans) == 1 else max(chans, key=lambda c: d.gap_before.get(c, 0))
-            k = chans.index(c0)
-            r = (cases[0].meas[c0] - before[0][c0]) / cases[0].scale[c0]
-            a2.plot(cases[0].t, r, lw=0.6, color="tab:red", label="residual (nominal)")
-            a2.plot(cases[0].t, sig[k * n:(k + 1) * n], lw=0.8, color="tab:green",
-                    label=f"signature of {d.effects[0]['name']}")
-            a2.set_xlabel("time [s]")
-            a2.set_ylabel(f"{c0} / rms")
-            a2.legend(loc="upper right", fontsize=8)
-        else:
-            a2.text(0.5, 0.5, "no effect named", ha="center", va="center")
-        fig.tight_layout()
-        fig.savefig(out / "signature.png", dpi=110)
-        plt.close(fig)
-        figs["signature"] = "signature.png"
-    # 3. the gap closing
-    hist = P["history"]
-    fig, ax = plt.subplots(figsize=(7, 3.4))
+    return fig
+
+
+def _signature_figure(d):
+    """Round 1's screening scores and the signature that named the first effect
+    against the nominal residual (None without a screened candidate)."""
+    from matplotlib.figure import Figure
+
+    first = [c for c in d.candidates if c.round == 1 and c.screening_score is not None]
+    if not first:
+        return None
+    cases, before = d.plots["cases"], d.plots["sims_before"]
+    chans = list(cases[0].meas)
+    fig = Figure(figsize=(11, 3.6))
+    a1, a2 = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.6]})
+    a1.barh([c.name for c in first], [c.screening_score for c in first],
+            color=["tab:green" if c.accepted else "tab:gray" for c in first])
+    a1.set_xlabel("share of the residual its signature explains (round 1)")
+    a1.invert_yaxis()
+    sig = d.plots["signatures"].get(d.effects[0]["name"]) if d.effects else None
+    if sig is None:
+        a2.text(0.5, 0.5, "no effect named", ha="center", va="center")
+        return fig
+    n = cases[0].t.size
+    c0 = chans[0] if len(chans) == 1 else max(chans, key=lambda c: d.gap_before.get(c, 0))
+    k = chans.index(c0)
+    r = (cases[0].meas[c0] - before[0][c0]) / cases[0].scale[c0]
+    a2.plot(cases[0].t, r, lw=0.6, color="tab:red", label="residual (nominal)")
+    a2.plot(cases[0].t, sig[k * n:(k + 1) * n], lw=0.8, color="tab:green", label=f"signature of {d.effects[0]['name']}")
+    a2.set_xlabel("time [s]")
+    a2.set_ylabel(f"{c0} / rms")
+    a2.legend(loc="upper right", fontsize=8)
+    return fig
+
+
+def _gap_figure(d):
+    """The gap per channel after each step (nominal, each effect, joint re-fits) and the noise floor."""
+    from matplotlib.figure import Figure
+
+    hist, chans = d.plots["history"], list(d.plots["cases"][0].meas)
+    fig = Figure(figsize=(7, 3.4))
+    ax = fig.subplots()
     w = 0.8 / (len(hist) + 1)
     for i, (label, g) in enumerate(hist):
         ax.bar(np.arange(len(chans)) + i * w, [100 * g[c] for c in chans], w,
@@ -105,11 +121,7 @@ def _plots(d, out: Path) -> dict:
     ax.set_xticklabels(chans)
     ax.set_ylabel("gap: normalised RMS error [%]")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out / "gap_closing.png", dpi=110)
-    plt.close(fig)
-    figs["gap"] = "gap_closing.png"
-    return figs
+    return fig
 
 
 def _fmt(v) -> str:
@@ -159,9 +171,9 @@ def _markdown(d, figs: dict) -> str:
     L += ["## Candidates", "", "| round | name | screening | balance eq. | ΔBIC | held-out | result |",
           "|---|---|---|---|---|---|---|"]
     for c in d.candidates:
-        L.append(f"| {c['round']} | {c['name']} | {_fmt(c['screening_score'])} | {_fmt(c['balance_score'])} | "
-                 f"{_fmt(c['delta_bic'])} | {_fmt(c['heldout_improvement'])} | "
-                 f"{'accepted' if c['accepted'] else c['rejection']} |")
+        L.append(f"| {c.round} | {c.name} | {_fmt(c.screening_score)} | {_fmt(c.balance_score)} | "
+                 f"{_fmt(c.delta_bic)} | {_fmt(c.heldout_improvement)} | "
+                 f"{'accepted' if c.accepted else c.rejection} |")
     L.append("")
     L += ["## Plots", ""]
     if "residual" in figs:

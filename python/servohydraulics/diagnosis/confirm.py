@@ -1,0 +1,114 @@
+"""Confirmation of a screened candidate by simulation-error fits: the start of
+the fit, the train-segment fit (held-out improvement), the fit on all data (BIC
+improvement, HAC 95 % intervals, joint test against "absent") and the bounded
+re-fit of the interacting nominal parameters."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from . import engine
+from .effects import Context
+from .types import Case, Fit, Refit
+
+
+def param_report(space, z: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> dict:
+    """The fitted parameters as diagnosis.json writes them: per key its value,
+    unit, 95 % interval, value meaning "absent" (external units) and rig key."""
+    ext = space.to_external(z)
+    elo, ehi = space.to_external(lo), space.to_external(hi)
+    absent = space.to_external(space.absent)
+    out = {}
+    keys = [(p.key, p.unit, p.rig_key) for p in space.params] + \
+           [(k, u, "re-fitted nominal parameter") for k, u in space.interacting]
+    for i, (key, unit, where) in enumerate(keys):
+        a, b = (ehi[i], elo[i]) if space.rec[i] else (elo[i], ehi[i])
+        a, b = min(a, b), max(a, b)
+        out[key] = {"value": _num(ext[i]), "unit": unit, "interval_95": [_num(a), _num(b)],
+                    "absent": _num(absent[i]), "rig_key": where}
+    return out
+
+
+def _num(v: float) -> float | None:
+    return float(v) if math.isfinite(v) else None
+
+
+def _heldout(space, z_tr: np.ndarray, x0_tr: np.ndarray, cases: list[Case], base_test: dict,
+             tau: float) -> tuple[float, float]:
+    """The held-out (test-segment) SSR improvement of the train-segment fit
+    (fraction) and of its -2 log likelihood (the held-out residual's effective
+    sample sizes before the effect)."""
+    rig_tr, tau_tr = space.rig_and_tau(z_tr, tau)
+    test = engine.channel_stats(engine.simulate_all(rig_tr, cases, tau_tr, x0_tr), cases, "test")
+    held = 1.0 - sum(s["ssr"] for s in test.values()) / sum(s["ssr"] for s in base_test.values())
+    ne_test = engine.n_eff(base_test)
+    held_lr = float(sum(ne_test[k] * math.log(max(base_test[k]["ssr"], 1e-300) / max(test[k]["ssr"], 1e-300))
+                        for k in base_test))
+    return held, held_lr
+
+
+def fit_space(space, z0: np.ndarray, cases: list[Case], x0s, stats: dict, base_test: dict, tau: float,
+              neff_ref: dict | None = None) -> Fit:
+    """Train-segment fit (held-out improvement), then the fit on all data, its BIC
+    improvement over the current model (``stats``: its channel statistics) and its
+    HAC 95 % intervals.  ``x0s``: the current initial displacements (the fits'
+    start for the co-fitted ones)."""
+    tr = engine.fit(space, cases, z0, tau, "train", x0s)
+    held, held_lr = _heldout(space, tr.z, tr.x0, cases, base_test, tau)
+    res = engine.fit(space, cases, tr.z, tau, "all", x0s, max_nfev=12)
+    z = res.z
+    rig_c, tau_c = space.rig_and_tau(z, tau)
+    sims_c = engine.simulate_all(rig_c, cases, tau_c, res.x0)
+    st_c = engine.channel_stats(sims_c, cases)
+    neff = neff_ref if neff_ref is not None else engine.n_eff(st_c)
+    dbic = engine.bic(stats, 0, neff) - engine.bic(st_c, z.size, neff)
+    lengths = engine.series_lengths(cases)
+    lo, hi = engine.intervals(space, res, lengths)
+    nm = space.n_main
+    tested = np.concatenate([space.tests_absent[:nm], np.zeros(z.size - nm, bool)])
+    joint, pval = engine.joint_excludes_absent(space, res, lengths, tested)
+    return Fit(space=space, z=z, z_tr=tr.z, lo=lo, hi=hi, rig=rig_c, tau=tau_c, x0=res.x0, joint_excludes=joint,
+               joint_p=pval, sims=sims_c, stats=st_c, neff=neff, dbic=dbic, held=held, held_lr=held_lr)
+
+
+def scan_start(space, z0: np.ndarray, cases: list[Case], x0s, tau: float, ctx: Context) -> np.ndarray:
+    """The start of the fit: the better (training-segment error) of the screening
+    estimate (a linear extrapolation of the signature, which can land far off for
+    a strongly nonlinear parameter such as K_a) and the probe value, and for an
+    effect whose error is not smooth in its first parameter (``Candidate.scan``)
+    the values of a coarse scan of it (a least-squares fit started where a hard
+    clip barely engages stops there)."""
+    starts = [np.asarray(z0, float), np.asarray(space.probe[: space.n_main], float)]
+    for v in (np.asarray(space.cand.scan(ctx), float) if space.cand.scan is not None else ()):
+        z = np.asarray(z0, float).copy()
+        z[0] = np.clip(space.to_internal(np.concatenate([[v], space.to_external(z)[1:]]))[0], space.lo[0], space.hi[0])
+        starts.append(z)
+    cost = []
+    for z in starts:
+        rig, t = space.rig_and_tau(z, tau)
+        r = engine.residuals(engine.simulate_all(rig, cases, t, x0s), cases, "train")
+        cost.append(float(r @ r))
+    return starts[int(np.argmin(cost))]
+
+
+def confirm(space, z0: np.ndarray, cases: list[Case], x0s, stats: dict, base_test: dict, tau: float, ctx: Context,
+            refit_interacting: bool) -> Fit:
+    """Fits the candidate alone, then (if it has interacting nominal parameters and
+    ``refit_interacting``) with the bounded +-25 % re-fit of them, started from the
+    first fit; keeps the re-fit only if it improves the BIC (same effective sample
+    sizes for both)."""
+    alone = engine.Space(space.cand, ctx, ())
+    z0 = scan_start(alone, z0[: alone.n_main], cases, x0s, tau, ctx)
+    a = fit_space(alone, z0, cases, x0s, stats, base_test, tau)
+    inter = space.interacting if refit_interacting else ()
+    if not inter:
+        return a
+    z1 = np.concatenate([a.z_tr, space.absent[space.n_main:]])
+    b = fit_space(space, z1, cases, x0s, stats, base_test, tau, neff_ref=a.neff)
+    keep = b.dbic > a.dbic
+    info = Refit(tried=True, kept=bool(keep), parameters=tuple(k for k, _ in inter), delta_bic_with=b.dbic,
+                 delta_bic_without=a.dbic)
+    return dataclasses.replace(b if keep else a, refit=info)

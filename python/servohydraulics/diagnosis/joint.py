@@ -1,0 +1,145 @@
+"""The joint re-fit ("polish") of the accepted effects.
+
+Each effect was fitted with the ones before it held at their values, so an
+earlier effect's parameter absorbs part of a later one (a fitted delay takes up
+part of a missing damping, and the damping fitted after it is biased the other
+way).  Here all accepted effects' own parameters (the command delay among them)
+and the nominal parameters their kept interacting re-fits moved are fitted
+together by simulation error (``engine.JointSpace``), started from the greedy
+model's values, each within its candidate's bounds; the HAC 95 % intervals come
+from the joint fit, so each effect's interval accounts for the others.  The
+joint fit is kept if its BIC (same parameters, the greedy model's effective
+sample sizes) is not worse than the greedy model's.
+
+An effect whose every own parameter a later effect also fits (coulomb_friction's
+F_c under lugre_friction) is superseded: it stays as the later effect left it.
+Effects that share only part of their parameters, or whose greedy model cannot
+be rebuilt from their parameters, are not re-fitted.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..rig import Rig
+from . import engine
+from .confirm import param_report
+from .types import Accepted, Case, FitResult, JointRefit
+
+JOINT_MAX_NFEV = 30  #: most least-squares iterations of the joint re-fit
+
+
+@dataclass(frozen=True, eq=False)
+class JointModel:
+    """A kept joint re-fit: the model, its initial displacements and
+    simulations, the re-fitted effects and their parameter reports."""
+
+    rig: Rig
+    tau: float
+    x0: np.ndarray
+    sims: list
+    accepted: dict  #: name -> the re-fitted ``Accepted``
+    parameters: dict  #: name -> its parameters as diagnosis.json writes them
+
+
+def _partition(accepted: list[Accepted]) -> tuple[list[Accepted], list[str], list[str]]:
+    """The effects to re-fit, the superseded ones (every own parameter fitted by
+    a later effect) and the parameters shared only in part."""
+    keys = [{prm.key for prm in a.space.params} for a in accepted]
+    later = [set().union(*keys[i + 1:]) for i in range(len(keys))]
+    held = [a.name for a, ks, lt in zip(accepted, keys, later) if ks <= lt]
+    shared = sorted({kk for ks, lt in zip(keys, later) if not ks <= lt for kk in ks & lt})
+    return [a for a, ks, lt in zip(accepted, keys, later) if not ks <= lt], held, shared
+
+
+def _start(accepted: list[Accepted], js: engine.JointSpace, current: Rig, tau: float) -> tuple[np.ndarray, float]:
+    """The greedy values (a nominal parameter, or an effect's own parameter, that
+    a later interacting re-fit moved starts from the model's value) and the base
+    delay the effects' fitted delays add to."""
+    z0 = np.concatenate([a.z[: a.space.n_main] for a in accepted]
+                        + [np.array([float(getattr(current, kk)) for kk, _ in js.interacting])])
+    inter = [{kk for kk, _ in a.space.interacting} for a in accepted]
+    for i, (a, blk) in enumerate(zip(accepted, js.blocks)):
+        moved = set().union(*inter[i + 1:])
+        for j, prm in enumerate(a.space.params):
+            if prm.key in moved and not prm.reciprocal and hasattr(current, prm.key):
+                z0[blk.start + j] = float(getattr(current, prm.key))
+    delay = sum(float(a.space.to_external(a.z)[0]) for a in accepted if a.space.cand.delays_command)
+    return z0, tau - delay
+
+
+def _refitted(accepted: list[Accepted], js: engine.JointSpace, res: FitResult,
+              lengths: list[int]) -> tuple[dict, dict]:
+    """Per effect: its block of the joint fit (``Accepted``, interacting
+    parameters too where the joint fit has them) and whether its tested
+    parameters exclude "absent" jointly."""
+    z = res.z
+    lo, hi = engine.intervals(js, res, lengths)
+    out, excl = {}, {}
+    for a, blk in zip(accepted, js.blocks):
+        sp, nm = a.space, a.space.n_main
+        zf, lof, hif = a.z.copy(), a.lo.copy(), a.hi.copy()
+        zf[:nm], lof[:nm], hif[:nm] = z[blk], lo[blk], hi[blk]
+        for jj, (kk, _) in enumerate(sp.interacting):
+            idx = js.index_of(kk)
+            if idx is not None:
+                zf[nm + jj], lof[nm + jj], hif[nm + jj] = z[idx], lo[idx], hi[idx]
+        out[a.name] = Accepted(a.name, sp, zf, lof, hif)
+        tested = sp.tests_absent[:nm]
+        outside = (sp.absent[:nm] < lo[blk]) | (sp.absent[:nm] > hi[blk])
+        mask = np.zeros(z.size, bool)
+        mask[blk] = tested
+        excl[a.name] = bool(np.any(outside & tested)) or engine.joint_excludes_absent(js, res, lengths, mask)[0]
+    return out, excl
+
+
+def _values(parameters: dict) -> dict:
+    return {kk: {"value": v["value"], "interval_95": v["interval_95"]} for kk, v in parameters.items()}
+
+
+def joint_refit(accepted: list[Accepted], parameters: dict, current: Rig, tau: float, cases: list[Case],
+                x0s, sims: list, rnd: int) -> tuple[JointRefit, JointModel | None]:
+    """The joint re-fit after round ``rnd`` of the ``accepted`` effects (in the
+    order added; ``parameters``: name -> their parameters in the diagnosis) on
+    top of the greedy model (``current``, delay ``tau`` [s], initial
+    displacements ``x0s``, simulations ``sims``).  Returns the record for
+    diagnosis.json and, if the joint fit is kept, the new model."""
+    t0 = time.time()
+    k = int(sum(a.z.size for a in accepted))  # the model's fitted parameters (the BIC penalty, both fits)
+    accepted, held, shared = _partition(accepted)
+    info = JointRefit(round=rnd, effects=tuple(a.name for a in accepted), superseded=tuple(held) or None)
+    if shared or len(accepted) < 2:
+        return dataclasses.replace(info, reason="not tried: " + (
+            f"effects share the parameter(s) {shared}" if shared else "fewer than two effects to re-fit")), None
+    js = engine.JointSpace([a.space for a in accepted], current)
+    z0, base_tau = _start(accepted, js, current, tau)
+    rig0, tau0 = js.rig_and_tau(z0, base_tau)
+    if not engine.same_rig(rig0, current) or not math.isclose(tau0, tau, rel_tol=1e-9, abs_tol=1e-12):
+        return dataclasses.replace(info, reason="not tried: the greedy model cannot be rebuilt from the effects' "
+                                                "parameters"), None
+    stats0 = engine.channel_stats(sims, cases)
+    neff = engine.n_eff(stats0)
+    res = engine.fit(js, cases, z0, base_tau, "all", x0s, max_nfev=JOINT_MAX_NFEV)
+    rig1, tau1 = js.rig_and_tau(res.z, base_tau)
+    sims1 = engine.simulate_all(rig1, cases, tau1, res.x0)
+    info = dataclasses.replace(info, parameters_fitted=tuple([prm.key for prm in js.params]
+                                                             + [kk for kk, _ in js.interacting]), nfev=res.nfev)
+    if any(s is None for s in sims1):
+        return dataclasses.replace(info, reason="the jointly fitted model's simulation fails: kept the greedy fit",
+                                   seconds=time.time() - t0), None
+    b0, b1 = engine.bic(stats0, k, neff), engine.bic(engine.channel_stats(sims1, cases), k, neff)
+    refit, excl = _refitted(accepted, js, res, engine.series_lengths(cases))
+    reports = {n: param_report(a.space, a.z, a.lo, a.hi) for n, a in refit.items()}
+    keep = b1 <= b0
+    info = dataclasses.replace(
+        info, kept=bool(keep), bic_greedy=b0, bic_joint=b1, delta_bic=b0 - b1, gap_greedy=engine.gap(sims, cases),
+        gap_joint=engine.gap(sims1, cases), parameters_greedy={a.name: _values(parameters[a.name]) for a in accepted},
+        parameters_joint={n: _values(r) for n, r in reports.items()}, excludes_absent_joint=excl,
+        reason=("joint BIC not worse than the greedy one: kept the joint fit" if keep
+                else "joint BIC worse than the greedy one: kept the greedy fit"), seconds=time.time() - t0)
+    return info, (JointModel(rig1, tau1, res.x0, sims1, refit, reports) if keep else None)

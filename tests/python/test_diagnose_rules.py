@@ -1,0 +1,91 @@
+"""Diagnose: the named rules of the workflow, alone, on synthetic inputs.
+
+The decision of a round (``workflow._decide``) against its stated contract
+(docs/diagnose.md, steps 4-5), the JSON row of a candidate (the keys written
+before and after a fit), and the lag-1 autocorrelation behind the effective
+sample sizes against an AR(1) process whose coefficient is known.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import servohydraulics as sh
+from servohydraulics.diagnosis import engine, workflow
+from servohydraulics.diagnosis.types import CandidateLog, Fit, Refit, Screening
+
+KEY = ("rec", "displacement")
+N = 1000
+
+
+def _passing(name: str, ssr: float, dbic: float) -> workflow._Passing:
+    """A candidate that passed every test, with residual sum of squares ``ssr``
+    over N samples (no autocorrelation: n_eff = N)."""
+    stats = {KEY: {"ssr": ssr, "n": N, "rho": 0.0, "floor": 0.0}}
+    z = np.zeros(1)
+    fit = Fit(space=None, z=z, z_tr=z, lo=z - 1, hi=z + 1, rig=sh.zhao2003(), tau=0.0, x0=np.zeros(1),
+              joint_excludes=True, joint_p=0.0, sims=[], stats=stats, neff={KEY: float(N)}, dbic=dbic, held=0.5,
+              held_lr=50.0)
+    return workflow._Passing(name, fit, Screening(0.5, z, None))
+
+
+def _log(*names: str) -> dict:
+    return {n: CandidateLog(n, 1, screening_score=0.5) for n in names}
+
+
+def test_decide_two_equal_fits_are_ambiguous() -> None:
+    # misfits differ by N log(100.2 / 100) = 2.0 < DELTA_FIT_AMBIGUOUS: neither is named
+    a, b = _passing("viscous_damping", 100.0, 40.0), _passing("leakage", 100.2, 38.0)
+    assert N * math.log(100.2 / 100.0) < workflow.DELTA_FIT_AMBIGUOUS
+    rnd = workflow._decide(1, [b, a], _log("viscous_damping", "leakage"), {})
+    assert rnd.outcome == "ambiguous" and rnd.best is None
+    assert rnd.ambiguous_between == ("viscous_damping", "leakage")
+    assert "viscous_damping" in rnd.separating_experiment and "leakage" in rnd.separating_experiment
+    assert all(row.rejection.startswith("ambiguous with") and not row.accepted for row in rnd.log)
+
+
+def test_decide_nested_candidates_are_never_ambiguous() -> None:
+    # lugre_friction nests coulomb_friction: the same small misfit gap is decided by the BIC
+    a, b = _passing("coulomb_friction", 100.0, 40.0), _passing("lugre_friction", 100.2, 38.0)
+    rnd = workflow._decide(1, [a, b], _log("coulomb_friction", "lugre_friction"), {})
+    assert rnd.outcome == "accept" and rnd.best_name == "coulomb_friction"
+    rows = {row.name: row for row in rnd.log}
+    assert rows["coulomb_friction"].accepted and rows["coulomb_friction"].rejection is None
+    assert rows["coulomb_friction"].fit_gap_to_runner_up == pytest.approx(N * math.log(100.2 / 100.0))
+    assert "passed, but BIC improvement" in rows["lugre_friction"].rejection
+
+
+def test_decide_clear_winner_and_nothing_passing() -> None:
+    a, b = _passing("viscous_damping", 100.0, 40.0), _passing("leakage", 110.0, 20.0)
+    rnd = workflow._decide(2, [b, a], _log("viscous_damping", "leakage"), {})
+    assert rnd.outcome == "accept" and rnd.best is a.fit and rnd.number == 2
+    stats = {KEY: {"ssr": 100.0, "n": N, "rho": 0.0, "floor": 10.0}}  # 10x the noise floor
+    stop = workflow._decide(2, [], _log("leakage"), stats)
+    assert stop.outcome == "stop" and "may not be in the library" in stop.summary
+
+
+def test_candidate_log_keys() -> None:
+    base = ["name", "round", "screening_score", "balance_score", "score", "delta_bic", "heldout_improvement",
+            "parameters", "accepted", "rejection"]
+    assert list(CandidateLog("leakage", 1, rejection="already added").to_dict()) == base
+    fitted = CandidateLog("leakage", 1, delta_bic=12.0, joint_p_absent=0.01, refit=Refit(), fit_seconds=1.0,
+                          heldout_lr=11.0).to_dict()
+    assert list(fitted) == base + ["joint_p_absent", "refit", "fit_seconds", "heldout_lr"]
+    assert fitted["refit"] == {"tried": False, "kept": False}
+
+
+def test_lag1_autocorrelation_of_an_ar1_process() -> None:
+    rng = np.random.default_rng(5)
+    phi, n = 0.6, 200_000
+    w = rng.normal(size=n)
+    e = np.empty(n)
+    e[0] = w[0]
+    for i in range(1, n):
+        e[i] = phi * e[i - 1] + w[i]
+    # the estimate's standard deviation is about sqrt((1 - phi^2) / n) = 0.0018
+    assert abs(engine.lag1_autocorrelation(e) - phi) < 0.01
+    assert engine.lag1_autocorrelation(np.cumsum(w)) == 0.999  # a random walk: clipped below 1
+    assert engine.lag1_autocorrelation(np.resize([1.0, -1.0], 100)) == 0.0  # negative: clipped at 0
