@@ -26,8 +26,11 @@ from pathlib import Path
 import numpy as np
 from scipy import signal
 
+from . import _core
+
+TWO_PI = 2.0 * math.pi
 G = 9.80665  #: standard gravity [m/s^2]
-DT = 5e-4  #: the paper's controller sample time (2 kHz) [s]
+DT = _core.EftConfig().dt  #: the paper's controller sample time (2 kHz), the core's default [s]
 SWEEP_DURATION = 40.0  #: default duration of the 0-10 Hz sweeps [s] (our choice, see module doc)
 
 #: The paper's sweep amplitudes (SI).
