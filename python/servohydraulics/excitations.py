@@ -84,6 +84,20 @@ def sine_sweep(amplitude: float, f0: float = 0.0, f1: float = 10.0, duration: fl
     return x
 
 
+def linear_chirp(duration: float, dt: float, f0: float, f1: float, amplitude: float,
+                 ramp: float = 0.5, tail: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Linear sine sweep from f0 to f1 [Hz] over ``duration`` [s], amplitude [m or N],
+    with half-cosine fades of ``ramp`` seconds at both ends, then ``tail``
+    seconds of zeros (for the response to settle).  Returns (time [s], signal)."""
+    t = time_axis(duration + tail, dt)
+    u = amplitude * signal.chirp(t, f0=f0, t1=duration, f1=f1, method="linear", phi=-90.0)
+    if ramp > 0:
+        w = np.clip(np.minimum(t, duration - t) / ramp, 0.0, 1.0)
+        u *= 0.5 - 0.5 * np.cos(math.pi * w)
+    u[t > duration] = 0.0
+    return t, u
+
+
 def sweep_frequency(t: np.ndarray, f0: float = 0.0, f1: float = 10.0, duration: float = SWEEP_DURATION) -> np.ndarray:
     """Instantaneous frequency of ``sine_sweep`` at times t [Hz]."""
     return f0 + (f1 - f0) * np.asarray(t) / duration
