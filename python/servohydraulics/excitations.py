@@ -24,6 +24,7 @@ import re
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy import signal
 
 from . import _core
@@ -98,7 +99,7 @@ def linear_chirp(duration: float, dt: float, f0: float, f1: float, amplitude: fl
     return t, u
 
 
-def sweep_frequency(t: np.ndarray, f0: float = 0.0, f1: float = 10.0, duration: float = SWEEP_DURATION) -> np.ndarray:
+def sweep_frequency(t: ArrayLike, f0: float = 0.0, f1: float = 10.0, duration: float = SWEEP_DURATION) -> np.ndarray:
     """Instantaneous frequency of ``sine_sweep`` at times t [Hz]."""
     return f0 + (f1 - f0) * np.asarray(t) / duration
 
@@ -125,7 +126,7 @@ def release_index(ramp_time: float = 5.0, hold_time: float = 1.0, dt: float = DT
     return int(round(ramp_time / dt)) + int(round(hold_time / dt))
 
 
-def resample(t: np.ndarray, a: np.ndarray, dt: float = DT, duration: float | None = None) -> np.ndarray:
+def resample(t: ArrayLike, a: ArrayLike, dt: float = DT, duration: float | None = None) -> np.ndarray:
     """Resamples a record a(t) onto t_k = k dt (linear interpolation, zero after the end).
 
     When the record's own step is coarser than dt this is what a DSP playing the

@@ -108,7 +108,7 @@ def _ar1_effective_n(res: np.ndarray) -> tuple[float, float]:
     return res.size * (1.0 - rho) / (1.0 + rho), rho
 
 
-def identify_damping_friction(time: np.ndarray, displacement: np.ndarray, rig: Rig,
+def identify_damping_friction(time: ArrayLike, displacement: ArrayLike, rig: Rig,
                               force: np.ndarray | None = None, x0: float | None = None,
                               guess: tuple[float, float] | None = None) -> FrictionEstimate:
     """Least-squares fit of c and F_c of Eq (5) to a displacement record (Fig 2b).
@@ -235,7 +235,7 @@ def fourier_ratio(output: ArrayLike, reference: ArrayLike, dt: float) -> tuple[n
     return f, np.abs(H)
 
 
-def identify_first_order(time: np.ndarray, command: np.ndarray, response: np.ndarray,
+def identify_first_order(time: ArrayLike, command: ArrayLike, response: ArrayLike,
                          band: tuple[float, float] = (0.1, 2.0)) -> FirstOrderEstimate:
     """Equivalent first-order roll-off and delay from a displacement-control sweep.
 
@@ -271,7 +271,7 @@ class FreeVibration:
     rms_error: float  #: fit residual relative to X [-]
 
 
-def identify_free_vibration(x: np.ndarray, dt: float, start: int = 0, duration: float = 4.0) -> FreeVibration:
+def identify_free_vibration(x: ArrayLike, dt: float, start: int = 0, duration: float = 4.0) -> FreeVibration:
     """Fits a damped cosine to x[start : start + duration/dt] by least squares.
 
     The frequency is started from the zero-padded FFT peak of the window; zeta from 0.

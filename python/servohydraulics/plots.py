@@ -15,6 +15,7 @@ from pathlib import Path
 import control as ct
 import numpy as np
 from matplotlib.figure import Figure
+from numpy.typing import ArrayLike
 
 from .excitations import TWO_PI
 NOTE = ("Simulated counterpart. The paper's measured curves are not available: "
@@ -37,7 +38,7 @@ def save(fig, path: Path) -> Path:
     return Path(path)
 
 
-def bode(ax_mag, ax_phase, sys_: ct.LTI, f: np.ndarray, label: str, db: bool = False, **style) -> None:
+def bode(ax_mag, ax_phase, sys_: ct.LTI, f: ArrayLike, label: str, db: bool = False, **style) -> None:
     """Magnitude (linear or dB) and phase [deg] of sys_ at frequencies f [Hz]."""
     h = np.asarray(sys_(1j * TWO_PI * np.asarray(f))).ravel()
     mag = 20 * np.log10(np.abs(h)) if db else np.abs(h)
@@ -65,7 +66,7 @@ def pole_zero(ax, sys_: ct.LTI, label: str, color: str, marker_size: float = 7.0
     ax.grid(True, lw=0.3)
 
 
-def root_locus(ax, poles: np.ndarray, gains: np.ndarray, marks: dict[str, float] | None = None) -> None:
+def root_locus(ax, poles: np.ndarray, gains: ArrayLike, marks: dict[str, float] | None = None) -> None:
     """Closed-loop poles (rows of ``poles``, one per gain) coloured by log gain."""
     g = np.repeat(np.log10(gains), poles.shape[1])
     sc = ax.scatter(poles.real.ravel(), poles.imag.ravel(), c=g, s=4, cmap="viridis")
