@@ -31,7 +31,7 @@ from .identify import (
     linear_chirp,
     simulate_structure,
 )
-from .rig import Rig, zhao2003
+from .rig import Rig, copy_rig, zhao2003
 from .simulate import simulate
 
 TWO_PI = 2.0 * math.pi
@@ -539,7 +539,7 @@ def section_rpsd_linear(ctx: Context) -> None:
 # --------------------------------------------------------------------------- Figs 3(b), 4(b, c): EFT loops
 def _with_effects(rig: Rig, **switches: bool) -> Rig:
     """A copy of ``rig`` with some effect switches changed."""
-    r = an._copy(rig)
+    r = copy_rig(rig)
     e = r.effects
     for name, on in switches.items():
         setattr(e, name, on)
