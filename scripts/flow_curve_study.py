@@ -11,9 +11,9 @@ to 1.6 cm at T_ld = 6 / 11.2 / 16 ms (Fig 8).  About 1 minute.
 
 import servohydraulics as sh
 from servohydraulics import excitations as ex
-from servohydraulics.signals import fourier_ratio, identify_free_vibration
+from servohydraulics.identify import fourier_ratio, identify_free_vibration
 
-DT = 5e-4
+DT = ex.DT  # the core's controller sample time (0.5 ms)
 
 
 def rig_with(curve: dict):

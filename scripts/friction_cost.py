@@ -27,7 +27,7 @@ print("| friction | CVODE steps / sample | RHS evals / sample | max |x - x(v_sti
 print("|---|---|---|---|")
 for vs in [None, 1e-3, 1e-4, 1e-5, 1e-6]:
     r = run(vs)
-    n = len(r.time) - 1
+    n = len(r) - 1
     diff = np.max(np.abs(r.displacement - ref.displacement)) * 1e3
     label = "off" if vs is None else f"v_stick = {vs:g} m/s"
-    print(f"| {label} | {r.summary['internal_steps'] / n:.2f} | {r.summary['rhs_evals'] / n:.2f} | {diff:.4f} |")
+    print(f"| {label} | {r.work.internal_steps / n:.2f} | {r.work.rhs_evals / n:.2f} | {diff:.4f} |")

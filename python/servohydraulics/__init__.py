@@ -6,9 +6,19 @@ Zhao, French, Shield, Posbergh (2003), Earthquake Engng Struct. Dyn. 32:1773-179
     import servohydraulics as sh
     rig = sh.zhao2003()
     res = sh.simulate(rig, mode="displacement", command=u, dt=0.0005)
+    res.displacement, res.units["displacement"], res.warnings(), res.to_pandas()
+
+Importing the package loads the library (model, integration, control loops,
+records) only.  The heavier parts load on first use (PEP 562): ``analysis``
+(python-control), ``sweep`` (pandas), the diagnosis and the paper's
+reproduction (matplotlib).  Importing the package never touches matplotlib's
+backend.
 """
 
+import importlib as _importlib
 import os as _os
+import sys as _sys
+import types as _types
 
 # Development hook: SERVOHYDRAULICS_CORE_DIR names a CMake build directory whose
 # _core module is used instead of an installed one (scripts/dev-build.sh).
@@ -24,17 +34,96 @@ except ImportError as e:  # pragma: no cover - only without a built core
         f"build directory made by scripts/dev-build.sh ({e})"
     ) from e
 
-from . import analysis, identify  # noqa: E402
-from ._core import ControlMode, Dynamics, FlowCurve, Plant, SolverOptions, linearize
-from .diagnosis import Diagnosis, diagnose
-from .methods import MethodResult, TestMethodError, run_eft, run_rpsd, run_tracking
-from .records import read_record, write_record
-from .reproduce import reproduce  # the function shadows the module name
-from .rig import PARAMETERS, Error, Rig, copy_rig, load_rig, rig_from_dict, rig_to_dict, save_rig, zhao2003
-from .simulate import SimulationError, SimulationResult, make_plant, simulate, solver_options
-from .sweep import summary_run, sweep
+from ._core import ControlMode, Dynamics, FlowCurve, Plant, SolverOptions  # noqa: E402
+from .loops import run_eft, run_rpsd, run_tracking  # noqa: E402
+from .records import read_record, write_record  # noqa: E402
+from .response import Response, SimulationError  # noqa: E402
+from .rig import (  # noqa: E402
+    PARAMETERS,
+    Error,
+    Rig,
+    copy_rig,
+    load_rig,
+    rig_from_dict,
+    rig_to_dict,
+    save_rig,
+    zhao2003,
+)
+from .simulate import make_plant, simulate, solver_options  # noqa: E402
 
 __version__ = "0.1.0"
+
+#: Lazily imported submodules (first attribute access imports them).
+_SUBMODULES = ("analysis", "identify", "excitations", "sweep", "plots", "diagnosis", "paper")
+
+#: Lazily resolved names: name -> candidate (module, attribute) pairs, the first
+#: that exists wins (so both the old flat layout and the diagnosis/ and paper/
+#: packages work).
+_LAZY = {
+    "linearize": ((".analysis", "linearize"),),
+    "sweep": ((".sweep", "sweep"),),
+    "summary_run": ((".sweep", "summary_run"),),
+    "diagnose": ((".diagnosis", "diagnose"), (".diagnose", "diagnose")),
+    "Diagnosis": ((".diagnosis", "Diagnosis"), (".diagnose", "Diagnosis")),
+    "reproduce": ((".paper.reproduce", "reproduce"), (".reproduce", "reproduce")),
+}
+
+#: Deprecated names, kept for one release: name -> (replacement, object).
+_DEPRECATED = {
+    "TestMethodError": ("SimulationError", SimulationError),
+    "SimulationResult": ("Response", Response),
+    "MethodResult": ("Response", Response),
+}
+
+
+def _resolve(name: str):
+    for module, attr in _LAZY[name]:
+        try:
+            mod = _importlib.import_module(module, __name__)
+        except ModuleNotFoundError as e:
+            if e.name is None or not (__name__ + module).startswith(e.name):
+                raise
+            continue
+        return getattr(mod, attr)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")  # pragma: no cover
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        return _resolve(name)
+    if name in _SUBMODULES:
+        return _importlib.import_module(f".{name}", __name__)
+    if name in _DEPRECATED:
+        import warnings
+
+        new, obj = _DEPRECATED[name]
+        warnings.warn(f"servohydraulics.{name} is deprecated; use servohydraulics.{new}", DeprecationWarning,
+                      stacklevel=2)
+        return obj
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY) | set(_SUBMODULES))
+
+
+class _Package(_types.ModuleType):
+    """``sh.diagnose``, ``sh.reproduce`` and ``sh.sweep`` are functions even where a
+    submodule of the same name exists (``sweep.py``; ``diagnose/`` and
+    ``reproduce.py`` before the diagnosis/ and paper/ packages): importing that
+    submodule must not rebind the package attribute to the module.  The
+    submodules stay importable by their names (``importlib.import_module``,
+    ``from servohydraulics.sweep import ...``)."""
+
+
+def _function_property(name: str) -> property:
+    return property(lambda self: _resolve(name), lambda self, value: None,
+                    doc=f"servohydraulics.{name}, resolved on first use")
+
+
+for _name in ("diagnose", "reproduce", "sweep"):
+    setattr(_Package, _name, _function_property(_name))
+_sys.modules[__name__].__class__ = _Package
 
 __all__ = [
     "PARAMETERS",
@@ -43,20 +132,18 @@ __all__ = [
     "Dynamics",
     "Error",
     "FlowCurve",
-    "MethodResult",
     "Plant",
+    "Response",
     "Rig",
     "SimulationError",
-    "SimulationResult",
     "SolverOptions",
-    "TestMethodError",
-    "_core",
     "copy_rig",
     "diagnose",
     "linearize",
     "load_rig",
     "make_plant",
     "read_record",
+    "reproduce",
     "rig_from_dict",
     "rig_to_dict",
     "run_eft",
@@ -68,8 +155,5 @@ __all__ = [
     "summary_run",
     "sweep",
     "write_record",
-    "analysis",
-    "identify",
-    "reproduce",
     "zhao2003",
 ]

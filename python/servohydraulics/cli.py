@@ -16,20 +16,17 @@ def _demo(args: argparse.Namespace) -> int:
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    import numpy as np
-
-    from .records import write_record
+    from .excitations import sine
     from .rig import load_rig, zhao2003
     from .simulate import simulate
 
     rig = load_rig(args.rig) if args.rig else zhao2003()
-    t = np.arange(int(round(args.duration / args.dt)) + 1) * args.dt
-    command = args.amplitude * np.sin(2 * np.pi * args.frequency * t)
+    command = sine(args.amplitude, args.frequency, args.duration, args.dt)
     res = simulate(rig, mode=args.mode, command=command, dt=args.dt, x0=args.x0)
-    write_record(args.out, res)
+    res.to_csv(args.out)
     for w in res.warnings():
         print("warning:", w, file=sys.stderr)
-    print(f"wrote {args.out}: {len(res.time)} rows, {res.summary['internal_steps']} CVODE steps")
+    print(f"wrote {args.out}: {len(res)} rows, {res.work.internal_steps} CVODE steps")
     return 0
 
 

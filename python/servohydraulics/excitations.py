@@ -24,10 +24,14 @@ import re
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy import signal
 
+from . import _core
+
+TWO_PI = 2.0 * math.pi
 G = 9.80665  #: standard gravity [m/s^2]
-DT = 5e-4  #: the paper's controller sample time (2 kHz) [s]
+DT = _core.EftConfig().dt  #: the paper's controller sample time (2 kHz), the core's default [s]
 SWEEP_DURATION = 40.0  #: default duration of the 0-10 Hz sweeps [s] (our choice, see module doc)
 
 #: The paper's sweep amplitudes (SI).
@@ -81,7 +85,21 @@ def sine_sweep(amplitude: float, f0: float = 0.0, f1: float = 10.0, duration: fl
     return x
 
 
-def sweep_frequency(t: np.ndarray, f0: float = 0.0, f1: float = 10.0, duration: float = SWEEP_DURATION) -> np.ndarray:
+def linear_chirp(duration: float, dt: float, f0: float, f1: float, amplitude: float,
+                 ramp: float = 0.5, tail: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Linear sine sweep from f0 to f1 [Hz] over ``duration`` [s], amplitude [m or N],
+    with half-cosine fades of ``ramp`` seconds at both ends, then ``tail``
+    seconds of zeros (for the response to settle).  Returns (time [s], signal)."""
+    t = time_axis(duration + tail, dt)
+    u = amplitude * signal.chirp(t, f0=f0, t1=duration, f1=f1, method="linear", phi=-90.0)
+    if ramp > 0:
+        w = np.clip(np.minimum(t, duration - t) / ramp, 0.0, 1.0)
+        u *= 0.5 - 0.5 * np.cos(math.pi * w)
+    u[t > duration] = 0.0
+    return t, u
+
+
+def sweep_frequency(t: ArrayLike, f0: float = 0.0, f1: float = 10.0, duration: float = SWEEP_DURATION) -> np.ndarray:
     """Instantaneous frequency of ``sine_sweep`` at times t [Hz]."""
     return f0 + (f1 - f0) * np.asarray(t) / duration
 
@@ -108,7 +126,7 @@ def release_index(ramp_time: float = 5.0, hold_time: float = 1.0, dt: float = DT
     return int(round(ramp_time / dt)) + int(round(hold_time / dt))
 
 
-def resample(t: np.ndarray, a: np.ndarray, dt: float = DT, duration: float | None = None) -> np.ndarray:
+def resample(t: ArrayLike, a: ArrayLike, dt: float = DT, duration: float | None = None) -> np.ndarray:
     """Resamples a record a(t) onto t_k = k dt (linear interpolation, zero after the end).
 
     When the record's own step is coarser than dt this is what a DSP playing the

@@ -10,6 +10,10 @@
 * :func:`identify_first_order`: the equivalent first-order roll-off and delay
   of a displacement-controlled actuator from a sweep record (Eq 13: 1.96 Hz,
   81 ms in the paper).
+* :func:`identify_free_vibration`: frequency and damping of a free vibration
+  (a damped cosine fitted by least squares; Figs 2b, 9).
+* :func:`frequency_response` and :func:`fourier_ratio`: frequency responses of
+  sweep records as ratios of whole-record DFTs (one implementation, ``_dft_ratio``).
 
 SI units: m, s, N, N s/m.
 """
@@ -20,15 +24,16 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import signal
+from numpy.typing import ArrayLike
+from scipy import optimize
 from scipy.optimize import least_squares
 from scipy.stats import norm
 
 from . import _core
-from .rig import Rig, rig_from_dict, rig_to_dict
+from .excitations import TWO_PI, linear_chirp
+from .response import uniform_dt
+from .rig import Rig, copy_rig
 from .simulate import make_plant, solver_options
-
-TWO_PI = 2.0 * math.pi
 
 
 @dataclass
@@ -58,15 +63,8 @@ class FrictionEstimate:
         return v - z * s, v + z * s
 
 
-def _uniform_dt(time: np.ndarray) -> float:
-    t = np.asarray(time, dtype=float)
-    if t.ndim != 1 or t.size < 10:
-        raise ValueError(f"invalid time shape = {t.shape}: need a 1-D record of at least 10 samples")
-    d = np.diff(t)
-    dt = float(np.mean(d))
-    if not (dt > 0) or np.max(np.abs(d - dt)) > 1e-6 * dt + 1e-12:
-        raise ValueError("invalid time: the record must be uniformly sampled and increasing")
-    return dt
+def _uniform_dt(time: ArrayLike) -> float:
+    return uniform_dt(time, "invalid time", min_rows=10)
 
 
 def simulate_structure(rig: Rig, c: float, F_c: float, n: int, dt: float, x0: float = 0.0,
@@ -74,7 +72,7 @@ def simulate_structure(rig: Rig, c: float, F_c: float, n: int, dt: float, x0: fl
     """Displacement [m] of the structure alone (Eq 5, Free mode) with damping c
     [N s/m] and friction F_c [N], released at rest from x0 [m] and driven by
     ``force`` [N] per sample (zero if None); n samples at dt [s]."""
-    r = rig_from_dict(rig_to_dict(rig))
+    r = copy_rig(rig)
     r.c, r.F_c = float(c), float(F_c)
     r.effects.coulomb_friction = True
     plant = make_plant(r, "free", dt, solver_options(rtol=rtol, max_steps_per_sample=20000), x0)
@@ -96,16 +94,21 @@ def _interval_mean(force: np.ndarray) -> np.ndarray:
     return held
 
 
+def lag1_autocorrelation(x: ArrayLike) -> float:
+    """Lag-1 autocorrelation of a series about its mean [-] (0 for a constant series)."""
+    e = np.asarray(x, dtype=float)
+    e = e - e.mean()
+    den = float(e @ e)
+    return float(e[:-1] @ e[1:]) / den if den > 0 else 0.0
+
+
 def _ar1_effective_n(res: np.ndarray) -> tuple[float, float]:
     """(effective sample size, lag-1 autocorrelation) of residuals, AR(1) model."""
-    e = res - res.mean()
-    den = float(e @ e)
-    rho = float(e[:-1] @ e[1:]) / den if den > 0 else 0.0
-    rho = min(max(rho, 0.0), 0.999)
+    rho = min(max(lag1_autocorrelation(res), 0.0), 0.999)
     return res.size * (1.0 - rho) / (1.0 + rho), rho
 
 
-def identify_damping_friction(time: np.ndarray, displacement: np.ndarray, rig: Rig,
+def identify_damping_friction(time: ArrayLike, displacement: ArrayLike, rig: Rig,
                               force: np.ndarray | None = None, x0: float | None = None,
                               guess: tuple[float, float] | None = None) -> FrictionEstimate:
     """Least-squares fit of c and F_c of Eq (5) to a displacement record (Fig 2b).
@@ -191,7 +194,20 @@ class FirstOrderEstimate:
         return self.gain / (1j * TWO_PI * np.asarray(f) * self.tau + 1.0)
 
 
-def frequency_response(time: np.ndarray, command: np.ndarray, response: np.ndarray,
+def _dft_ratio(output: np.ndarray, reference: np.ndarray, dt: float,
+               from_rest: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Whole-record DFTs of a sweep: (f [Hz], Y, U, Y/U).  ``from_rest``: the first
+    sample of each signal is removed first (the record starts at rest there)."""
+    y = np.asarray(output, dtype=float)
+    u = np.asarray(reference, dtype=float)[: y.size]
+    if from_rest:
+        y, u = y - y[0], u - u[0]
+    Y, U = np.fft.rfft(y), np.fft.rfft(u)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.fft.rfftfreq(y.size, dt), Y, U, Y / U
+
+
+def frequency_response(time: ArrayLike, command: ArrayLike, response: ArrayLike,
                        min_level: float = 0.05) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Frequency response of a sweep record as the ratio of whole-record DFTs, Y/U.
 
@@ -205,15 +221,21 @@ def frequency_response(time: np.ndarray, command: np.ndarray, response: np.ndarr
     y = np.asarray(response, dtype=float)
     if u.shape != y.shape:
         raise ValueError(f"invalid response shape = {y.shape}: must match command {u.shape}")
-    U, Y = np.fft.rfft(u - u[0]), np.fft.rfft(y - y[0])
-    f = np.fft.rfftfreq(u.size, dt)
+    f, _, U, H = _dft_ratio(y, u, dt, from_rest=True)
     ok = np.abs(U) >= min_level * np.max(np.abs(U))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        h = np.where(ok, Y / np.where(ok, U, 1.0), np.nan)
-    return f, h, ok
+    return f, np.where(ok, H, np.nan), ok
 
 
-def identify_first_order(time: np.ndarray, command: np.ndarray, response: np.ndarray,
+def fourier_ratio(output: ArrayLike, reference: ArrayLike, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """|FFT(output)| / |FFT(reference)| of one record -> (frequency [Hz], ratio [-]).
+
+    For a sine sweep this is the amplitude of the frequency response (the paper
+    plots Fourier amplitudes of the measured force against the command)."""
+    f, _, _, H = _dft_ratio(output, reference, dt, from_rest=False)
+    return f, np.abs(H)
+
+
+def identify_first_order(time: ArrayLike, command: ArrayLike, response: ArrayLike,
                          band: tuple[float, float] = (0.1, 2.0)) -> FirstOrderEstimate:
     """Equivalent first-order roll-off and delay from a displacement-control sweep.
 
@@ -238,19 +260,51 @@ def identify_first_order(time: np.ndarray, command: np.ndarray, response: np.nda
                               excited=ok, band=band)
 
 
-def linear_chirp(duration: float, dt: float, f0: float, f1: float, amplitude: float,
-                 ramp: float = 0.5, tail: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """Linear sine sweep from f0 to f1 [Hz] over ``duration`` [s], amplitude [m or N],
-    with half-cosine fades of ``ramp`` seconds at both ends, then ``tail``
-    seconds of zeros (for the response to settle).  Returns (time [s], signal)."""
-    t = np.arange(int(round((duration + tail) / dt)) + 1) * dt
-    u = amplitude * signal.chirp(t, f0=f0, t1=duration, f1=f1, method="linear", phi=-90.0)
-    if ramp > 0:
-        w = np.clip(np.minimum(t, duration - t) / ramp, 0.0, 1.0)
-        u *= 0.5 - 0.5 * np.cos(math.pi * w)
-    u[t > duration] = 0.0
-    return t, u
+@dataclass
+class FreeVibration:
+    """Identified free vibration x(t) = X exp(-zeta w_n t) cos(w_d t + phi) + x_inf."""
+
+    frequency: float  #: damped natural frequency f_d [Hz]
+    damping_ratio: float  #: zeta [-] (negative: the response grows)
+    amplitude: float  #: X [same unit as the signal]
+    offset: float  #: x_inf
+    rms_error: float  #: fit residual relative to X [-]
 
 
-__all__ = ["FirstOrderEstimate", "FrictionEstimate", "frequency_response", "identify_damping_friction",
-           "identify_first_order", "linear_chirp", "simulate_structure"]
+def identify_free_vibration(x: ArrayLike, dt: float, start: int = 0, duration: float = 4.0) -> FreeVibration:
+    """Fits a damped cosine to x[start : start + duration/dt] by least squares.
+
+    The frequency is started from the zero-padded FFT peak of the window; zeta from 0.
+    Robust to the small oil-column ripple that makes peak picking unreliable."""
+    n = int(round(duration / dt))
+    y = np.asarray(x, dtype=float)[start: start + n]
+    if y.size < 16:
+        raise ValueError(f"invalid window: {y.size} samples from start = {start}")
+    t = np.arange(y.size) * dt
+    yc = y - y.mean()
+    nfft = 16 * y.size
+    spec = np.abs(np.fft.rfft(yc * np.hanning(y.size), nfft))
+    freqs = np.fft.rfftfreq(nfft, dt)
+    f0 = freqs[np.argmax(spec[1:]) + 1]
+
+    def model(p: np.ndarray) -> np.ndarray:
+        X, z, f, phi, c = p
+        wn = 2 * np.pi * f / np.sqrt(max(1 - z * z, 1e-9))
+        return X * np.exp(-z * wn * t) * np.cos(2 * np.pi * f * t + phi) + c
+
+    X0 = np.abs(yc).max()
+    best = None
+    for phi0 in (0.0, np.pi / 2, np.pi, -np.pi / 2):
+        r = optimize.least_squares(lambda p: model(p) - y, [X0, 0.0, f0, phi0, y.mean()],
+                                   bounds=([0, -0.9, 0.5 * f0, -10, -np.inf], [np.inf, 0.9, 2 * f0, 10, np.inf]))
+        if best is None or r.cost < best.cost:
+            best = r
+    X, z, f, _, c = best.x
+    rms = float(np.sqrt(np.mean(best.fun**2)) / max(X, 1e-300))
+    return FreeVibration(frequency=float(f), damping_ratio=float(z), amplitude=float(X), offset=float(c),
+                         rms_error=rms)
+
+
+__all__ = ["FirstOrderEstimate", "FreeVibration", "FrictionEstimate", "fourier_ratio", "frequency_response",
+           "identify_damping_friction", "identify_first_order", "identify_free_vibration", "lag1_autocorrelation",
+           "linear_chirp", "simulate_structure"]

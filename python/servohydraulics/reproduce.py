@@ -31,7 +31,7 @@ from .identify import (
     linear_chirp,
     simulate_structure,
 )
-from .rig import Rig, zhao2003
+from .rig import Rig, copy_rig, zhao2003
 from .simulate import simulate
 
 TWO_PI = 2.0 * math.pi
@@ -508,8 +508,8 @@ def section_rpsd_linear(ctx: Context) -> None:
         fig, ax = plots.new_figure(f"Fig 10({tag}): RPsD loop poles, physical mass = "
                                    f"{'modelled mass' if tag == 'b' else '2 % of modelled mass (140 kg)'} "
                                    "(linear analysis, 68 + 11.2 ms leads)", figsize=(8, 6))
-        for opt, color in zip(an.RESTORING_FORCES, ("k", "C3", "C1", "C2", "C0")):
-            s = an.rpsd_loop(lin, M_M, C_M, opt, physical_mass=mass)
+        for (opt, kw), color in zip(an.fig10_variants(lin, mass).items(), ("k", "C3", "C1", "C2", "C0")):
+            s = an.rpsd_loop(lin, M_M, C_M, physical_mass=mass, **kw)
             modes[(tag, opt)] = an.structural_mode(s, w_n)
             plots.pole_zero(ax[0, 0], s[0, 0], f"f = {opt.replace('_', ' ')}", color, xlim=(-6, 3), ylim=(-2, 16))
         ax[0, 0].legend(fontsize=7, ncol=2)
@@ -539,7 +539,7 @@ def section_rpsd_linear(ctx: Context) -> None:
 # --------------------------------------------------------------------------- Figs 3(b), 4(b, c): EFT loops
 def _with_effects(rig: Rig, **switches: bool) -> Rig:
     """A copy of ``rig`` with some effect switches changed."""
-    r = an._copy(rig)
+    r = copy_rig(rig)
     e = r.effects
     for name, on in switches.items():
         setattr(e, name, on)

@@ -41,10 +41,12 @@ from typing import Any, Callable
 
 import numpy as np
 import pandas as pd
+from numpy.typing import ArrayLike
 
 from . import _core
+from .excitations import sine
 from .rig import EFFECTS, PARAMETERS, Rig, rig_from_dict, rig_to_dict, zhao2003
-from .simulate import SimulationError, simulate, solver_options
+from .simulate import simulate, solver_options
 
 _RIG_KEYS = {f"{p.section}.{p.key}" for p in PARAMETERS} | {f"effects.{e}" for e in EFFECTS} | {
     "servovalve.flow_curve.b"}
@@ -52,7 +54,7 @@ _RIG_KEYS = {f"{p.section}.{p.key}" for p in PARAMETERS} | {f"effects.{e}" for e
 __all__ = ["summary_run", "sweep", "grid_points", "monte_carlo_points"]
 
 
-def summary_run(rig: Rig, mode: str = "displacement", command: np.ndarray | None = None,
+def summary_run(rig: Rig, mode: str = "displacement", command: ArrayLike | None = None,
                 amplitude: float = 0.01, frequency: float = 1.0, duration: float = 2.0, dt: float = 5e-4,
                 method: str = "cvode", rtol: float = 1e-6, rk4_substeps: int = 0,
                 keep_record: bool = False) -> dict[str, Any]:
@@ -66,7 +68,7 @@ def summary_run(rig: Rig, mode: str = "displacement", command: np.ndarray | None
             ``duration`` [s].
         dt: controller sample time [s].
         method, rtol, rk4_substeps: solver options (``solver_options``).
-        keep_record: also return the full ``SimulationResult`` under ``"record"``.
+        keep_record: also return the full :class:`~servohydraulics.response.Response` under ``"record"``.
 
     Returns:
         ``ok`` (the run finished without diverging), ``status``, ``failure_time``
@@ -77,22 +79,18 @@ def summary_run(rig: Rig, mode: str = "displacement", command: np.ndarray | None
         ``internal_steps`` (CVODE, whole run) and ``wall_time`` [s].
     """
     if command is None:
-        n = int(round(duration / dt)) + 1
-        command = amplitude * np.sin(2.0 * math.pi * frequency * dt * np.arange(n))
+        command = sine(amplitude, frequency, duration, dt)
     options = solver_options(method=method, rtol=rtol, rk4_substeps=rk4_substeps)
     t0 = time.perf_counter()
-    try:
-        res = simulate(rig, mode=mode, command=command, dt=dt, options=options, raise_on_failure=False)
-    except SimulationError as e:  # pragma: no cover - raise_on_failure=False returns instead
-        return {"ok": False, "status": str(e)}
+    res = simulate(rig, mode=mode, command=command, dt=dt, options=options, raise_on_failure=False)
     wall = time.perf_counter() - t0
     measured = res.displacement if mode == "displacement" else res.force
     err = res.command - measured
     n = len(res.time)
     out: dict[str, Any] = {
-        "ok": bool(res.summary["ok"]),
-        "status": res.summary["status"],
-        "failure_time": res.summary["failure_time"] if res.summary["failure_time"] is not None else math.nan,
+        "ok": res.success,
+        "status": res.work.status.message,
+        "failure_time": math.nan if res.success else res.work.status.t,
         "peak_displacement": float(np.max(np.abs(res.displacement))) if n else math.nan,
         "peak_force": float(np.max(np.abs(res.force))) if n else math.nan,
         "rms_tracking_error": float(np.sqrt(np.mean(err**2))) if n else math.nan,
@@ -100,7 +98,7 @@ def summary_run(rig: Rig, mode: str = "displacement", command: np.ndarray | None
         "capacity_exceeded": res.capacity_exceeded,
         "supply_limited": res.supply_limited,
         "spool_saturated": bool(np.any(res.flags & _core.FLAG_SPOOL_SATURATED)),
-        "internal_steps": int(res.summary["internal_steps"]),
+        "internal_steps": int(res.work.internal_steps),
         "wall_time": wall,
     }
     if keep_record:

@@ -9,7 +9,7 @@ import pytest
 import servohydraulics as sh
 from servohydraulics import _core
 from servohydraulics import excitations as ex
-from servohydraulics.signals import fourier_ratio, identify_free_vibration
+from servohydraulics.identify import fourier_ratio, identify_free_vibration
 
 DT = 5e-4
 SWEEP = 20.0  # [s]: 0-10 Hz at 0.5 Hz/s
@@ -125,7 +125,7 @@ def test_eft_delay_compensation_moves_peak_and_overcompensation_is_unstable():
     P = ex.sine_sweep(ex.SWEEP_FORCE_SMALL, duration=SWEEP)
     res = sh.run_eft(rig, effective_force=P, lead_T=40e-3, raise_on_failure=False)
     assert np.max(np.abs(res.displacement)) > 0.1
-    assert any("saturated" in w for w in res.warnings)
+    assert any("saturated" in w for w in res.warnings())
 
 
 # ------------------------------------------------------------------ RPsD

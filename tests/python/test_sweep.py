@@ -133,5 +133,5 @@ def test_keep_records_returns_the_simulation():
     df = sh.sweep(grid={"controller.G_p": [0.8]}, fixed={"duration": 0.1}, keep_records=True,
                   executor=ThreadPoolExecutor(1), progress=False)
     rec = df.loc[0, "record"]
-    assert isinstance(rec, sh.SimulationResult)
+    assert isinstance(rec, sh.Response) and rec.kind == "plant"
     assert rec.displacement.max() == pytest.approx(df.loc[0, "peak_displacement"])

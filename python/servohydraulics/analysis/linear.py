@@ -1,0 +1,212 @@
+"""Linearisation of the C++ model into python-control objects, and the linear
+compensator blocks of Fig 1 (phase leads, the ZOH delay).
+Nonsmooth effects at an equilibrium
+-----------------------------------
+The nonlinear model has two points where the tangent linearisation is not the
+small-signal model the paper analyses (Eqs 6-8):
+
+* Coulomb friction ``F_c tanh(v / v_stick)`` has slope ``F_c / v_stick`` at
+  ``v = 0`` (3.2e5 N s/m for the attached rig, 150 times ``c``): the tangent
+  model describes a structure stuck in static friction.  ``linearize`` therefore
+  takes ``friction="off"`` (default: F_c dropped), ``"equivalent"`` (Eq 8: F_c
+  replaced by the energy-equivalent viscous damping ``4 F_c / (pi w X)`` of a
+  harmonic motion of amplitude X at w, Jacobsen) or ``"tangent"`` (the raw
+  Jacobian, stuck structure).
+* The load-pressure factor of Eq (3) contains ``sgn(x_v)``; its derivative by p
+  is multiplied by ``g(x_v)``, which vanishes at the null spool, so the Jacobian
+  is continuous there (the C++ code uses sgn(0) = 0).  Away from null, the
+  operating point's spool sign selects the branch: that is the valve's
+  flow-pressure coefficient at that opening, and it is kept.
+* Saturations (drive, spool end stops) are inactive at any equilibrium inside
+  the travel; spring softening only matters for ``|x0| > x_contact``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import control as ct
+import numpy as np
+
+from .. import _core
+from ..response import channel_units
+from ..rig import Rig, copy_rig
+from ..simulate import MODES
+from .closed_form import equivalent_viscous_damping, velocity_feedback_gain
+
+ALPHA = _core.RpsdConfig().alpha  #: constant of the paper's phase-lead networks (Table I), the core's default [-]
+OUTPUT_UNITS = {n: u for n, u in channel_units("plant", "displacement").items()
+                if n not in ("time", "command", "flags", "internal_steps", "rhs_evals")}
+OUTPUTS = tuple(OUTPUT_UNITS)  #: the plant's output channels, in the order of LinearModel.C's rows
+STATES = ("x", "v", "p", "x_v", "x_v_dot", "z")
+FRICTION_TREATMENTS = ("off", "equivalent", "tangent")
+
+
+def phase_lead(T: float, alpha: float = ALPHA) -> ct.TransferFunction:
+    """Phase-lead network (T s + 1)/(alpha T s + 1) of Fig 1 [-]; T [s]."""
+    if not (math.isfinite(T) and T > 0):
+        raise ValueError(f"invalid T = {T!r}: the lead time constant must be finite and > 0 [s]")
+    if not (0 < alpha < 1):
+        raise ValueError(f"invalid alpha = {alpha!r}: must be in (0, 1)")
+    return ct.tf([T, 1.0], [alpha * T, 1.0])
+
+
+def zoh_delay(dt: float, order: int = 3) -> ct.TransferFunction:
+    """Half-sample delay of the zero-order hold of a controller at sample time dt [s] (Pade)."""
+    num, den = ct.pade(dt / 2.0, order)
+    return ct.tf(num, den)
+
+
+@dataclass(frozen=True)
+class Compensation:
+    """Linear compensators put in the loop by :func:`linearize` (all times in s).
+
+    amplitude_T: amplitude compensation lead (T s+1)/(alpha T s+1) on the
+        command, Fig 1(b) (paper: 68 ms).
+    velocity_feedback: EFT velocity-feedback compensation of Fig 1(a): the
+        command gets ``A / (K_v K_s C_F G_p) * lead(velocity_feedback_T) * v``
+        added, the linear inverse of the natural velocity feedback.
+    velocity_feedback_T: phase lead of that path (paper: 5 ms); None: no lead.
+    zoh_dt: controller sample time whose half-sample ZOH delay is put on the
+        command (None: continuous).
+    """
+
+    amplitude_T: float | None = None
+    velocity_feedback: bool = False
+    velocity_feedback_T: float | None = None
+    alpha: float = ALPHA
+    zoh_dt: float | None = None
+
+
+def linear_analysis_rig(rig: Rig, friction: str = "off", friction_amplitude: float = 0.0127,
+                        friction_frequency: float | None = None) -> Rig:
+    """Copy of the rig with the friction treated as in the linear analysis.
+
+    friction: ``"off"`` (F_c dropped), ``"equivalent"`` (F_c replaced by
+    ``c_eq = 4 F_c / (pi w X)``, Eq 8, at amplitude ``friction_amplitude`` [m]
+    and ``friction_frequency`` [rad/s], default sqrt(k/m)), ``"tangent"``
+    (unchanged).
+    """
+    if friction not in FRICTION_TREATMENTS:
+        raise ValueError(f"invalid friction = {friction!r}: expected one of {list(FRICTION_TREATMENTS)}")
+    r = copy_rig(rig)
+    if friction == "tangent":
+        return r
+    if friction == "equivalent" and r.effects.coulomb_friction:
+        r.c = r.c + equivalent_viscous_damping(r, friction_amplitude, friction_frequency)
+    r.effects.coulomb_friction = False
+    return r
+
+
+def hold_command(dyn: _core.Dynamics, y0: Sequence[float]) -> float:
+    """The held command u0 [m or N] for which the equilibrium state y0 is at rest.
+
+    The rate equation that u drives (the spool, or the pressure with a static
+    valve) is affine in u away from saturation: two secant steps make it exact.
+    """
+    mode = dyn.mode
+    if mode == _core.ControlMode.Free:
+        return float(dyn.spring_force(y0[0]))
+    idx = 4 if dyn.rhs(list(y0), 1.0)[4] != dyn.rhs(list(y0), 0.0)[4] else 2
+
+    def r(u: float) -> float:
+        return float(dyn.rhs(list(y0), u)[idx])
+
+    u_a = float(y0[0]) if mode == _core.ControlMode.Displacement else float(dyn.outputs(list(y0), 0.0).force)
+    scale = 1e-4 if mode == _core.ControlMode.Displacement else 10.0
+    u_b = u_a + scale
+    for _ in range(3):
+        ra, rb = r(u_a), r(u_b)
+        if rb == ra:
+            break
+        u_a, u_b = u_b, u_b - rb * (u_b - u_a) / (rb - ra)
+    return u_b
+
+
+def linearize(rig: Rig, mode: str = "displacement", x0: float = 0.0, u0: float | None = None,
+              outputs: Sequence[str] = ("displacement",), compensators: Compensation | None = None,
+              friction: str = "off", friction_amplitude: float = 0.0127,
+              friction_frequency: float | None = None) -> ct.StateSpace:
+    """Linearises the nonlinear C++ model about its static equilibrium at x0.
+
+    Args:
+        rig: the rig (not modified).
+        mode: ``"displacement"`` (input: command [m]), ``"force"`` (command [N])
+            or ``"free"`` (ideal external force [N]).
+        x0: operating displacement [m].
+        u0: held command [m or N]; default: the command that holds x0.
+        outputs: channels among ``OUTPUTS`` (SI units, see ``OUTPUT_UNITS``).
+        compensators: linear compensators in the loop (:class:`Compensation`).
+        friction: treatment of the Coulomb friction (module docstring).
+        friction_amplitude, friction_frequency: X [m] and w [rad/s] of the
+            equivalent viscous damping (``friction="equivalent"``).
+
+    Returns:
+        ``control.StateSpace`` from input ``"u"`` to the named outputs, with the
+        inactive states (pressure and spool in Free mode, the spool without
+        valve dynamics) dropped, and the compensator states appended.
+    """
+    if mode not in MODES:
+        raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(MODES)}")
+    outs = list(outputs)
+    for o in outs:
+        if o not in OUTPUTS:
+            raise ValueError(f"invalid output = {o!r}: expected one of {list(OUTPUTS)}")
+    if not outs:
+        raise ValueError("invalid outputs = (): name at least one output channel")
+    if not math.isfinite(x0):
+        raise ValueError(f"invalid x0 = {x0!r}: must be finite [m]")
+    comp = compensators or Compensation()
+    r = linear_analysis_rig(rig, friction, friction_amplitude, friction_frequency)
+    dyn = _core.Dynamics(r, MODES[mode])
+    y0 = list(dyn.equilibrium(float(x0)))
+    u_op = hold_command(dyn, y0) if u0 is None else float(u0)
+    lm = _core.linearize(dyn, y0, u_op)
+    keep = np.flatnonzero(np.asarray(lm.active, dtype=bool))
+    need = list(dict.fromkeys(outs + (["velocity"] if comp.velocity_feedback else [])))
+    rows = [OUTPUTS.index(o) for o in need]
+    A = np.asarray(lm.A)[np.ix_(keep, keep)]
+    B = np.asarray(lm.B).reshape(-1, 1)[keep]
+    C = np.asarray(lm.C)[np.ix_(rows, keep)]
+    D = np.asarray(lm.D).reshape(-1, 1)[rows]
+    plant = ct.ss(A, B, C, D, inputs=["u"], outputs=need, states=[STATES[i] for i in keep],
+                  name="plant")
+    return _close_compensators(plant, r, mode, comp, outs)
+
+
+def _close_compensators(plant: ct.StateSpace, rig: Rig, mode: str, comp: Compensation,
+                        outs: list[str]) -> ct.StateSpace:
+    """Puts the linear compensators around the plant (python-control interconnect)."""
+    if comp.amplitude_T is None and not comp.velocity_feedback and comp.zoh_dt is None:
+        return ct.ss(plant[[plant.output_labels.index(o) for o in outs], :]) if len(outs) < plant.noutputs \
+            else plant
+    blocks: list = [plant]
+    signal = "u_cmd"
+    chain: list[tuple[str, ct.TransferFunction]] = []
+    if comp.amplitude_T is not None:
+        chain.append(("amplitude_lead", phase_lead(comp.amplitude_T, comp.alpha)))
+    if comp.zoh_dt is not None:
+        chain.append(("zoh", zoh_delay(comp.zoh_dt)))
+    for name, tf in chain:
+        nxt = f"{name}_out"
+        blocks.append(ct.ss(tf, inputs=[signal], outputs=[nxt], name=name))
+        signal = nxt
+    if comp.velocity_feedback:
+        if mode != "force":
+            raise ValueError(f"invalid compensators.velocity_feedback = True in mode = {mode!r}: "
+                             "velocity-feedback compensation is the force-control (EFT) scheme")
+        gain = velocity_feedback_gain(rig)  # [N per m/s]
+        vf = ct.tf([gain], [1.0]) if comp.velocity_feedback_T is None else \
+            gain * phase_lead(comp.velocity_feedback_T, comp.alpha)
+        blocks.append(ct.ss(vf, inputs=["velocity"], outputs=["u_vfc"], name="velocity_feedback"))
+        blocks.append(ct.summing_junction(inputs=[signal, "u_vfc"], output="u", name="sum"))
+    else:
+        blocks.append(ct.summing_junction(inputs=[signal], output="u", name="sum"))
+    return ct.interconnect(blocks, inplist=["u_cmd"], outlist=outs, inputs=["u"], outputs=outs,
+                           name="compensated")
+
+
+__all__ = ["ALPHA", "Compensation", "FRICTION_TREATMENTS", "OUTPUTS", "OUTPUT_UNITS", "STATES", "hold_command",
+           "linear_analysis_rig", "linearize", "phase_lead", "zoh_delay"]

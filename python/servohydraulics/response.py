@@ -1,0 +1,391 @@
+"""One time-response type for every run and record, and one error.
+
+:class:`Response` is shaped like python-control's ``TimeResponseData`` and
+scipy's ``OdeResult``: ``time``, named ``channels`` with ``units``, the
+provenance of the data (``kind``, ``mode``, ``dt``, ``rig``) and the outcome
+(``success``, ``status``, ``message``, ``work``).  ``simulate``, ``run_eft``,
+``run_rpsd``, ``run_tracking`` and ``read_record`` all return it;
+``to_csv`` writes every channel and ``read_record`` reads it back.
+
+Row k holds the sensors at ``time[k]``, before command k is applied (the
+row convention of record.hpp and loops.hpp).
+
+Channel names and units come from the C++ core's channel tables (one place:
+:func:`channel_units`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping
+from pathlib import Path
+from types import SimpleNamespace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from . import _core
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+
+    from .rig import Rig
+
+KINDS = ("plant", "eft", "rpsd", "tracking", "record")
+
+#: Columns a record file must have (the diagnosis needs them).
+REQUIRED = ("time", "command", "displacement", "force")
+
+#: Per-row bookkeeping of a run (integer counts, not measurements).
+_COUNTS = {"flags": "-", "internal_steps": "-", "rhs_evals": "-"}
+_INTEGER = frozenset(_COUNTS)
+
+#: Old CSV column names still read (with a DeprecationWarning) for one release.
+DEPRECATED_COLUMNS = {"ground_accel": "ground_acceleration"}
+
+
+def _core_tables() -> tuple[tuple[tuple[str, str], ...], ...]:
+    """(plant, EFT, RPsD) channel tables as ((name, unit), ...) from the C++ core."""
+    if all(hasattr(_core, n) for n in ("PLANT_CHANNELS", "EFT_CHANNELS", "RPSD_CHANNELS")):
+        return (tuple(map(tuple, _core.PLANT_CHANNELS)), tuple(map(tuple, _core.EFT_CHANNELS)),
+                tuple(map(tuple, _core.RPSD_CHANNELS)))
+    # TEMPORARY until the core tables land (_core.PLANT_CHANNELS, EFT_CHANNELS, RPSD_CHANNELS).
+    plant = (("time", "s"), ("displacement", "m"), ("velocity", "m/s"), ("acceleration", "m/s^2"),
+             ("force", "N"), ("pressure", "Pa"), ("spool", "-"), ("drive", "V"), ("flow", "m^3/s"))
+    eft = (("ground_acceleration", "m/s^2"), ("effective_force", "N"), ("compensation", "N"),
+           ("compensation_opening", "-"), ("command", "N"))
+    rpsd = (("ground_acceleration", "m/s^2"), ("external_force", "N"), ("measured_restoring_force", "N"),
+            ("restoring_force", "N"), ("calc_displacement", "m"), ("calc_velocity", "m/s"),
+            ("calc_acceleration", "m/s^2"), ("target_displacement", "m"), ("command", "m"))
+    return plant, eft, rpsd
+
+
+def _command_unit(mode: str | None) -> str:
+    return {"displacement": "m", "force": "N", "free": "N"}.get(mode or "", "m or N")
+
+
+def channel_units(kind: str = "record", mode: str | None = None) -> dict[str, str]:
+    """Every channel a response of ``kind`` can carry, in file order, name -> SI unit.
+
+    ``"plant"``/``"tracking"``: the plant's channels, the held command (unit
+    from ``mode``) and the per-row counts.  ``"eft"``/``"rpsd"``: the plant's
+    channels, the flags and the method's channels.  ``"record"``: the union of
+    all of them (what a record file may hold).
+    """
+    if kind not in KINDS:
+        raise ValueError(f"invalid kind = {kind!r}: expected one of {list(KINDS)}")
+    plant, eft, rpsd = _core_tables()
+    out = dict(plant)
+    if kind in ("plant", "tracking", "record"):
+        out["command"] = _command_unit(mode)
+        out.update(_COUNTS)
+    if kind in ("eft", "record"):
+        out["flags"] = _COUNTS["flags"]
+        out.update((n, u) for n, u in eft if n != "command" or kind == "eft")
+    if kind in ("rpsd", "record"):
+        out["flags"] = _COUNTS["flags"]
+        out.update((n, u) for n, u in rpsd if n != "command" or kind == "rpsd")
+    return out
+
+
+class Work(SimpleNamespace):
+    """The run's summary counts, copied from the core's ``RunSummary`` (so a
+    Response pickles): ``rows``, ``internal_steps``, ``rhs_evals``, ``restarts``,
+    ``max_internal_steps``, ``flags_any``, ``peak_force`` [N],
+    ``first_capacity_time`` [s], and ``status`` (``ok``, ``code``, ``message``,
+    ``t`` [s], ``cvode_flag``, ...), whatever fields the core exports."""
+
+    @classmethod
+    def from_core(cls, summary: Any) -> Work:
+        return cls(**_public_fields(summary))
+
+
+def _public_fields(obj: Any) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for name in dir(obj):
+        if name.startswith("_"):
+            continue
+        v = getattr(obj, name)
+        if name == "ok" and callable(v):
+            out["ok"] = bool(v())
+        elif name == "code":
+            out["code"] = _snake(v.name)
+        elif isinstance(v, _core.Status):
+            out[name] = SimpleNamespace(**_public_fields(v))
+        elif not callable(v) and not isinstance(v, type):
+            out[name] = v
+    return out
+
+
+def _snake(name: str) -> str:
+    return "".join(f"_{c.lower()}" if c.isupper() else c for c in name).lstrip("_")
+
+
+def _first_time(time: np.ndarray, flags: np.ndarray, bit: int) -> float:
+    return float(time[np.argmax((flags & bit) > 0)])
+
+
+def limit_warnings(flags: np.ndarray, time: np.ndarray, peak_force: float, rig: Rig | None = None) -> list[str]:
+    """Notes on the physical limits a run hit, from its per-row OutputFlag bits
+    (``rig`` adds the limit values)."""
+    out = []
+    if np.any(flags & _core.FLAG_CAPACITY_EXCEEDED):
+        cap = f" > {rig.F_cap / 1e3:.0f} kN" if rig is not None else ""
+        out.append(f"actuator capacity exceeded: peak force {peak_force / 1e3:.1f} kN{cap}, "
+                   f"first at t = {_first_time(time, flags, _core.FLAG_CAPACITY_EXCEEDED):.3f} s")
+    if np.any(flags & _core.FLAG_SUPPLY_LIMITED):
+        lim = f" (p_s A = {rig.p_s * rig.A / 1e3:.1f} kN)" if rig is not None else ""
+        out.append(f"load pressure reached the supply pressure{lim}, force limited, "
+                   f"first at t = {_first_time(time, flags, _core.FLAG_SUPPLY_LIMITED):.3f} s")
+    if np.any(flags & _core.FLAG_STROKE_EXCEEDED):
+        lim = f" (+-{rig.stroke * 1e3:.0f} mm)" if rig is not None else ""
+        out.append(f"displacement beyond the actuator stroke{lim} first at t = "
+                   f"{_first_time(time, flags, _core.FLAG_STROKE_EXCEEDED):.3f} s: a real actuator would hit "
+                   "its end stop")
+    if np.any(flags & _core.FLAG_SPOOL_SATURATED):
+        out.append("servovalve spool saturated (fully open) first at t = "
+                   f"{_first_time(time, flags, _core.FLAG_SPOOL_SATURATED):.3f} s")
+    if np.any(flags & _core.FLAG_DRIVE_SATURATED):
+        out.append(f"servovalve drive saturated first at t = "
+                   f"{_first_time(time, flags, _core.FLAG_DRIVE_SATURATED):.3f} s")
+    return out
+
+
+class Channels(Mapping):
+    """Read-only name -> array mapping whose channels are also attributes."""
+
+    __slots__ = ("_data",)
+
+    def __init__(self, data: Mapping[str, np.ndarray]):
+        object.__setattr__(self, "_data", dict(data))
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self._data[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._data)
+
+    def __len__(self) -> int:
+        return len(self._data)
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        try:
+            return object.__getattribute__(self, "_data")[name]
+        except KeyError:
+            raise AttributeError(f"no channel {name!r}; channels: {list(self._data)}") from None
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise AttributeError("channels are read-only")
+
+    def __repr__(self) -> str:
+        return f"Channels({list(self._data)})"
+
+    def __reduce__(self):
+        return (Channels, (self._data,))
+
+
+class _Warnings(list):
+    """The warnings of a run: call it (``res.warnings()``, the API).  It is also
+    a list so that code written for the old ``MethodResult.warnings`` list keeps
+    working until it is ported."""
+
+    def __init__(self, res: Response):
+        super().__init__(res._warning_list(None))
+        self._res = res
+
+    def __call__(self, rig: Rig | None = None) -> list[str]:
+        """The notes as a plain list (``rig`` overrides the run's rig for the limit values)."""
+        return list(self) if rig is None else self._res._warning_list(rig)
+
+
+class Response:
+    """Every channel of a run or record, SI units, one row per controller sample.
+
+    Attributes:
+        time: [s], the same array as ``channels["time"]``.
+        channels: read-only mapping name -> array (also attributes:
+            ``res.displacement``); it includes ``time``.
+        units: name -> SI unit of each channel.
+        kind: ``"plant"`` (simulate), ``"eft"``, ``"rpsd"``, ``"tracking"`` or ``"record"``.
+        mode: control mode (``"displacement"``, ``"force"``, ``"free"``), None if unknown.
+        dt: controller sample time [s].
+        rig: the rig the run used (RPsD: the physical rig), None for a record.
+        success: the run finished (no solver failure or divergence).
+        status: ``"ok"`` or the failure code (``"solver_failure"``, ``"too_much_work"``, ``"non_finite"``).
+        message: ``"ok"`` or what failed, when and why.
+        work: the run's summary counts (:class:`Work`, from the core's
+            ``RunSummary``: rows, internal steps, rhs evaluations, restarts,
+            peak force, status); None for a record.
+        path: the file of a record, else None.
+    """
+
+    def __init__(self, channels: Mapping[str, ArrayLike], *, kind: str = "record", mode: str | None = None,
+                 dt: float | None = None, rig: Rig | None = None, work: _core.RunSummary | Work | None = None,
+                 units: Mapping[str, str] | None = None, path: str | Path | None = None):
+        if kind not in KINDS:
+            raise ValueError(f"invalid kind = {kind!r}: expected one of {list(KINDS)}")
+        if "time" not in channels:
+            raise ValueError(f"invalid channels {list(channels)}: a response needs a 'time' channel")
+        data = {n: (np.asarray(v) if n in _INTEGER else np.asarray(v, dtype=float)) for n, v in channels.items()}
+        table = channel_units(kind, mode)
+        self.channels = Channels(data)
+        self.units = {n: (units or {}).get(n, table.get(n, "?")) for n in data}
+        if work is not None and not isinstance(work, Work):
+            work = Work.from_core(work)
+        self.kind, self.mode, self.rig, self.work = kind, mode, rig, work
+        self.path = None if path is None else Path(path)
+        t = data["time"]
+        self.dt = float(dt) if dt is not None else (float((t[-1] - t[0]) / (t.size - 1)) if t.size > 1 else math.nan)
+        status = None if work is None else work.status
+        self.success = True if status is None else bool(status.ok)
+        self.status = "ok" if self.success else status.code
+        self.message = "ok" if self.success else _failure_message(kind, status)
+
+    # ---- channel access ------------------------------------------------------------
+    @property
+    def time(self) -> np.ndarray:
+        """Sample times [s]."""
+        return self.channels["time"]
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        if name.startswith("_") or name == "channels":
+            raise AttributeError(name)
+        try:
+            return self.channels[name]
+        except KeyError:
+            raise AttributeError(f"{type(self).__name__} has no attribute or channel {name!r}; "
+                                 f"channels: {list(self.channels)}") from None
+
+    def __len__(self) -> int:
+        return int(self.time.size)
+
+    def __repr__(self) -> str:
+        return (f"Response(kind={self.kind!r}, mode={self.mode!r}, rows={len(self)}, dt={self.dt:.6g}, "
+                f"status={self.status!r}, channels={list(self.channels)})")
+
+    # ---- outcome ---------------------------------------------------------------------
+    @property
+    def flags(self) -> np.ndarray:
+        """OutputFlag bits per row (zeros for a record without a ``flags`` column)."""
+        if "flags" in self.channels:
+            return self.channels["flags"]
+        return np.zeros(len(self), dtype=np.uint32)
+
+    @property
+    def capacity_exceeded(self) -> bool:
+        """|load-cell force| > F_cap somewhere."""
+        return bool(np.any(self.flags & _core.FLAG_CAPACITY_EXCEEDED))
+
+    @property
+    def supply_limited(self) -> bool:
+        """|p| >= 0.98 p_s somewhere."""
+        return bool(np.any(self.flags & _core.FLAG_SUPPLY_LIMITED))
+
+    def first_flag_time(self, flags: int) -> float | None:
+        """Time of the first row with any of ``flags`` [s], or None."""
+        hit = np.flatnonzero(self.flags & flags)
+        return float(self.time[hit[0]]) if hit.size else None
+
+    @property
+    def warnings(self) -> _Warnings:
+        """``res.warnings(rig=None)``: plain-language notes on the limits the run hit and,
+        for a failed run, the failure."""
+        return _Warnings(self)
+
+    def _warning_list(self, rig: Rig | None) -> list[str]:
+        rig = self.rig if rig is None else rig
+        peak = self.work.peak_force if self.work is not None else float(np.max(np.abs(self.force), initial=0.0))
+        out = limit_warnings(self.flags, self.time, peak, rig)
+        if not self.success:
+            out.append(self.message)
+        return out
+
+    @property
+    def summary(self) -> dict[str, Any]:
+        """The run's counts as a dict (kept for existing callers; ``work`` is the bound RunSummary)."""
+        w = self.work
+        if w is None:
+            return {"status": self.status, "ok": self.success, "rows": len(self)}
+        return {"status": w.status.message, "ok": self.success, "rows": w.rows,
+                "failure_time": None if self.success else w.status.t, "cvode_flag": w.status.cvode_flag,
+                "internal_steps": w.internal_steps, "rhs_evals": w.rhs_evals, "restarts": w.restarts,
+                "max_internal_steps": w.max_internal_steps, "flags_any": w.flags_any, "peak_force": w.peak_force,
+                "first_capacity_time": w.first_capacity_time}
+
+    # ---- export ----------------------------------------------------------------------
+    def to_pandas(self) -> pd.DataFrame:
+        """One column per channel (``time`` first), units in ``df.attrs["units"]``."""
+        import pandas as pd
+
+        df = pd.DataFrame({n: self.channels[n] for n in self.channels})
+        df.attrs["units"] = dict(self.units)
+        return df
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Writes every channel to a record CSV (``time, command, displacement,
+        force`` first); ``read_record`` reads it back.  Returns the path."""
+        path = Path(path)
+        missing = [c for c in REQUIRED if c not in self.channels]
+        if missing:
+            raise ValueError(f"cannot write {path}: missing channel(s) {missing}")
+        names = list(REQUIRED) + [n for n in self.channels if n not in REQUIRED]
+        cols = [np.asarray(self.channels[n], dtype=float) for n in names]
+        n0 = cols[0].size
+        for n, c in zip(names, cols):
+            if c.shape != (n0,):
+                raise ValueError(f"cannot write {path}: channel {n!r} has shape {c.shape}, expected ({n0},)")
+            if not np.all(np.isfinite(c)):
+                raise ValueError(f"cannot write {path}: channel {n!r} has non-finite values")
+        uniform_dt(cols[0], f"cannot write {path}")
+        np.savetxt(path, np.column_stack(cols), delimiter=",", header=",".join(names), comments="", fmt="%.10g")
+        return path
+
+
+def uniform_dt(time: ArrayLike, where: str = "time", min_rows: int = 2) -> float:
+    """The sample time [s] of a uniformly sampled, increasing time axis; errors name ``where``."""
+    t = np.asarray(time, dtype=float)
+    if t.ndim != 1 or t.size < min_rows:
+        raise ValueError(f"{where}: a record needs at least {min_rows} rows in a 1-D time axis, got shape {t.shape}")
+    d = np.diff(t)
+    if np.any(d <= 0):
+        i = int(np.flatnonzero(d <= 0)[0])
+        raise ValueError(f"{where}: time must be increasing; time[{i + 1}] = {t[i + 1]} <= time[{i}] = {t[i]}")
+    dt = (t[-1] - t[0]) / (t.size - 1)
+    worst = int(np.argmax(np.abs(d - dt)))
+    if abs(d[worst] - dt) > 1e-6 * dt + 1e-12:
+        raise ValueError(f"{where}: time must be uniform; step {worst} is {d[worst]:.9g} s, "
+                         f"the mean step is {dt:.9g} s")
+    return float(dt)
+
+
+_LABELS = {"plant": "simulation", "eft": "EFT", "rpsd": "RPsD", "tracking": "tracking", "record": "record"}
+
+
+def _failure_message(kind: str, status: SimpleNamespace) -> str:
+    flag = f" (CVODE flag {status.cvode_flag})" if status.cvode_flag else ""
+    return f"{_LABELS[kind]} failed at t = {status.t:.6g} s: {status.message}{flag}"
+
+
+class SimulationError(RuntimeError):
+    """A run failed (solver failure, overrun or divergence).
+
+    Attributes:
+        status: the failure code (``Response.status``).
+        partial: the :class:`Response` up to the failure.
+    """
+
+    def __init__(self, partial: Response):
+        super().__init__(partial.message)
+        self.status = partial.status
+        self.partial = partial
+
+
+def finish(res: Response, raise_on_failure: bool) -> Response:
+    """Returns the response, or raises SimulationError carrying it when it failed."""
+    if not res.success and raise_on_failure:
+        raise SimulationError(res)
+    return res
+
+
+__all__ = ["Channels", "Response", "Work", "SimulationError", "channel_units", "limit_warnings", "uniform_dt"]
