@@ -1,0 +1,2 @@
+def draw(name, results, rig, out):
+    return []
