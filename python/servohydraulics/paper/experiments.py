@@ -158,6 +158,23 @@ def equivalent_damping(rig: Rig, zeta_free_measured: float = 0.011) -> Equivalen
     return EquivalentDamping(amplitude=X, zeta_attached=z)
 
 
+@dataclass(frozen=True)
+class FreeDecay:
+    """Free vibration from x0 in free mode and its damped-cosine fit (friction shows as extra damping)."""
+
+    time: np.ndarray
+    displacement: np.ndarray  #: [m]
+    frequency: float  #: damped frequency [Hz]
+    damping_ratio: float  #: equivalent damping of the fit window [-]
+
+
+def free_decay(rig: Rig, x0: float = 0.013, duration: float = 10.0, fit: float = 4.0) -> FreeDecay:
+    """Free vibration of ``rig`` from x0 [m], fitted over the first ``fit`` seconds."""
+    res = simulate(rig, mode="free", duration=duration, dt=DT, x0=x0)
+    fv = identify_free_vibration(res.displacement, DT, duration=fit)
+    return FreeDecay(res.time, res.displacement, fv.frequency, fv.damping_ratio)
+
+
 # --------------------------------------------------------------------------- Figs 3(a), 4(a), Eq (11): force control
 @dataclass(frozen=True)
 class DirectEft:
@@ -346,6 +363,9 @@ class DisplacementSweeps:
 
     first_order: FirstOrderEstimate  #: fit of (a) over 0.1-2 Hz (frequency, response, excited inside)
     gain_2hz: float  #: |x/u| of (a) at 2 Hz [-]
+    time_a: np.ndarray
+    force_a: np.ndarray  #: load-cell force of (a) [N]
+    duration_a: float  #: (a) sweeps 0.1 -> 10 Hz linearly over this time [s]
     time_b: np.ndarray
     frequency_b: np.ndarray
     response_b: np.ndarray
@@ -359,7 +379,8 @@ class DisplacementSweeps:
 def fig5_displacement_sweeps(rig: Rig, quick: bool = False) -> DisplacementSweeps:
     dur = 20.0 if quick else 40.0
     t, u = linear_chirp(dur, DT, 0.1, 10.0, SWEEP_X, tail=2.0)
-    fo = identify_first_order(t, u, simulate(rig, "displacement", u, DT).displacement)
+    res = simulate(rig, "displacement", u, DT)
+    fo = identify_first_order(t, u, res.displacement)
     t2, u2 = linear_chirp(dur * 0.6, DT, 0.1, 6.0, SWEEP_X, tail=2.0)
     res2 = simulate(rig, "displacement", lead(u2, T_AMP), DT)
     f2, h2, ok2 = frequency_response(t2, u2, res2.displacement)
@@ -368,6 +389,7 @@ def fig5_displacement_sweeps(rig: Rig, quick: bool = False) -> DisplacementSweep
     peak_lin = float(np.max(np.abs(np.asarray(g_lead(1j * TWO_PI * np.linspace(0.2, 5.0, 400))))))
     in5 = t2 <= (5.0 - 0.1) / (6.0 - 0.1) * dur * 0.6  # the sweep below 5 Hz
     return DisplacementSweeps(first_order=fo, gain_2hz=abs(interp_response(fo.frequency, fo.response, 2.0)),
+                              time_a=t, force_a=res.force, duration_a=dur,
                               time_b=t2, frequency_b=f2, response_b=h2, excited_b=ok2,
                               peak_b=float(np.max(np.abs(h2[sel]))), peak_b_linear=peak_lin,
                               spool_b=float(np.max(np.abs(res2.spool[in5]))),
