@@ -14,6 +14,8 @@ from dataclasses import dataclass
 import control as ct
 import numpy as np
 
+import servohydraulics as sh  # public names, looked up at call time
+
 from .. import _core
 from .. import analysis as an
 from .. import excitations as ex
@@ -26,10 +28,8 @@ from ..identify import (
     linear_chirp,
     simulate_structure,
 )
-from ..methods import run_eft, run_rpsd
-from ..rig import Rig, copy_rig, zhao2003
+from ..rig import Rig
 from ..signals import FreeVibration, fourier_ratio, identify_free_vibration
-from ..simulate import simulate
 
 TWO_PI = 2.0 * math.pi
 _EFT = _core.EftConfig()
@@ -55,7 +55,7 @@ def lead(u: np.ndarray, T: float) -> np.ndarray:
 
 def with_effects(rig: Rig, **switches: bool) -> Rig:
     """A copy of ``rig`` with some effect switches changed."""
-    r = copy_rig(rig)
+    r = sh.copy_rig(rig)
     for name, on in switches.items():
         setattr(r.effects, name, on)
     return r
@@ -105,7 +105,7 @@ class FreeVibrationFit:
 
 def fig2b_free_vibration(rig: Rig, quick: bool = False) -> FreeVibrationFit:
     """Free vibration from 1.3 cm of the structure alone (2 ms samples, 0.05 mm noise), fitted for c and F_c."""
-    free = zhao2003(actuator_attached=False)
+    free = sh.zhao2003(actuator_attached=False)
     dt, dur = 2e-3, (6.0 if quick else 10.0)
     n = int(round(dur / dt)) + 1
     t = np.arange(n) * dt
@@ -133,7 +133,7 @@ def forced_vibration(rig: Rig, quick: bool = False) -> ForcedVibrationFit:
     rng = np.random.default_rng(2003)
     rng.standard_normal(int(round((6.0 if quick else 10.0) / 2e-3)) + 1)  # the free-vibration record's draws
     tt, u = linear_chirp(8.0 if quick else 12.0, DT, 0.3, 4.0, SWEEP_F, tail=1.0)
-    res = simulate(rig, "force", u, DT)
+    res = sh.simulate(rig, "force", u, DT)
     dec = 4  # fit at 2 ms, as the free-vibration record
     x_f = res.displacement[::dec] + NOISE_X * rng.standard_normal(res.displacement[::dec].size)
     F_f = res.force[::dec] + NOISE_F * rng.standard_normal(x_f.size)
@@ -151,7 +151,7 @@ class EquivalentDamping:
 
 def equivalent_damping(rig: Rig, zeta_free_measured: float = 0.011) -> EquivalentDamping:
     """The amplitude X is fixed by the free structure's measured 1.1 %; the attached ratio follows (Eq 8)."""
-    free = zhao2003(actuator_attached=False)
+    free = sh.zhao2003(actuator_attached=False)
     per_metre = an.damping_ratio(free, an.equivalent_viscous_damping(free, 1.0))  # zeta_eq X [m]
     X = per_metre / (zeta_free_measured - an.damping_ratio(free))
     z = an.damping_ratio(rig) + an.damping_ratio(rig, an.equivalent_viscous_damping(rig, X))
@@ -170,7 +170,7 @@ class FreeDecay:
 
 def free_decay(rig: Rig, x0: float = 0.013, duration: float = 10.0, fit: float = 4.0) -> FreeDecay:
     """Free vibration of ``rig`` from x0 [m], fitted over the first ``fit`` seconds."""
-    res = simulate(rig, mode="free", duration=duration, dt=DT, x0=x0)
+    res = sh.simulate(rig, mode="free", duration=duration, dt=DT, x0=x0)
     fv = identify_free_vibration(res.displacement, DT, duration=fit)
     return FreeDecay(res.time, res.displacement, fv.frequency, fv.damping_ratio)
 
@@ -195,7 +195,7 @@ class DirectEft:
 def fig3a_direct_eft(rig: Rig, quick: bool = False) -> DirectEft:
     lin = an.linear_analysis_rig(rig)
     t, u = linear_chirp(20.0 if quick else 40.0, DT, 0.1, 10.0, SWEEP_F, tail=2.0)
-    res = simulate(rig, "force", u, DT)
+    res = sh.simulate(rig, "force", u, DT)
     f, h, ok = frequency_response(t, u, res.force)
     band = ok & (f > 0.3) & (f < 5.0)
     ff = np.linspace(0.3, 5.0, 2000)
@@ -220,7 +220,7 @@ class ForceLoopBounds:
 def eq11_force_loop(rig: Rig) -> ForceLoopBounds:
     per_gain = an.loop_gain_force(rig) / rig.G_p  # K_v C_F K_s A-free part of Eq (9) [m^3/s per N]
     return ForceLoopBounds(rolloff_hz=an.omega_cEFT(rig) / TWO_PI,
-                           rolloff_printed_hz=an.omega_cEFT(zhao2003("printed")) / TWO_PI,
+                           rolloff_printed_hz=an.omega_cEFT(sh.zhao2003("printed")) / TWO_PI,
                            gain_for_120hz=(TWO_PI * 120.0 * rig.K_a - rig.C_l) / (rig.A * per_gain),
                            piston_mass=rig.m_p, piston_fraction=rig.m_p / (rig.m + rig.m_p))
 
@@ -269,7 +269,7 @@ class EftSweep:
 def eft_sweep(rig: Rig, amplitude: float, duration: float = SWEEP_DURATION, **kw) -> EftSweep:
     """``run_eft`` on ``excitations.sine_sweep(amplitude)`` (keywords go to run_eft)."""
     P = ex.sine_sweep(amplitude, duration=duration, dt=DT)
-    res = run_eft(rig, effective_force=P, dt=DT, raise_on_failure=False, **kw)
+    res = sh.run_eft(rig, effective_force=P, dt=DT, raise_on_failure=False, **kw)
     f, H = fourier_ratio(res.force, P, DT)
     b = (f > 0.3) & (f < 10.0)
     return EftSweep(frequency=f[b], ratio=H[b], effective_force=P, result=res)
@@ -352,7 +352,7 @@ def fig6a_amplitude_compensation(rig: Rig) -> DisplacementLoop:
     g_lin = an.G_xu(lin) * an.zoh_delay(DT)
     T_best, dev = an.amplitude_compensation_T(g_lin, (0.0, 5.0))
     return DisplacementLoop(omega_c=an.omega_cRPD(rig), g_lin=g_lin, oil_column_hz=an.omega_oil_column(rig) / TWO_PI,
-                            oil_column_printed_hz=an.omega_oil_column(zhao2003("printed")) / TWO_PI,
+                            oil_column_printed_hz=an.omega_oil_column(sh.zhao2003("printed")) / TWO_PI,
                             closed_loop_mode=an.dominant_modes(an.G_xu(lin))[-1], T_amplitude=T_best,
                             worst_deviation=dev, band_68ms=an.acceptable_band(g_lin, T_AMP, 0.05))
 
@@ -379,10 +379,10 @@ class DisplacementSweeps:
 def fig5_displacement_sweeps(rig: Rig, quick: bool = False) -> DisplacementSweeps:
     dur = 20.0 if quick else 40.0
     t, u = linear_chirp(dur, DT, 0.1, 10.0, SWEEP_X, tail=2.0)
-    res = simulate(rig, "displacement", u, DT)
+    res = sh.simulate(rig, "displacement", u, DT)
     fo = identify_first_order(t, u, res.displacement)
     t2, u2 = linear_chirp(dur * 0.6, DT, 0.1, 6.0, SWEEP_X, tail=2.0)
-    res2 = simulate(rig, "displacement", lead(u2, T_AMP), DT)
+    res2 = sh.simulate(rig, "displacement", lead(u2, T_AMP), DT)
     f2, h2, ok2 = frequency_response(t2, u2, res2.displacement)
     sel = ok2 & (f2 >= 0.2) & (f2 <= 5.0)
     g_lead = an.phase_lead(T_AMP) * an.G_xu(an.linear_analysis_rig(rig)) * an.zoh_delay(DT)
@@ -412,7 +412,7 @@ def capacity_limit(rig: Rig, quick: bool = False) -> Capacity:
         tt = np.arange(int(round(max(1.5, 8.0 / fq) / DT)) + 1) * DT
         ramp = np.clip(tt / 0.3, 0, 1)
         uu = SWEEP_X * np.sin(TWO_PI * fq * tt) * (0.5 - 0.5 * np.cos(math.pi * ramp))
-        rr = simulate(rig, "displacement", lead(uu, T_AMP), DT, raise_on_failure=False)
+        rr = sh.simulate(rig, "displacement", lead(uu, T_AMP), DT, raise_on_failure=False)
         if rr.supply_limited or rr.capacity_exceeded:
             return Capacity(freqs, float(fq), float(np.max(np.abs(rr.force))), rig.p_s * rig.A)
     return Capacity(freqs, None, 0.0, rig.p_s * rig.A)
@@ -458,7 +458,7 @@ def fig6b_gain_bound(rig: Rig, quick: bool = False) -> GainBound:
                      gain_static_valve=an.max_p_gain_curve(lin, masses, False),
                      eigen_confirmed=all(routh_matches_eigenvalues(lin, m)
                                          for m in (masses[0], masses[len(masses) // 2], masses[-1])),
-                     gain_used=rig.G_p, gain_printed=an.max_p_gain(zhao2003("printed")), locus_gains=gains,
+                     gain_used=rig.G_p, gain_printed=an.max_p_gain(sh.zhao2003("printed")), locus_gains=gains,
                      locus_poles=an.root_locus_gains(lin, gains), bode=bode)
 
 
@@ -528,7 +528,7 @@ class RpsdRelease:
 def rpsd_release(rig: Rig, release: Release = Release(), **kw) -> RpsdRelease:
     """``run_rpsd`` on the ramp-and-release external force from 1.6 cm (keywords go to run_rpsd)."""
     kw = {"m_m": M_M, "c_m": C_M, **kw}
-    res = run_rpsd(rig, external_force=release.force(rig), dt=DT, raise_on_failure=False, **kw)
+    res = sh.run_rpsd(rig, external_force=release.force(rig), dt=DT, raise_on_failure=False, **kw)
     return RpsdRelease(res, identify_free_vibration(res.calc_displacement, DT, start=release.index,
                                                     duration=release.fit))
 
@@ -672,7 +672,7 @@ class RpsdSweeps:
 def fig8_rpsd_delay(rig: Rig) -> RpsdSweeps:
     ag = ex.sine_sweep(ex.SWEEP_GROUND_ACCELERATION, duration=SWEEP_DURATION, dt=DT)
     ts = np.arange(ag.size) * DT
-    sw = {T: run_rpsd(rig, ground_acceleration=ag, dt=DT, m_m=M_M, c_m=C_M, delay_T=T, raise_on_failure=False)
+    sw = {T: sh.run_rpsd(rig, ground_acceleration=ag, dt=DT, m_m=M_M, c_m=C_M, delay_T=T, raise_on_failure=False)
           for T in (0.006, 0.016)}
     x_exact = ct.forced_response(ct.tf([1.0], [M_M, C_M, rig.k]), ts, -M_M * ag).outputs
     v_exact = np.gradient(x_exact, DT)
@@ -698,8 +698,27 @@ class Table1:
 
 
 def table1(rig: Rig) -> Table1:
-    printed = zhao2003("printed")
+    printed = sh.zhao2003("printed")
     re = [float(np.max(np.real(an.G_xu(an.linear_analysis_rig(r)).poles()))) for r in (rig, printed)]
     return Table1(max_real_pole_calibrated=re[0], max_real_pole_printed=re[1],
                   oil_volume_printed=4.0 * printed.K_a * 1.0e9 * 1e3, oil_volume_calibrated=4 * rig.K_a * 0.69e9 * 1e3,
                   swept_volume=rig.A * 0.254 * 1e3)
+
+
+# --------------------------------------------------------------------------- 1.27 cm tracking sweep
+@dataclass(frozen=True)
+class TrackingSweep:
+    """``run_tracking`` (68 ms lead) on the 1.27 cm 0-10 Hz sweep: where the supply or capacity limit is hit."""
+
+    result: object
+    first_limit_time: float | None  #: [s]
+    first_limit_frequency: float | None  #: instantaneous sweep frequency then [Hz]
+
+
+def tracking_sweep(rig: Rig, duration: float = SWEEP_DURATION) -> TrackingSweep:
+    res = sh.run_tracking(rig, ex.sine_sweep(SWEEP_X, duration=duration, dt=DT), DT)
+    hit = np.flatnonzero(res.flags & (_core.FLAG_SUPPLY_LIMITED | _core.FLAG_CAPACITY_EXCEEDED))
+    if not hit.size:
+        return TrackingSweep(res, None, None)
+    t = float(res.time[hit[0]])
+    return TrackingSweep(res, t, float(ex.sweep_frequency(t, duration=duration)))
