@@ -7,6 +7,11 @@ side by side, re-derives the calibrated values from the paper's reported
 behaviour, and writes every number to ``DIR/calibration.json`` and a Bode plot
 to ``DIR/calibration_bode.png``.
 
+The transfer functions and bounds are the library's (``servohydraulics.analysis``:
+Eq (12) ``G_xu``, Routh ``max_p_gain``, ``amplitude_compensation_T``, ...) on the
+presets ``zhao2003("printed")`` and ``zhao2003()`` with friction off and the
+7084 kg as the whole moving mass, as in the paper's linear analysis.
+
 Usage::
 
     python scripts/calibration_table1.py --out DIR
@@ -24,94 +29,59 @@ import math
 import sys
 import time
 import warnings
-from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import control as ct
-import matplotlib
 import numpy as np
+from matplotlib.figure import Figure
 from scipy.optimize import brentq, minimize_scalar
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import servohydraulics as sh
+from servohydraulics import analysis as an
+from servohydraulics.paper import experiments as xp
 
 TWO_PI = 2.0 * math.pi
-ALPHA = 0.1  # constant of every phase-lead network (Table I)
-T_AMP = 0.068  # amplitude-compensation time constant used in the paper [s]
-T_EFT = 0.005  # EFT velocity-feedback phase-lead time constant [s]
-T_LD = 0.0112  # delay-compensation time constant used in the paper [s]
+ALPHA = xp.ALPHA  # constant of every phase-lead network (Table I)
+T_AMP = xp.T_AMP  # amplitude-compensation time constant used in the paper [s]
+T_EFT = xp.T_EFT  # EFT velocity-feedback phase-lead time constant [s]
+T_LD = xp.T_LD  # delay-compensation time constant used in the paper [s]
+DT = xp.DT  # digital controller sample time [s] (2 kHz)
 F_BAND = 5.0  # upper edge of the band "acceptable" with T = 68 ms (Fig 6a) [Hz]
 F_N = 1.58  # natural frequency of the test structure [Hz]
-C_M = 3.5e3  # modelled damping of the RPsD solver [N s/m] (Table I)
+C_M = xp.C_M  # modelled damping of the RPsD solver [N s/m] (Table I)
 MASSES = (54.0, 140.0, 500.0, 1000.0, 3000.0, 7084.0)  # Fig 6b sweep [kg]
 GAIN_MARGIN_TARGET = 2.0  # Ziegler-Nichols P tuning: G_p = G_p,max / 2 [-]
 TAU_VALVE = (1.0 - ALPHA) * T_EFT  # valve low-frequency group delay [s]
+#: the parameters this study varies and reports
+PARAMETERS = ("A", "K_v", "K_s", "C_F_disp", "C_F_force", "G_p", "m", "c", "k", "K_a", "C_l", "f_v", "zeta_v")
 
 
-@dataclass(frozen=True)
-class Rig:
-    """Linear-analysis parameters of the rig (Eqs 1-8, 12).  SI units."""
-
-    A: float = 82.1e-4  # piston area [m^2]
-    K_v: float = 1.6e-2  # null flow gain [m^3/s per unit opening]
-    K_s: float = 0.1  # static valve gain [1/V]
-    C_F: float = 78.74  # conversion factor, displacement control [V/m]
-    C_F_force: float = 0.056e-3  # conversion factor, force control [V/N]
-    G_p: float = 0.8059  # proportional gain [-]
-    m: float = 7084.0  # moving mass [kg]
-    c: float = 2.1e3  # viscous damping, actuator attached [N s/m]
-    k: float = 700.8e3  # stiffness [N/m]
-    K_a: float = 1.36e-12  # compressibility coefficient V_t/(4 beta_e) [m^5/N]
-    C_l: float = 3.4e-11  # total flow-pressure coefficient [m^3/(s Pa)]
-    f_v: float = 70.7  # valve natural frequency [Hz]: 2 zeta_v/(2 pi f_v) = 4.5 ms
-    zeta_v: float = 1.0  # valve damping ratio [-]
-    dt: float = 0.5e-3  # digital controller sample time [s] (2 kHz)
-
-    @property
-    def loop_gain(self) -> float:
-        """A K_v C_F K_s G_p of Eq (12) [m^3/(s m)] = [m^2/s]."""
-        return self.A * self.K_v * self.C_F * self.K_s * self.G_p
+def linear_rig(rig: sh.Rig) -> sh.Rig:
+    """The linear-analysis rig of this study: friction off and the 7084 kg as the whole moving mass
+    (piston-mass effect off), as in the paper's Eq (12)."""
+    return an.rig_with_mass(an.linear_analysis_rig(rig), rig.m)
 
 
-PRINTED = Rig(K_a=3e-12, C_l=1e-12)  # Table I as printed, in SI
-CALIBRATED = Rig()  # docs/calibration.md
+def replace(rig: sh.Rig, **values: float) -> sh.Rig:
+    """A copy of ``rig`` with some parameters changed."""
+    r = sh.copy_rig(rig)
+    for name, v in values.items():
+        setattr(r, name, float(v))
+    return r
 
 
-def valve(rig: Rig) -> ct.TransferFunction:
-    """Servovalve second order of Eq (2), unit static gain: w^2/(s^2+2 zeta w s+w^2)."""
-    w = TWO_PI * rig.f_v
-    return ct.tf([w * w], [1.0, 2.0 * rig.zeta_v * w, w * w])
+PRINTED = linear_rig(sh.zhao2003("printed"))  # Table I as printed, in SI
+CALIBRATED = linear_rig(sh.zhao2003())  # docs/calibration.md
 
 
-def zoh(rig: Rig) -> ct.TransferFunction:
-    """Half-sample delay of the zero-order hold, 3rd-order Pade [-]."""
-    num, den = ct.pade(rig.dt / 2.0, 3)
-    return ct.tf(num, den)
+def parameters(rig: sh.Rig) -> dict[str, float]:
+    return {name: getattr(rig, name) for name in PARAMETERS}
 
 
-def lead(T: float, alpha: float = ALPHA) -> ct.TransferFunction:
-    """Phase-lead network (T s + 1)/(alpha T s + 1), T in s."""
-    return ct.tf([T, 1.0], [alpha * T, 1.0])
-
-
-def open_loop(rig: Rig, with_valve: bool = True) -> ct.TransferFunction:
-    """Loop transfer u - x -> x of Fig 1(b) [-]; Eq (12) is its unity feedback."""
-    s = ct.tf("s")
-    structure = rig.m * s**2 + rig.c * s + rig.k
-    plant = rig.A / ((rig.K_a * s + rig.C_l) * structure + rig.A**2 * s)  # x/Q [s/m^2]
-    loop = rig.C_F * rig.G_p * rig.K_s * rig.K_v * plant
-    return loop * valve(rig) if with_valve else loop
-
-
-def g_xu(rig: Rig, with_valve: bool = True) -> ct.TransferFunction:
-    """Closed-loop displacement transfer x/u, Eq (12) (optionally with the valve) [-]."""
-    return ct.feedback(open_loop(rig, with_valve), 1)
-
-
-def compensated(rig: Rig, T: float, with_valve: bool = True) -> ct.TransferFunction:
-    """Amplitude-compensated response lead(T) * ZOH * G_xu [-]."""
-    return lead(T) * zoh(rig) * g_xu(rig, with_valve)
+def compensated(rig: sh.Rig, T: float, with_valve: bool = True) -> ct.TransferFunction:
+    """Amplitude-compensated response lead(T) * ZOH * G_xu, Eq (12) [-]."""
+    return an.phase_lead(T) * an.zoh_delay(DT) * an.G_xu(rig, with_valve)
 
 
 def freq_resp(sys_: ct.TransferFunction, f: np.ndarray) -> np.ndarray:
@@ -134,72 +104,55 @@ def oil_column_mode(sys_: ct.TransferFunction) -> tuple[float, float]:
 F_GRID = np.linspace(0.02, F_BAND, 250)
 
 
-def max_deviation(rig: Rig, T: float, with_valve: bool = True) -> float:
+def max_deviation(rig: sh.Rig, T: float, with_valve: bool = True) -> float:
     """max over 0-5 Hz of | |lead(T) ZOH G_xu| - 1 | [-] (magnitude only)."""
     h = freq_resp(compensated(rig, T, with_valve), F_GRID)
     return float(np.max(np.abs(np.abs(h) - 1.0)))
 
 
-def best_T(rig: Rig, with_valve: bool = True) -> tuple[float, float]:
-    """Minimax amplitude-compensation time constant over 0-5 Hz: (T [s], deviation [-])."""
-    g = freq_resp(g_xu(rig, with_valve) * zoh(rig), F_GRID)
-    w = TWO_PI * F_GRID
-
-    def dev(T: float) -> float:
-        mag_lead = np.sqrt((1.0 + (w * T) ** 2) / (1.0 + (ALPHA * w * T) ** 2))
-        return float(np.max(np.abs(mag_lead * np.abs(g) - 1.0)))
-
-    res = minimize_scalar(dev, bounds=(0.02, 0.15), method="bounded", options={"xatol": 1e-6})
-    return float(res.x), float(res.fun)
+def best_T(rig: sh.Rig, with_valve: bool = True) -> tuple[float, float]:
+    """Minimax amplitude-compensation time constant over 0-5 Hz (Fig 6a): (T [s], deviation [-])."""
+    return an.amplitude_compensation_T(an.G_xu(rig, with_valve) * an.zoh_delay(DT), (0.0, F_BAND),
+                                       bounds=(0.02, 0.15))
 
 
-def max_gain(rig: Rig, mass: float | None = None, with_valve: bool = True) -> float:
-    """Largest stable G_p (Routh limit) at the given physical mass [kg], via the gain margin."""
-    r = replace(rig, m=rig.m if mass is None else mass, G_p=1.0)
-    gm = float(ct.stability_margins(open_loop(r, with_valve))[0])
-    # Cross-check with the closed-loop poles just below and above the limit.
-    below = is_stable(ct.feedback(open_loop(replace(r, G_p=0.999 * gm), with_valve), 1))
-    above = is_stable(ct.feedback(open_loop(replace(r, G_p=1.001 * gm), with_valve), 1))
-    if not (below and not above):
-        raise RuntimeError(f"gain margin {gm} not confirmed by the closed-loop poles")
-    return gm
+def max_gain(rig: sh.Rig, mass: float | None = None, with_valve: bool = True) -> float:
+    """Largest stable G_p (Routh) at the given physical mass [kg] (default the rig's)."""
+    return an.max_p_gain(rig, mass, with_valve)
 
 
 def equivalent_delay_ms(sys_: ct.TransferFunction, f: float) -> float:
     """Phase lag expressed as a delay, -angle(H(j w))/w, at f [Hz] -> [ms]."""
-    w = TWO_PI * f
-    return float(-np.angle(freq_resp(sys_, np.array([f]))[0]) / w * 1e3)
+    return 1e3 * an.equivalent_delay(sys_, f)
 
 
 def group_delay_ms(sys_: ct.TransferFunction, f: float = 0.01) -> float:
-    """Low-frequency group delay -d(phase)/dw, central difference at f [Hz] -> [ms]."""
-    df = 1e-4 * f
-    ph = np.unwrap(np.angle(freq_resp(sys_, np.array([f - df, f + df]))))
-    return float(-(ph[1] - ph[0]) / (TWO_PI * 2.0 * df) * 1e3)
+    """Low-frequency group delay -d(phase)/dw at f [Hz] -> [ms]."""
+    return 1e3 * an.group_delay(sys_, f)
 
 
-def rpsd_damping(rig: Rig, T_ld: float) -> float:
+def rpsd_damping(rig: sh.Rig, T_ld: float) -> float:
     """Damping ratio of the RPsD loop of Fig 7(a) at 1.58 Hz with delay compensation T_ld [-].
 
     The solver's restoring force k x_meas = k H x with H = lead(T_ld) lead(68 ms)
     ZOH G_xu; its quadrature part acts as damping -k Im(H)/w, so the net ratio
     is c_m/(2 sqrt(k m)) - |H| sin(phase lag)/2 at w = sqrt(k/m).
     """
-    h = compensated(rig, T_AMP) * (lead(T_ld) if T_ld > 0 else 1)
+    h = compensated(rig, T_AMP) * (an.phase_lead(T_ld) if T_ld > 0 else 1)
     w = math.sqrt(rig.k / rig.m)
     hv = freq_resp(h, np.array([w / TWO_PI]))[0]
     zeta_m = C_M / (2.0 * math.sqrt(rig.k * rig.m))
     return float(zeta_m + np.imag(hv) / 2.0)
 
 
-def eft_valve_check(rig: Rig) -> dict[str, Any]:
+def eft_valve_check(rig: sh.Rig) -> dict[str, Any]:
     """Valve phase vs the 5 ms EFT phase lead: equivalent delays [ms], net phase [deg]."""
     fs = [1.0, F_N, 5.0, 10.0]
-    v, net = valve(rig), lead(T_EFT) * valve(rig)
+    v, net = an.servovalve(rig), an.phase_lead(T_EFT) * an.servovalve(rig)
     return {
         "f_Hz": fs,
         "valve_delay_ms": [equivalent_delay_ms(v, f) for f in fs],
-        "lead_advance_ms": [-equivalent_delay_ms(lead(T_EFT), f) for f in fs],
+        "lead_advance_ms": [-equivalent_delay_ms(an.phase_lead(T_EFT), f) for f in fs],
         "net_phase_deg": [float(np.degrees(np.angle(freq_resp(net, np.array([f]))[0]))) for f in fs],
         "valve_group_delay_ms": group_delay_ms(v),
         "valve_f_3dB_Hz": float(ct.bandwidth(v) / TWO_PI),
@@ -207,16 +160,16 @@ def eft_valve_check(rig: Rig) -> dict[str, Any]:
     }
 
 
-def evaluate(rig: Rig) -> dict[str, Any]:
+def evaluate(rig: sh.Rig) -> dict[str, Any]:
     """Every validation number of docs/calibration.md for one preset."""
-    out: dict[str, Any] = {"parameters": asdict(rig)}
-    w_c = rig.K_v * rig.C_F * rig.K_s * rig.G_p / rig.A  # Eq (13) [rad/s]
+    out: dict[str, Any] = {"parameters": parameters(rig)}
+    w_c = an.omega_cRPD(rig)  # Eq (13) [rad/s]
     out["omega_cRPD_Hz"] = w_c / TWO_PI
     out["inv_omega_cRPD_ms"] = 1e3 / w_c
-    out["eq14_oil_column_Hz"] = math.sqrt(rig.A**2 / (rig.m * rig.K_a)) / TWO_PI
-    out["static_gain_loss"] = rig.C_l * rig.k / (rig.C_l * rig.k + rig.loop_gain)
+    out["eq14_oil_column_Hz"] = an.omega_oil_column(rig) / TWO_PI
+    out["static_gain_loss"] = static_gain_loss(rig)
     for tag, wv in (("no_valve", False), ("valve", True)):
-        g = g_xu(rig, wv)
+        g = an.G_xu(rig, wv)
         f_oc, z_oc = oil_column_mode(g)
         T, dev = best_T(rig, wv)
         d = {
@@ -232,7 +185,7 @@ def evaluate(rig: Rig) -> dict[str, Any]:
                 f"{f:g}Hz": float(abs(freq_resp(compensated(rig, T_AMP, wv), np.array([f]))[0]))
                 for f in (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0)
             },
-            "group_delay_G_ms": group_delay_ms(g * zoh(rig)),
+            "group_delay_G_ms": group_delay_ms(g * an.zoh_delay(DT)),
             "remaining_group_delay_T68_ms": group_delay_ms(compensated(rig, T_AMP, wv)),
             "remaining_delay_T68_at_1p58Hz_ms": equivalent_delay_ms(compensated(rig, T_AMP, wv), F_N),
             "Gp_max": {f"{mass:g}kg": max_gain(rig, mass, wv) for mass in MASSES},
@@ -243,19 +196,24 @@ def evaluate(rig: Rig) -> dict[str, Any]:
     out["rpsd_zeta"] = {f"T_ld={T * 1e3:g}ms": rpsd_damping(rig, T) for T in (0.0, 0.006, T_LD, 0.016)}
     out["rpsd_zeta_model_only"] = C_M / (2.0 * math.sqrt(rig.k * rig.m))
     # Eq (11), force control: with the printed G_p, and the G_p needed for 120 Hz.
-    kf = rig.A * rig.K_v * rig.C_F_force * rig.K_s
-    out["eq11_force_rolloff_Hz"] = (rig.C_l + kf * rig.G_p) / rig.K_a / TWO_PI
-    out["eq11_Gp_needed_for_120Hz"] = (TWO_PI * 120.0 * rig.K_a - rig.C_l) / kf
+    eq11 = xp.eq11_force_loop(rig)
+    out["eq11_force_rolloff_Hz"] = eq11.rolloff_hz
+    out["eq11_Gp_needed_for_120Hz"] = eq11.gain_for_120hz
     out["eft_valve"] = eft_valve_check(rig)
     return out
 
 
-def solve_K_a_for_T(C_l: float, rig: Rig, T: float = T_AMP) -> float:
+def static_gain_loss(rig: sh.Rig) -> float:
+    """Static loss of the displacement loop to the leakage, C_l k / (C_l k + A K_v C_F K_s G_p) [-]."""
+    return rig.C_l * rig.k / (rig.C_l * rig.k + rig.A * an.loop_gain_displacement(rig))
+
+
+def solve_K_a_for_T(C_l: float, rig: sh.Rig, T: float = T_AMP) -> float:
     """K_a [m^5/N] at which the minimax-best amplitude-compensation constant equals T [s]."""
     return float(brentq(lambda ka: best_T(replace(rig, K_a=ka, C_l=C_l))[0] - T, 3e-13, 3e-12, xtol=1e-17))
 
 
-def calibrate(rig: Rig) -> tuple[float, float]:
+def calibrate(rig: sh.Rig) -> tuple[float, float]:
     """(K_a, C_l) such that best T = 68 ms and G_p,max(7084 kg) = 2 G_p (valve included)."""
 
     def gm_err(C_l: float) -> float:
@@ -266,7 +224,7 @@ def calibrate(rig: Rig) -> tuple[float, float]:
     return solve_K_a_for_T(C_l, rig), C_l
 
 
-def valve_variants() -> dict[str, Rig]:
+def valve_variants() -> dict[str, sh.Rig]:
     """Alternative readings of "highly damped, rolls off at approximately 30 Hz"."""
     w3 = TWO_PI * 30.0
     crit_3db = w3 / math.sqrt(math.sqrt(2.0) - 1.0)  # zeta = 1: -3 dB at 0.6436 w_n
@@ -279,14 +237,14 @@ def valve_variants() -> dict[str, Rig]:
     }
 
 
-def solve_C_l_for_gain_margin(rig: Rig, target: float = GAIN_MARGIN_TARGET) -> float:
+def solve_C_l_for_gain_margin(rig: sh.Rig, target: float = GAIN_MARGIN_TARGET) -> float:
     """C_l [m^3/(s Pa)] at which G_p,max(7084 kg) = target * G_p for the rig's K_a."""
     return float(
         brentq(lambda cl: max_gain(replace(rig, C_l=cl)) / rig.G_p - target, 1e-12, 1e-9, xtol=1e-15)
     )
 
 
-def min_best_T_over_C_l(rig: Rig) -> dict[str, float]:
+def min_best_T_over_C_l(rig: sh.Rig) -> dict[str, float]:
     """Smallest achievable minimax-best T [ms] over stable C_l, at the rig's K_a."""
     cl_min = solve_C_l_for_gain_margin(rig, 1.01)
     res = minimize_scalar(
@@ -295,7 +253,7 @@ def min_best_T_over_C_l(rig: Rig) -> dict[str, float]:
     return {"C_l": float(10.0**res.x), "best_T_ms": float(res.fun) * 1e3, "C_l_stability_limit": cl_min}
 
 
-def alternatives() -> dict[str, Rig]:
+def alternatives() -> dict[str, sh.Rig]:
     """Candidate explanations evaluated and rejected in docs/calibration.md."""
     printed_ka = replace(CALIBRATED, K_a=3e-12)
     return {
@@ -309,12 +267,11 @@ def alternatives() -> dict[str, Rig]:
     }
 
 
-def summarize(rig: Rig) -> dict[str, Any]:
+def summarize(rig: sh.Rig) -> dict[str, Any]:
     """The handful of numbers that discriminate the candidates."""
-    g = g_xu(rig)
+    g = an.G_xu(rig, True)
     f_oc, z_oc = oil_column_mode(g)
     T, dev = best_T(rig)
-    kf = rig.A * rig.K_v * rig.C_F_force * rig.K_s
     return {
         "K_a": rig.K_a,
         "C_l": rig.C_l,
@@ -327,8 +284,8 @@ def summarize(rig: Rig) -> dict[str, Any]:
         "best_T_max_dev": dev,
         "max_dev_T68": max_deviation(rig, T_AMP),
         "Gp_max_7084kg": max_gain(rig),
-        "static_gain_loss": rig.C_l * rig.k / (rig.C_l * rig.k + rig.loop_gain),
-        "eq11_force_rolloff_Hz": (rig.C_l + kf * rig.G_p) / rig.K_a / TWO_PI,
+        "static_gain_loss": static_gain_loss(rig),
+        "eq11_force_rolloff_Hz": an.omega_cEFT(rig) / TWO_PI,
     }
 
 
@@ -336,12 +293,13 @@ def plot(path: Path) -> None:
     """Printed vs calibrated |G_xu| and compensated (T = 68 ms) response, 0.1-20 Hz."""
     f = np.logspace(-1, np.log10(20.0), 600)
     w = TWO_PI * f
-    fig, (ax_m, ax_p) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
-    first = ct.tf([1.0], [1.0 / (CALIBRATED.loop_gain / CALIBRATED.A**2), 1.0])
+    fig = Figure(figsize=(8, 7))
+    ax_m, ax_p = fig.subplots(2, 1, sharex=True)
+    first = ct.tf([1.0], [1.0 / an.omega_cRPD(CALIBRATED), 1.0])
     curves = [
-        ("printed $G_{xu}$ (unstable; |.| of mirror)", g_xu(PRINTED, False), "C3", "--"),
+        ("printed $G_{xu}$ (unstable; |.| of mirror)", an.G_xu(PRINTED, False), "C3", "--"),
         ("printed, lead 68 ms", compensated(PRINTED, T_AMP, False), "C3", "-"),
-        ("calibrated $G_{xu}$ (valve + ZOH)", g_xu(CALIBRATED) * zoh(CALIBRATED), "C0", "--"),
+        ("calibrated $G_{xu}$ (valve + ZOH)", an.G_xu(CALIBRATED, True) * an.zoh_delay(DT), "C0", "--"),
         ("calibrated, lead 68 ms", compensated(CALIBRATED, T_AMP), "C0", "-"),
         ("first order, Eq (13)", first, "0.5", ":"),
     ]
@@ -363,7 +321,6 @@ def plot(path: Path) -> None:
         ax.grid(True, which="both", lw=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
-    plt.close(fig)
 
 
 def main(argv: list[str] | None = None) -> int:
