@@ -36,11 +36,13 @@ def _plot(rig, fd: xp.FreeDecay, s: xp.DisplacementSweeps, w_c: float, d: xp.Dir
     ff = np.linspace(0.01, 10.0, 200)
     ax[0, 1].plot(ff, 1 / np.sqrt(1 + (2 * np.pi * ff / w_c) ** 2), "--",
                   label=f"first order, Eq (13): {w_c / 2 / np.pi:.2f} Hz")
-    ax[0, 1].set(xlabel="frequency [Hz]", ylabel="|x / u|", title="Displacement control, 12.7 mm sweep, no compensation")
+    ax[0, 1].set(xlabel="frequency [Hz]", ylabel="|x / u|",
+                 title="Displacement control, 12.7 mm sweep, no compensation")
     sel = d.excited & (d.frequency > 0.1) & (d.frequency < 10.0)
     ax[1, 0].plot(d.frequency[sel], np.abs(d.response[sel]))
     ax[1, 0].axvline(fd.frequency, color="gray", ls=":", label=f"structure f_n = {fd.frequency:.2f} Hz")
-    ax[1, 0].set(xlabel="frequency [Hz]", ylabel="|F / u|", title="Force control, 2.3 kN sweep, no compensation (Fig 3a)")
+    ax[1, 0].set(xlabel="frequency [Hz]", ylabel="|F / u|",
+                 title="Force control, 2.3 kN sweep, no compensation (Fig 3a)")
     fe, peak = _force_envelope(s)
     ax[1, 1].plot(fe, peak / 1e3, "o-", ms=3, label="peak load-cell force")
     ax[1, 1].axhline(rig.F_cap / 1e3, color="r", ls="--", label="rated capacity 170 kN")

@@ -83,7 +83,8 @@ def natural_frequency(r) -> Measured:
 
 def zeta_free(r) -> Measured:
     fv = r["fig2b_free_vibration"]
-    return _identified(fv.estimate, "zeta", "%", 100.0, 0.1, 100 * fv.zeta_table, zeta=100 * fv.zeta_table, c=fv.c_table)
+    z = 100 * fv.zeta_table
+    return _identified(fv.estimate, "zeta", "%", 100.0, 0.1, z, zeta=z, c=fv.c_table)
 
 
 def friction_free(r) -> Measured:
@@ -97,7 +98,8 @@ def crossing_frequency(r) -> Measured:
 
 def zeta_attached(r) -> Measured:
     fv = r["forced_vibration"]
-    return _identified(fv.estimate, "zeta", "%", 100.0, 0.2, 100 * fv.zeta_table, zeta=100 * fv.zeta_table, c=fv.c_table)
+    z = 100 * fv.zeta_table
+    return _identified(fv.estimate, "zeta", "%", 100.0, 0.2, z, zeta=z, c=fv.c_table)
 
 
 def friction_attached(r) -> Measured:
@@ -106,7 +108,8 @@ def friction_attached(r) -> Measured:
 
 def equivalent_damping(r) -> Measured:
     e = r["equivalent_damping"]
-    return Measured(100 * e.zeta_attached, f"1.1 % -> {100 * e.zeta_attached:.2f} % (at X = {1e3 * e.amplitude:.1f} mm)")
+    z = 100 * e.zeta_attached
+    return Measured(z, f"1.1 % -> {z:.2f} % (at X = {1e3 * e.amplitude:.1f} mm)")
 
 
 # --------------------------------------------------------------------------- force control (Figs 3a, 4a, Eq 11)

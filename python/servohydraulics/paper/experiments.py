@@ -113,7 +113,8 @@ def fig2b_free_vibration(rig: Rig, quick: bool = False) -> FreeVibrationFit:
     x_meas = x_true + NOISE_X * np.random.default_rng(2003).standard_normal(n)
     est = identify_damping_friction(t, x_meas, free)
     up = np.flatnonzero((x_true[:-1] < 0) & (x_true[1:] >= 0))
-    return FreeVibrationFit(natural_frequency=an.natural_frequency(rig) / TWO_PI, zeta_table=an.damping_ratio(free), c_table=free.c,
+    return FreeVibrationFit(natural_frequency=an.natural_frequency(rig) / TWO_PI, zeta_table=an.damping_ratio(free),
+                            c_table=free.c,
                             time=t, x_true=x_true, x_meas=x_meas, estimate=est,
                             crossing_frequency=1.0 / float(np.mean(np.diff(t[up]))))
 
