@@ -154,8 +154,9 @@ DISPLACEMENT = (
           "overshoot", paper_text="slight overshoot", tolerance_text="1.00-1.10", interval=(1.0, 1.10),
           why="the linear model overshoots ({linear:.3f}); in the nonlinear simulation the spool opens to "
               "{spool:.0f} % and |p| reaches {pressure:.0f} % of p_s below 5 Hz, where the flow gain (Fig 4a "
-              "curve: linear to 10 %, 0.56 at full opening) and the load-pressure term of Eq (3) lower the gain: the mechanism the paper "
-              "describes in its nonlinearity section; the flow curve is a modelling choice, not a measured one",
+              "curve: linear to 10 %, 0.56 at full opening) and the load-pressure term of Eq (3) lower the gain: "
+              "the mechanism the paper describes in its nonlinearity section; the flow curve is a modelling choice, "
+              "not a measured one",
           value=ev.overshoot_5b),
     Claim(key="capacity", figure="5b", statement="required forces exceed the actuator capacity above 6 Hz (1.27 cm, "
           "68 ms compensation)", paper_text="above 6 Hz", paper_value=6.0,
