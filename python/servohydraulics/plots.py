@@ -1,5 +1,6 @@
-"""Matplotlib helpers (Agg backend) for the analysis figures: Bode plots,
-pole-zero maps, root loci and the note that every reproduced figure carries.
+"""Matplotlib helpers for the analysis figures: Bode plots, pole-zero maps,
+root loci and the note that every reproduced figure carries.  Figures are
+``matplotlib.figure.Figure`` objects saved with ``fig.savefig`` (no pyplot state).
 
 Axes are labelled with units; where the paper plots kN, mm or Hz the label says so.
 """
@@ -8,12 +9,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import control as ct  # noqa: E402
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import control as ct
+import numpy as np
+from matplotlib.figure import Figure
 
 TWO_PI = 2.0 * np.pi
 NOTE = ("Simulated counterpart. The paper's measured curves are not available: "
@@ -22,17 +20,17 @@ NOTE = ("Simulated counterpart. The paper's measured curves are not available: "
 
 def new_figure(title: str, nrows: int = 1, ncols: int = 1, figsize=(8.0, 5.0), **kw):
     """Figure with the paper-figure title and the 'measured curves not available' note."""
-    fig, axes = plt.subplots(nrows, ncols, figsize=figsize, squeeze=False, **kw)
+    fig = Figure(figsize=figsize)
+    axes = fig.subplots(nrows, ncols, squeeze=False, **kw)
     fig.suptitle(title, fontsize=11)
     fig.text(0.5, 0.005, NOTE, ha="center", va="bottom", fontsize=7, color="0.35", wrap=True)
     return fig, axes
 
 
 def save(fig, path: Path) -> Path:
-    """Tight layout (room for the note), save as PNG at 110 dpi, close."""
+    """Tight layout (room for the note), save as PNG at 110 dpi."""
     fig.tight_layout(rect=(0, 0.04, 1, 0.96))
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return Path(path)
 
 
@@ -68,7 +66,7 @@ def root_locus(ax, poles: np.ndarray, gains: np.ndarray, marks: dict[str, float]
     """Closed-loop poles (rows of ``poles``, one per gain) coloured by log gain."""
     g = np.repeat(np.log10(gains), poles.shape[1])
     sc = ax.scatter(poles.real.ravel(), poles.imag.ravel(), c=g, s=4, cmap="viridis")
-    cb = plt.colorbar(sc, ax=ax)
+    cb = ax.figure.colorbar(sc, ax=ax)
     cb.set_label("log10 G_p [-]")
     ax.axvline(0.0, color="k", lw=0.6)
     ax.set_xlabel("real part [rad/s]")

@@ -12,26 +12,11 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from .. import analysis as an
-from ..plots import NOTE, bode, pole_zero
+from ..plots import bode, new_figure, pole_zero, save
+from ..plots import root_locus as plot_root_locus
 from . import experiments as xp
 
 TWO_PI = 2.0 * np.pi
-
-
-def new_figure(title: str, nrows: int = 1, ncols: int = 1, figsize=(8.0, 5.0), **kw):
-    """Figure with the paper-figure title and the 'measured curves not available' note."""
-    fig = Figure(figsize=figsize)
-    axes = fig.subplots(nrows, ncols, squeeze=False, **kw)
-    fig.suptitle(title, fontsize=11)
-    fig.text(0.5, 0.005, NOTE, ha="center", va="bottom", fontsize=7, color="0.35", wrap=True)
-    return fig, axes
-
-
-def save(fig: Figure, path: Path) -> Path:
-    """Tight layout (room for the note), PNG at 110 dpi."""
-    fig.tight_layout(rect=(0, 0.04, 1, 0.96))
-    fig.savefig(path, dpi=110)
-    return Path(path)
 
 
 def _finish(axes, fontsize: int = 8, legend: bool = True, **grid) -> None:
@@ -211,19 +196,9 @@ def fig6b(g: xp.GainBound) -> Figure:
 
 def root_locus(g: xp.GainBound) -> Figure:
     fig, ax = new_figure("Root locus of the displacement loop over G_p (valve on, 7138 kg)")
-    ax = ax[0, 0]
-    p = g.locus_poles
-    sc = ax.scatter(p.real.ravel(), p.imag.ravel(), c=np.repeat(np.log10(g.locus_gains), p.shape[1]), s=4,
-                    cmap="viridis")
-    fig.colorbar(sc, ax=ax).set_label("log10 G_p [-]")
-    ax.axvline(0.0, color="k", lw=0.6)
-    ax.set_xlabel("real part [rad/s]")
-    ax.set_ylabel("imaginary part [rad/s]")
-    for label, value in (("G_p,max", g.gain_valve[-1]), ("G_p used", g.gain_used)):
-        ax.plot([], [], " ", label=f"{label} = {value:.3g}")
-    ax.set_xlim(-120, 40)
-    ax.set_ylim(-150, 150)
-    _finish(ax, fontsize=7)
+    plot_root_locus(ax[0, 0], g.locus_poles, g.locus_gains, {"G_p,max": g.gain_valve[-1], "G_p used": g.gain_used})
+    ax[0, 0].set_xlim(-120, 40)
+    ax[0, 0].set_ylim(-150, 150)
     return fig
 
 
