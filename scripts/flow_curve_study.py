@@ -8,12 +8,10 @@ to 1.6 cm at T_ld = 6 / 11.2 / 16 ms (Fig 8).  About 1 minute.
     python scripts/flow_curve_study.py
 """
 
-
 import servohydraulics as sh
-from servohydraulics import excitations as ex
-from servohydraulics.identify import fourier_ratio, identify_free_vibration
+from servohydraulics.paper import experiments as xp
 
-DT = ex.DT  # the core's controller sample time (0.5 ms)
+RELEASE = xp.Release(free=4.0, fit=4.0)  # ramp 5 s, hold 1 s, 4 s of free vibration fitted
 
 
 def rig_with(curve: dict):
@@ -21,18 +19,13 @@ def rig_with(curve: dict):
 
 
 def frf_min(rig, amp: float, **kw) -> float:
-    P = ex.sine_sweep(amp, duration=20.0)
-    res = sh.run_eft(rig, effective_force=P, raise_on_failure=False, **kw)
-    f, H = fourier_ratio(res.force, P, DT)
-    band = (f > 0.3) & (f < 10)
-    return float(H[band].min())
+    """Minimum |F/P| over 0.3-10 Hz of the 20 s EFT sweep (experiments.eft_sweep)."""
+    return float(xp.eft_sweep(rig, amp, **kw).ratio.min())
 
 
 def damping(rig, T: float) -> float:
-    pe = ex.ramp_and_release(rig.k * 0.016, 5.0, 1.0, 4.0)
-    res = sh.run_rpsd(rig, external_force=pe, delay_T=T, raise_on_failure=False)
-    fv = identify_free_vibration(res.calc_displacement, DT, start=ex.release_index(5.0, 1.0), duration=4.0)
-    return fv.damping_ratio
+    """Damping ratio of the RPsD free vibration from 1.6 cm (experiments.rpsd_release)."""
+    return xp.rpsd_release(rig, RELEASE, delay_T=T).fit.damping_ratio
 
 
 CANDIDATES = {

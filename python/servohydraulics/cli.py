@@ -9,7 +9,7 @@ from collections.abc import Sequence
 
 
 def _demo(args: argparse.Namespace) -> int:
-    from .demo import run_demo
+    from .paper.demo import run_demo
 
     run_demo(out=args.out, quick=args.quick)
     return 0
@@ -31,7 +31,7 @@ def _simulate(args: argparse.Namespace) -> int:
 
 
 def _reproduce(args: argparse.Namespace) -> int:
-    from .reproduce import reproduce
+    from .paper.reproduce import reproduce
 
     if args.workers < 1:
         raise ValueError(f"invalid --workers = {args.workers}: must be >= 1")

@@ -185,20 +185,6 @@ class Channels(Mapping):
         return (Channels, (self._data,))
 
 
-class _Warnings(list):
-    """The warnings of a run: call it (``res.warnings()``, the API).  It is also
-    a list so that code written for the old ``MethodResult.warnings`` list keeps
-    working until it is ported."""
-
-    def __init__(self, res: Response):
-        super().__init__(res._warning_list(None))
-        self._res = res
-
-    def __call__(self, rig: Rig | None = None) -> list[str]:
-        """The notes as a plain list (``rig`` overrides the run's rig for the limit values)."""
-        return list(self) if rig is None else self._res._warning_list(rig)
-
-
 class Response:
     """Every channel of a run or record, SI units, one row per controller sample.
 
@@ -287,11 +273,10 @@ class Response:
         hit = np.flatnonzero(self.flags & flags)
         return float(self.time[hit[0]]) if hit.size else None
 
-    @property
-    def warnings(self) -> _Warnings:
-        """``res.warnings(rig=None)``: plain-language notes on the limits the run hit and,
-        for a failed run, the failure."""
-        return _Warnings(self)
+    def warnings(self, rig: Rig | None = None) -> list[str]:
+        """Plain-language notes on the limits the run hit and, for a failed run, the
+        failure (``rig`` overrides the run's rig for the limit values)."""
+        return self._warning_list(rig)
 
     def _warning_list(self, rig: Rig | None) -> list[str]:
         rig = self.rig if rig is None else rig

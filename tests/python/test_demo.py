@@ -7,7 +7,7 @@ import pytest
 
 import servohydraulics as sh
 from servohydraulics.cli import main
-from servohydraulics.demo import run_demo
+from servohydraulics.paper.demo import run_demo
 
 
 def test_demo_writes_outputs_matching_physics(tmp_path):
@@ -23,6 +23,12 @@ def test_demo_writes_outputs_matching_physics(tmp_path):
     # uncompensated displacement control loses ~30 % at 2 Hz (Fig 5a); force control collapses at f_n (Fig 3a)
     assert 0.65 < s["displacement_gain_at_2hz"] < 0.8
     assert s["force_gain_min"] < 0.15 and abs(s["force_gain_min_at_hz"] - f_d) < 0.2
+
+
+def test_old_demo_module_reexports():
+    from servohydraulics import demo
+
+    assert demo.run_demo is run_demo
 
 
 def test_cli_reports_bad_input_without_traceback(tmp_path, capsys):

@@ -1,4 +1,5 @@
-"""The reproduction table: a fast subset of ``reproduce`` checked against the paper's numbers."""
+"""The reproduction table: a fast subset of ``reproduce`` checked against the paper's numbers
+(servohydraulics.paper; ``servohydraulics.reproduce`` re-exports it)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import math
 
 import pytest
 
-rp = importlib.import_module("servohydraulics.reproduce")  # sh.reproduce is the function
+rp = importlib.import_module("servohydraulics.paper.reproduce")
 
 #: the paper's values of rows in the fast subset (None: a statement without a number)
 PAPER = {"natural_frequency": 1.58, "T_ld_estimate": 13.0, "friction_free": 95.7, "friction_attached": 31.6,
@@ -110,3 +111,20 @@ def test_linear_rows_paper_numbers():
     assert abs(1e3 / an.omega_cRPD(rig) - 81.0) <= 1.0
     T, _ = an.amplitude_compensation_T(an.G_xu(an.linear_analysis_rig(rig)) * an.zoh_delay(5e-4))
     assert abs(1e3 * T - 68.0) <= 3.0
+
+
+def test_old_module_reexports_the_driver():
+    """``servohydraulics.reproduce`` (the CLI's old path) and ``sh.reproduce`` are the paper driver."""
+    import servohydraulics as sh
+
+    old = importlib.import_module("servohydraulics.reproduce")
+    assert old.reproduce is rp.reproduce is sh.reproduce
+    assert old.SECTIONS is rp.SECTIONS
+
+
+def test_every_section_has_its_claims_with_unique_keys():
+    from servohydraulics.paper.claims import CLAIMS
+
+    assert list(CLAIMS) == list(rp.SECTIONS)
+    keys = [c.key for claims in CLAIMS.values() for c in claims]
+    assert len(keys) == len(set(keys)) == 53

@@ -141,7 +141,9 @@ def test_old_names_are_deprecated_aliases():
         assert sh.TestMethodError is sh.SimulationError
     with pytest.warns(DeprecationWarning, match="SimulationResult is deprecated"):
         assert sh.SimulationResult is sh.Response
-    methods = importlib.import_module("servohydraulics.methods")
+    sys.modules.pop("servohydraulics.methods", None)
+    with pytest.warns(DeprecationWarning, match="methods is deprecated; import servohydraulics.loops"):
+        methods = importlib.import_module("servohydraulics.methods")
     assert methods.run_eft is sh.run_eft and methods.TestMethodError is sh.SimulationError
 
 
