@@ -1,7 +1,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include "servohydraulics/presets.hpp"
+#include "servohydraulics/zhao2003.hpp"
 #include "servohydraulics/rig.hpp"
 
 namespace py = pybind11;
@@ -69,5 +69,15 @@ void expose_rig(py::module_& m) {
   py::enum_<Zhao2003Variant>(m, "Zhao2003Variant")
       .value("Calibrated", Zhao2003Variant::Calibrated)
       .value("Printed", Zhao2003Variant::Printed);
+  py::class_<Zhao2003TestMethods>(m, "Zhao2003TestMethods",
+                                  "Constants of the paper's test methods (Table I and text), SI")
+      .def(py::init<>())
+      .def_readonly("dt", &Zhao2003TestMethods::dt)
+      .def_readonly("eft_lead_T", &Zhao2003TestMethods::eft_lead_T)
+      .def_readonly("amplitude_T", &Zhao2003TestMethods::amplitude_T)
+      .def_readonly("delay_T", &Zhao2003TestMethods::delay_T)
+      .def_readonly("alpha", &Zhao2003TestMethods::alpha)
+      .def_readonly("model", &Zhao2003TestMethods::model);
+  m.attr("ZHAO2003_TEST_METHODS") = Zhao2003TestMethods{};
   m.def("zhao2003", &zhao2003, py::arg("variant") = Zhao2003Variant::Calibrated, py::arg("actuator_attached") = true);
 }

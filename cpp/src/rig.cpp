@@ -69,14 +69,6 @@ double FlowCurve::inverse(double q) const noexcept {
   return std::copysign(x, q);
 }
 
-FlowCurve zhao2003_flow_curve() {
-  FlowCurve fc;
-  fc.kind = FlowCurve::Kind::Table;
-  fc.opening = {0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.7, 1.0};
-  fc.flow = {0.0, 0.1, 0.19, 0.265, 0.33, 0.385, 0.47, 0.56};
-  return fc;
-}
-
 void FlowCurve::validate() const {
   if (kind == Kind::Rational) {
     require(std::isfinite(b) && b >= 0.0, "flow_curve.b", b, "must be finite and >= 0");
