@@ -26,6 +26,7 @@ except ImportError as e:  # pragma: no cover - only without a built core
 
 from . import analysis, identify  # noqa: E402
 from ._core import ControlMode, Dynamics, FlowCurve, Plant, SolverOptions, linearize
+from .controllers import EftController, RpsdController
 from .diagnose import Diagnosis, diagnose  # the function shadows the subpackage name
 from .methods import MethodResult, TestMethodError, run_eft, run_rpsd, run_tracking
 from .records import read_record, write_record
@@ -41,11 +42,13 @@ __all__ = [
     "ControlMode",
     "Diagnosis",
     "Dynamics",
+    "EftController",
     "Error",
     "FlowCurve",
     "MethodResult",
     "Plant",
     "Rig",
+    "RpsdController",
     "SimulationError",
     "SimulationResult",
     "SolverOptions",

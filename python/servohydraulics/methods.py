@@ -11,20 +11,26 @@
   amplitude compensation alone (Fig 5).
 
 The loops run in C++ (``_core.EffectiveForceTest``, ``_core.RealTimePseudoDynamicTest``);
-this module only builds configurations and wraps the arrays.
+this module only builds configurations and wraps the arrays.  The controllers
+alone, for stepping by hand against a plant or a real rig, are
+``servohydraulics.controllers`` (``sh.EftController``, ``sh.RpsdController``).
+The defaults (2 kHz, 5 ms, 68 ms, 11.2 ms, alpha = 0.1, m_m, c_m) are the
+core's ``_core.ZHAO2003_TEST_METHODS`` (zhao2003.hpp).
 """
 
 from __future__ import annotations
 
 import copy
 import math
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from . import _core
 from .rig import Rig
-from .simulate import SimulationResult, limit_warnings, simulate, solver_options
+from .simulate import SimulationResult, limit_warnings, simulate
+from .simulate import solver_options as _solver_options
 
 COMPENSATION = {"none": _core.VelocityFeedbackCompensator.Kind.None_,
                 "linear": _core.VelocityFeedbackCompensator.Kind.Linear,
@@ -33,16 +39,13 @@ RESTORING_FORCE = {"calculated_displacement": _core.RestoringForce.CalculatedDis
                    "measured_displacement": _core.RestoringForce.MeasuredDisplacement,
                    "measured_force": _core.RestoringForce.MeasuredForce,
                    "measured_force_corrected": _core.RestoringForce.MeasuredForceCorrected}
-SOLVERS = {"central_difference": _core.SolverKind.CentralDifference,
-           "explicit_newmark": _core.SolverKind.ExplicitNewmark}
+SCHEMES = {"central_difference": _core.IntegrationScheme.CentralDifference,
+           "explicit_newmark": _core.IntegrationScheme.ExplicitNewmark}
 FORCE_MEASUREMENT = {"load_cell": _core.ForceMeasurement.LoadCell,
                      "actuator_pressure": _core.ForceMeasurement.ActuatorPressure}
 
-#: Paper constants (Table I and text), SI.
-EFT_LEAD_T = 5e-3  #: EFT phase lead on the compensation, Table I T_d-hat [s]
-AMPLITUDE_T = 68e-3  #: amplitude compensation T_d (text; Table I prints it as T_ld) [s]
-DELAY_T = 11.2e-3  #: delay compensation T_ld (text; Table I prints it as T_d) [s]
-ALPHA = 0.1  #: phase-lead constant (Table I)
+#: The paper's test-method constants (Table I and text), SI, from the core.
+_TM = _core.ZHAO2003_TEST_METHODS
 
 
 class TestMethodError(RuntimeError):
@@ -120,6 +123,16 @@ def _nonneg(name: str, v: float) -> float:
     return float(v)
 
 
+def _renamed(old: str, old_value, new: str, new_value):
+    """The value of a keyword renamed in issue 11; the old name warns (DeprecationWarning)."""
+    if old_value is None:
+        return new_value
+    warnings.warn(f"{old}= is deprecated, use {new}=", DeprecationWarning, stacklevel=3)
+    if new_value is not None:
+        raise ValueError(f"give {new}= or its deprecated alias {old}=, not both")
+    return old_value
+
+
 def _choice(name: str, v: str, table: dict):
     if v not in table:
         raise ValueError(f"invalid {name} = {v!r}: expected one of {sorted(table)}")
@@ -138,10 +151,27 @@ def _finish(method: str, d: dict, s: _core.RunSummary, rig: Rig, dt: float, rais
     return res
 
 
-def run_eft(rig: Rig, ground_acceleration=None, effective_force=None, dt: float = 5e-4,
-            compensation: str = "linear", lead_T: float = EFT_LEAD_T, alpha: float = ALPHA,
+def eft_config(dt: float = _TM.dt, compensation: str = "linear", lead_T: float = _TM.eft_lead_T,
+               alpha: float = _TM.alpha, mass: float | None = None, compute_delay: int = 0,
+               solver_options: _core.SolverOptions | None = None) -> _core.EftConfig:
+    """The core's EftConfig (validated); None = the default (mass: the rig's m)."""
+    cfg = _core.EftConfig()
+    cfg.dt = dt
+    cfg.mass = mass
+    cfg.compensation = _choice("compensation", compensation, COMPENSATION)
+    cfg.lead_T = _nonneg("lead_T", lead_T)
+    cfg.alpha = alpha
+    cfg.compute_delay = int(compute_delay)
+    cfg.plant_options = solver_options or _core.SolverOptions()
+    cfg.validate()
+    return cfg
+
+
+def run_eft(rig: Rig, ground_acceleration=None, effective_force=None, dt: float = _TM.dt,
+            compensation: str = "linear", lead_T: float = _TM.eft_lead_T, alpha: float = _TM.alpha,
             mass: float | None = None, compute_delay: int = 0, model: Rig | None = None,
-            options: _core.SolverOptions | None = None, raise_on_failure: bool = True) -> MethodResult:
+            solver_options: _core.SolverOptions | None = None, raise_on_failure: bool = True,
+            options: _core.SolverOptions | None = None) -> MethodResult:
     """Effective force testing (force control) of ``rig``.
 
     Args:
@@ -153,33 +183,60 @@ def run_eft(rig: Rig, ground_acceleration=None, effective_force=None, dt: float 
         mass: m in P_eff = -m a_g [kg] (default rig.m).
         compute_delay: samples of compute delay on the command.
         model: the controller's rig model for the compensator (default: ``rig``).
+        solver_options: the plant's ODE integrator (``solver_options(...)``); ``options=`` is
+            its deprecated alias.
     """
     if (ground_acceleration is None) == (effective_force is None):
         raise ValueError("give exactly one of ground_acceleration [m/s^2] or effective_force [N]")
-    cfg = _core.EftConfig()
-    cfg.dt = dt
-    cfg.mass = _nonneg("mass", 0.0 if mass is None else mass)
-    m = cfg.mass if cfg.mass > 0 else rig.m
+    opts = _renamed("options", options, "solver_options", solver_options)
+    cfg = eft_config(dt, compensation, lead_T, alpha, mass, compute_delay, opts or _solver_options())
+    m = rig.m if cfg.mass is None else cfg.mass
     ag = (_array("ground_acceleration", ground_acceleration) if effective_force is None
           else -_array("effective_force", effective_force) / m)
-    cfg.compensation = _choice("compensation", compensation, COMPENSATION)
-    cfg.lead_T = _nonneg("lead_T", lead_T)
-    cfg.alpha = alpha
-    cfg.compute_delay = int(compute_delay)
-    cfg.plant_options = options or solver_options()
     test = _core.EffectiveForceTest(rig, cfg, model)
     d, s = test.run(ag)
     return _finish("EFT", d, s, rig, dt, raise_on_failure)
 
 
+def rpsd_config(dt: float = _TM.dt, m_m: float = _TM.model.m_m, c_m: float = _TM.model.c_m,
+                k_m: float | None = None, scheme: str = "central_difference",
+                restoring_force: str = "measured_displacement", amplitude_T: float = _TM.amplitude_T,
+                delay_T: float | None = None, alpha: float = _TM.alpha, physical_mass_fraction: float = 1.0,
+                force_measurement: str = "load_cell", subtract_mass: float | None = None,
+                subtract_damping: float | None = None, compute_delay: int = 0,
+                solver_options: _core.SolverOptions | None = None) -> _core.RpsdConfig:
+    """The core's RpsdConfig (validated); None = the default (delay_T: 11.2 ms, or 0 for
+    ``"calculated_displacement"``; k_m, subtract_mass, subtract_damping: from the physical rig)."""
+    cfg = _core.RpsdConfig()
+    cfg.dt = dt
+    cfg.model = _core.ModelSDOF(m_m, c_m)
+    cfg.k_m = k_m
+    cfg.scheme = _choice("scheme", scheme, SCHEMES)
+    cfg.restoring_force = _choice("restoring_force", restoring_force, RESTORING_FORCE)
+    cfg.force_measurement = _choice("force_measurement", force_measurement, FORCE_MEASUREMENT)
+    cfg.amplitude_T = _nonneg("amplitude_T", amplitude_T)
+    if delay_T is None:
+        delay_T = 0.0 if restoring_force == "calculated_displacement" else _TM.delay_T
+    cfg.delay_T = _nonneg("delay_T", delay_T)
+    cfg.alpha = alpha
+    cfg.physical_mass_fraction = physical_mass_fraction
+    cfg.subtract_mass = subtract_mass
+    cfg.subtract_damping = subtract_damping
+    cfg.compute_delay = int(compute_delay)
+    cfg.plant_options = solver_options or _core.SolverOptions()
+    cfg.validate()
+    return cfg
+
+
 def run_rpsd(rig: Rig, ground_acceleration=None, external_force=None, restoring_force_error=None,
-             dt: float = 5e-4, m_m: float = 7084.0, c_m: float = 3.5e3, k_m: float | None = None,
-             solver: str = "central_difference", restoring_force: str = "measured_displacement",
-             amplitude_T: float = AMPLITUDE_T, delay_T: float | None = None, alpha: float = ALPHA,
+             dt: float = _TM.dt, m_m: float = _TM.model.m_m, c_m: float = _TM.model.c_m,
+             k_m: float | None = None, scheme: str | None = None, restoring_force: str = "measured_displacement",
+             amplitude_T: float = _TM.amplitude_T, delay_T: float | None = None, alpha: float = _TM.alpha,
              physical_mass_fraction: float = 1.0, force_measurement: str = "load_cell",
              subtract_mass: float | None = None, subtract_damping: float | None = None,
-             compute_delay: int = 0, options: _core.SolverOptions | None = None,
-             raise_on_failure: bool = True) -> MethodResult:
+             compute_delay: int = 0, solver_options: _core.SolverOptions | None = None,
+             raise_on_failure: bool = True, solver: str | None = None,
+             options: _core.SolverOptions | None = None) -> MethodResult:
     """Real-time pseudodynamic testing (displacement control) of ``rig``.
 
     The solver integrates m_m a + c_m v + f = -m_m a_g + P_ext (Eq 15) online.
@@ -190,7 +247,8 @@ def run_rpsd(rig: Rig, ground_acceleration=None, external_force=None, restoring_
         restoring_force_error: added to the restoring force [N] (Fig 9b), or None.
         m_m, c_m: modelled mass [kg] and damping [N s/m] (Table I: 7084 kg, 3.5 kN s/m).
         k_m: stiffness for the displacement-based restoring forces [N/m] (default rig.k).
-        solver: ``"central_difference"`` or ``"explicit_newmark"``.
+        scheme: the Eq (15) integration scheme, ``"central_difference"`` (default) or
+            ``"explicit_newmark"``; ``solver=`` is its deprecated alias.
         restoring_force: ``"calculated_displacement"`` (a), ``"measured_displacement"`` (b),
             ``"measured_force"`` (c) or ``"measured_force_corrected"`` (d: minus m a and c v).
         amplitude_T: amplitude compensation T_d on the command [s] (68 ms; 0 = none).
@@ -199,7 +257,10 @@ def run_rpsd(rig: Rig, ground_acceleration=None, external_force=None, restoring_
         physical_mass_fraction: the rig's structural mass is set to this times m_m (0.02 = 140 kg).
         force_measurement: ``"load_cell"`` or ``"actuator_pressure"`` (p A, includes the piston inertia).
         subtract_mass, subtract_damping: for (d) [kg], [N s/m]; default the physical values.
+        solver_options: the plant's ODE integrator; ``options=`` is its deprecated alias.
     """
+    scheme = _renamed("solver", solver, "scheme", scheme) or "central_difference"
+    opts = _renamed("options", options, "solver_options", solver_options)
     n = None
     for _name, a in (("ground_acceleration", ground_acceleration), ("external_force", external_force),
                     ("restoring_force_error", restoring_force_error)):
@@ -210,23 +271,9 @@ def run_rpsd(rig: Rig, ground_acceleration=None, external_force=None, restoring_
     ag = np.zeros(n) if ground_acceleration is None else _array("ground_acceleration", ground_acceleration, n)
     pe = None if external_force is None else _array("external_force", external_force, n)
     fe = None if restoring_force_error is None else _array("restoring_force_error", restoring_force_error, n)
-    cfg = _core.RpsdConfig()
-    cfg.dt = dt
-    cfg.model = _core.ModelSDOF(m_m, c_m)
-    cfg.k_m = _nonneg("k_m", 0.0 if k_m is None else k_m)
-    cfg.solver = _choice("solver", solver, SOLVERS)
-    cfg.restoring_force = _choice("restoring_force", restoring_force, RESTORING_FORCE)
-    cfg.force_measurement = _choice("force_measurement", force_measurement, FORCE_MEASUREMENT)
-    cfg.amplitude_T = _nonneg("amplitude_T", amplitude_T)
-    if delay_T is None:
-        delay_T = 0.0 if restoring_force == "calculated_displacement" else DELAY_T
-    cfg.delay_T = _nonneg("delay_T", delay_T)
-    cfg.alpha = alpha
-    cfg.physical_mass_fraction = physical_mass_fraction
-    cfg.subtract_mass = -1.0 if subtract_mass is None else _nonneg("subtract_mass", subtract_mass)
-    cfg.subtract_damping = -1.0 if subtract_damping is None else _nonneg("subtract_damping", subtract_damping)
-    cfg.compute_delay = int(compute_delay)
-    cfg.plant_options = options or solver_options()
+    cfg = rpsd_config(dt, m_m, c_m, k_m, scheme, restoring_force, amplitude_T, delay_T, alpha,
+                      physical_mass_fraction, force_measurement, subtract_mass, subtract_damping, compute_delay,
+                      opts or _solver_options())
     test = _core.RealTimePseudoDynamicTest(rig, cfg)
     d, s = test.run(ag, pe, fe)
     phys = copy.deepcopy(rig)
@@ -234,15 +281,17 @@ def run_rpsd(rig: Rig, ground_acceleration=None, external_force=None, restoring_
     return _finish("RPsD", d, s, phys, dt, raise_on_failure)
 
 
-def run_tracking(rig: Rig, displacement, dt: float = 5e-4, amplitude_T: float = AMPLITUDE_T,
-                 alpha: float = ALPHA, options: _core.SolverOptions | None = None) -> SimulationResult:
+def run_tracking(rig: Rig, displacement, dt: float = _TM.dt, amplitude_T: float = _TM.amplitude_T,
+                 alpha: float = _TM.alpha, solver_options: _core.SolverOptions | None = None,
+                 options: _core.SolverOptions | None = None) -> SimulationResult:
     """Displacement control of a given displacement [m] through the amplitude compensation
     (T_d phase lead on the command, Fig 1b / Fig 5b); returns the plant's SimulationResult
     (``.warnings()`` reports capacity and supply-pressure limits)."""
+    opts = _renamed("options", options, "solver_options", solver_options)
     d = _array("displacement", displacement)
     lead = _core.PhaseLead(_nonneg("amplitude_T", amplitude_T), alpha, dt)
     lead.reset(float(d[0]))
-    return simulate(rig, "displacement", lead.filter(d), dt, x0=float(d[0]), options=options,
+    return simulate(rig, "displacement", lead.filter(d), dt, x0=float(d[0]), options=opts,
                     raise_on_failure=False)
 
 
