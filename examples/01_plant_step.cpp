@@ -1,8 +1,8 @@
 // A 2 kHz digital controller on the host clock driving the simulated rig: the
 // way the plant is embedded in a real-time loop (pairs with
-// examples/python/01_plant_step.py).
+// examples/01_plant_step.py).
 //
-//   controller [duration_s = 2] [amplitude_m = 0.01] [frequency_Hz = 1] [cvode|rk4]
+//   01_plant_step [duration_s = 2] [amplitude_m = 0.01] [frequency_Hz = 1] [cvode|rk4]
 //
 // Each period: sleep to an absolute deadline (clock_nanosleep, CLOCK_MONOTONIC,
 // TIMER_ABSTIME), read the sensors of the last sample, compute the next
@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "servohydraulics/plant.hpp"
-#include "servohydraulics/presets.hpp"
+#include "servohydraulics/zhao2003.hpp"
 
 namespace sh = servohydraulics;
 
