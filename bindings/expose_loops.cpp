@@ -6,11 +6,13 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "protocol.hpp"
 #include "servohydraulics/controllers.hpp"
 #include "servohydraulics/loops.hpp"
 
 namespace py = pybind11;
 using namespace servohydraulics;
+using servohydraulics::bindings::add_protocol;
 
 namespace {
 using Arr = py::array_t<double, py::array::c_style | py::array::forcecast>;
@@ -58,12 +60,13 @@ const double* optional_input(const std::optional<Arr>& a, std::size_t n, const c
 
 void expose_loops(py::module_& m) {
   // --- integration schemes of Eq (15) ---------------------------------------------------------------
-  py::class_<ModelSDOF>(m, "ModelSDOF", "Modelled SDOF system of Eq (15): m_m [kg], c_m [N s/m]")
-      .def(py::init<>())
+  py::class_<ModelSDOF> model(m, "ModelSDOF", "Modelled SDOF system of Eq (15): m_m [kg], c_m [N s/m]");
+  model.def(py::init<>())
       .def(py::init([](double m_m, double c_m) { return ModelSDOF{m_m, c_m}; }), py::arg("m_m"), py::arg("c_m"))
       .def_readwrite("m_m", &ModelSDOF::m_m)
       .def_readwrite("c_m", &ModelSDOF::c_m)
       .def("validate", &ModelSDOF::validate);
+  add_protocol(model, {"m_m", "c_m"});
   py::class_<IntegratorState>(m, "IntegratorState")
       .def_readonly("displacement", &IntegratorState::displacement)
       .def_readonly("velocity", &IntegratorState::velocity)
@@ -86,8 +89,8 @@ void expose_loops(py::module_& m) {
       .def_property_readonly("state", &ExplicitNewmark::state);
 
   // --- EFT -------------------------------------------------------------------
-  py::class_<EftConfig>(m, "EftConfig")
-      .def(py::init<>())
+  py::class_<EftConfig> eft_config(m, "EftConfig");
+  eft_config.def(py::init<>())
       .def_readwrite("dt", &EftConfig::dt)
       .def_readwrite("mass", &EftConfig::mass)
       .def_readwrite("compensation", &EftConfig::compensation)
@@ -96,6 +99,7 @@ void expose_loops(py::module_& m) {
       .def_readwrite("compute_delay", &EftConfig::compute_delay)
       .def_readwrite("plant_options", &EftConfig::plant_options)
       .def("validate", &EftConfig::validate);
+  add_protocol(eft_config, {"dt", "mass", "compensation", "lead_T", "alpha", "compute_delay", "plant_options"});
   py::class_<EftOutput>(m, "EftOutput")
       .def_readonly("plant", &EftOutput::plant)
       .def_readonly("ground_acceleration", &EftOutput::ground_acceleration)
@@ -166,8 +170,8 @@ void expose_loops(py::module_& m) {
   py::enum_<ForceMeasurement>(m, "ForceMeasurement")
       .value("LoadCell", ForceMeasurement::LoadCell)
       .value("ActuatorPressure", ForceMeasurement::ActuatorPressure);
-  py::class_<RpsdConfig>(m, "RpsdConfig")
-      .def(py::init<>())
+  py::class_<RpsdConfig> rpsd_config(m, "RpsdConfig");
+  rpsd_config.def(py::init<>())
       .def_readwrite("dt", &RpsdConfig::dt)
       .def_readwrite("model", &RpsdConfig::model)
       .def_readwrite("k_m", &RpsdConfig::k_m)
@@ -183,6 +187,9 @@ void expose_loops(py::module_& m) {
       .def_readwrite("compute_delay", &RpsdConfig::compute_delay)
       .def_readwrite("plant_options", &RpsdConfig::plant_options)
       .def("validate", &RpsdConfig::validate);
+  add_protocol(rpsd_config, {"dt", "model", "k_m", "scheme", "restoring_force", "force_measurement", "amplitude_T",
+                             "delay_T", "alpha", "physical_mass_fraction", "subtract_mass", "subtract_damping",
+                             "compute_delay", "plant_options"});
   py::class_<RpsdOutput>(m, "RpsdOutput")
       .def_readonly("plant", &RpsdOutput::plant)
       .def_readonly("ground_acceleration", &RpsdOutput::ground_acceleration)
