@@ -29,7 +29,7 @@
 
 #include "servohydraulics/loops.hpp"
 #include "servohydraulics/plant.hpp"
-#include "servohydraulics/presets.hpp"
+#include "servohydraulics/zhao2003.hpp"
 #include "servohydraulics/record.hpp"
 
 namespace sh = servohydraulics;

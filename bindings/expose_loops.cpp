@@ -126,10 +126,8 @@ void expose_loops(py::module_& m) {
       .def_property_readonly("mass", &EftController::mass)
       .def_property_readonly("compensator", &EftController::compensator, py::return_value_policy::reference_internal);
   py::class_<EffectiveForceTest>(m, "EffectiveForceTest", "Effective force testing loop (force control, Fig 1a)")
-      .def(py::init([](const Rig& rig, const EftConfig& cfg, std::optional<Rig> model) {
-             return std::make_unique<EffectiveForceTest>(rig, cfg, model ? &*model : nullptr);
-           }),
-           py::arg("rig"), py::arg("config"), py::arg("model") = py::none())
+      .def(py::init<const Rig&, const EftConfig&, const std::optional<Rig>&>(), py::arg("rig"), py::arg("config"),
+           py::arg("model") = py::none())
       .def("reset", &EffectiveForceTest::reset)
       .def(
           "step",

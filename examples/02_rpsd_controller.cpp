@@ -21,6 +21,7 @@
 #include <cstdlib>
 #include <vector>
 
+#include "realtime_clock.hpp"
 #include "servohydraulics/controllers.hpp"
 #include "servohydraulics/plant.hpp"
 #include "servohydraulics/zhao2003.hpp"
@@ -28,7 +29,9 @@
 namespace sh = servohydraulics;
 
 namespace {
-constexpr long kNsPerS = 1000000000L;
+using examples::add_ns;
+using examples::kNsPerS;
+using examples::seconds;
 constexpr double kPi = 3.14159265358979323846;
 
 // ---------------------------------------------------------------------------
@@ -53,14 +56,6 @@ class RigIo {
   sh::Output sensors_;
 };
 
-void add_ns(timespec& t, long ns) {
-  t.tv_nsec += ns;
-  while (t.tv_nsec >= kNsPerS) {
-    t.tv_nsec -= kNsPerS;
-    ++t.tv_sec;
-  }
-}
-double seconds(const timespec& t) { return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec); }
 
 // Frequency [Hz] from the zero crossings of x[i0..] (linear interpolation).
 double crossing_frequency(const std::vector<double>& x, std::size_t i0, double dt) {

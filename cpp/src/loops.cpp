@@ -20,9 +20,9 @@ EftConfig with_mass(const EftConfig& config, const Rig& rig) {
 }
 }  // namespace
 
-EffectiveForceTest::EffectiveForceTest(const Rig& rig, const EftConfig& config, const Rig* model)
+EffectiveForceTest::EffectiveForceTest(const Rig& rig, const EftConfig& config, const std::optional<Rig>& model)
     : ClosedLoop(Plant(rig, ControlMode::Force, config.dt, config.plant_options),
-                 EftController(with_mass(config, rig), model ? *model : rig)) {}
+                 EftController(with_mass(config, rig), model.value_or(rig))) {}
 
 Rig RealTimePseudoDynamicTest::physical_rig(const Rig& rig, const RpsdConfig& cfg) {
   cfg.validate();

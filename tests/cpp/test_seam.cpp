@@ -33,6 +33,22 @@ bool same(const Output& a, const Output& b) {
          a.drive == b.drive && a.flow == b.flow && a.flags == b.flags;
 }
 
+// Steps the plant by hand, command(k, sensors) at each sample, and counts the
+// rows where the sensors or the command differ from the runner's rows.
+template <class Row, class Command>
+std::size_t mismatches_by_hand(Plant& plant, const std::vector<Row>& rows, Command&& command) {
+  plant.reset(0.0, 0.0);
+  Output sensors;
+  plant.observe(sensors);
+  std::size_t mismatches = 0;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const double u = command(k, sensors);
+    if (!same(sensors, rows[k].plant) || u != rows[k].command) ++mismatches;
+    plant.step(u, sensors);
+  }
+  return mismatches;
+}
+
 void eft_seam(VelocityFeedbackCompensator::Kind kind, bool other_model) {
   const Rig rig = zhao2003();
   Rig model = zhao2003();
@@ -41,7 +57,7 @@ void eft_seam(VelocityFeedbackCompensator::Kind kind, bool other_model) {
   cfg.compensation = kind;
   cfg.compute_delay = other_model ? 1 : 0;
   const auto ag = ground_motion(2.0, 1.3, cfg.dt);
-  EffectiveForceTest loop(rig, cfg, &model);
+  EffectiveForceTest loop(rig, cfg, model);
   std::vector<EftOutput> rows(kN);
   const RunSummary sum = run_eft(loop, ag.data(), kN, rows.data());
   CHECK(sum.status.ok() && sum.rows == kN);
@@ -50,15 +66,8 @@ void eft_seam(VelocityFeedbackCompensator::Kind kind, bool other_model) {
   ccfg.mass = rig.m;  // the loop's P_eff uses the plant's mass
   EftController ctrl(ccfg, model);
   Plant plant(rig, ControlMode::Force, cfg.dt);
-  plant.reset(0.0, 0.0);
-  Output sensors;
-  plant.observe(sensors);
-  std::size_t mismatches = 0;
-  for (std::size_t k = 0; k < kN; ++k) {
-    const double u = ctrl.command(sensors, ag[k]);
-    if (!same(sensors, rows[k].plant) || u != rows[k].command) ++mismatches;
-    plant.step(u, sensors);
-  }
+  const std::size_t mismatches =
+      mismatches_by_hand(plant, rows, [&](std::size_t k, const Output& s) { return ctrl.command(s, ag[k]); });
   std::printf("EFT seam kind %d, other model %d: %zu mismatches in %zu samples\n", static_cast<int>(kind),
               static_cast<int>(other_model), mismatches, kN);
   CHECK(mismatches == 0);
@@ -82,17 +91,13 @@ void rpsd_seam(IntegrationScheme scheme, RestoringForce rf, ForceMeasurement fm,
   const Rig physical = RealTimePseudoDynamicTest::physical_rig(rig, cfg);
   RpsdController ctrl(cfg, physical);
   Plant plant(physical, ControlMode::Displacement, cfg.dt);
-  plant.reset(0.0, 0.0);
-  Output sensors;
-  plant.observe(sensors);
-  std::size_t mismatches = 0;
-  for (std::size_t k = 0; k < kN; ++k) {
-    const double u = ctrl.command(sensors, ag[k], pe[k], fe[k]);
-    if (!same(sensors, rows[k].plant) || u != rows[k].command ||
-        ctrl.integrator_state().displacement != rows[k].calc_displacement)
-      ++mismatches;
-    plant.step(u, sensors);
-  }
+  std::size_t solver_mismatches = 0;
+  std::size_t mismatches = mismatches_by_hand(plant, rows, [&](std::size_t k, const Output& s) {
+    const double u = ctrl.command(s, ag[k], pe[k], fe[k]);
+    if (ctrl.integrator_state().displacement != rows[k].calc_displacement) ++solver_mismatches;
+    return u;
+  });
+  mismatches += solver_mismatches;
   std::printf("RPsD seam scheme %d, option %d, force %d, mass fraction %g: %zu mismatches\n",
               static_cast<int>(scheme), static_cast<int>(rf), static_cast<int>(fm), fraction, mismatches);
   CHECK(mismatches == 0);

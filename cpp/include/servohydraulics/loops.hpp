@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <utility>
 
 #include "servohydraulics/controllers.hpp"
@@ -59,9 +60,9 @@ class ClosedLoop {
 class EffectiveForceTest : public ClosedLoop<EftController> {
  public:
   //! rig: the plant; model: the controller's model of the rig for the compensator
-  //! (nullptr = the same rig, i.e. perfect knowledge).  config.mass none = rig.m
+  //! (none = the same rig, i.e. perfect knowledge).  config.mass none = rig.m
   //! (the plant's, whatever the model).
-  EffectiveForceTest(const Rig& rig, const EftConfig& config, const Rig* model = nullptr);
+  EffectiveForceTest(const Rig& rig, const EftConfig& config, const std::optional<Rig>& model = std::nullopt);
 
   Status step(double ground_acceleration, EftOutput& out) noexcept {
     return ClosedLoop::step(out, ground_acceleration);
