@@ -257,6 +257,8 @@ void expose_loops(py::module_& m) {
       .def_property_readonly("controller", &RealTimePseudoDynamicTest::controller,
                              py::return_value_policy::reference_internal)
       .def_property_readonly("integrator_state", &RealTimePseudoDynamicTest::integrator_state)
+      .def_static("physical_rig", &RealTimePseudoDynamicTest::physical_rig, py::arg("rig"), py::arg("config"),
+                  "The rig the plant simulates: rig with m = physical_mass_fraction * m_m")
       .def_property_readonly("k_m", &RealTimePseudoDynamicTest::k_m)
       .def_property_readonly("subtract_mass", &RealTimePseudoDynamicTest::subtract_mass)
       .def_property_readonly("subtract_damping", &RealTimePseudoDynamicTest::subtract_damping);

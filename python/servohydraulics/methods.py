@@ -20,7 +20,6 @@ core's ``_core.ZHAO2003_TEST_METHODS`` (zhao2003.hpp).
 
 from __future__ import annotations
 
-import copy
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -276,8 +275,7 @@ def run_rpsd(rig: Rig, ground_acceleration=None, external_force=None, restoring_
                       opts or _solver_options())
     test = _core.RealTimePseudoDynamicTest(rig, cfg)
     d, s = test.run(ag, pe, fe)
-    phys = copy.deepcopy(rig)
-    phys.m = physical_mass_fraction * m_m
+    phys = _core.RealTimePseudoDynamicTest.physical_rig(rig, cfg)
     return _finish("RPsD", d, s, phys, dt, raise_on_failure)
 
 
