@@ -370,7 +370,7 @@ def markdown(r: dict) -> str:
               f"1 worker {sw['wall_s_1']:.2f} s, 2 workers {sw['wall_s_2']:.2f} s, speed-up "
               f"{sw['speedup']:.2f}x (2 cores shared with other jobs: the speed-up is bounded by the cores "
               "the other jobs leave free).", "",
-              "Usage (examples/python/03_sweep_gain_mass.py and 04_uncertainty.py run these):", "",
+              "Usage (examples/04_sweep_gain_mass.py and 05_uncertainty.py run these):", "",
               "```python",
               "import servohydraulics as sh",
               "from scipy import stats",

@@ -29,7 +29,7 @@
 
 #include "servohydraulics/loops.hpp"
 #include "servohydraulics/plant.hpp"
-#include "servohydraulics/presets.hpp"
+#include "servohydraulics/zhao2003.hpp"
 #include "servohydraulics/record.hpp"
 
 namespace sh = servohydraulics;
@@ -254,7 +254,7 @@ Result run_case(const Case& c, const sh::Rig& rig, const Input& in, std::size_t 
   if (c.group == "rpsd") {
     sh::RpsdConfig cfg;
     cfg.dt = dt;
-    cfg.solver = sh::SolverKind::ExplicitNewmark;
+    cfg.scheme = sh::IntegrationScheme::ExplicitNewmark;
     // Both phase leads: T_d = 68 ms on the command, T_ld on the restoring force
     // from the measured displacement (option b, Fig 7a).  T_ld = 20 ms, not the
     // paper's 11.2 ms: the calibrated model's residual delay after the 68 ms lead

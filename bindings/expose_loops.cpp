@@ -6,10 +6,13 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "protocol.hpp"
+#include "servohydraulics/controllers.hpp"
 #include "servohydraulics/loops.hpp"
 
 namespace py = pybind11;
 using namespace servohydraulics;
+using servohydraulics::bindings::add_protocol;
 
 namespace {
 using Arr = py::array_t<double, py::array::c_style | py::array::forcecast>;
@@ -19,26 +22,8 @@ const std::pair<const char*, double Output::*> kPlantFields[] = {
     {"acceleration", &Output::acceleration}, {"force", &Output::force},   {"pressure", &Output::pressure},
     {"spool", &Output::spool},    {"drive", &Output::drive},               {"flow", &Output::flow}};
 
-const std::pair<const char*, double EftOutput::*> kEftFields[] = {
-    {"ground_acceleration", &EftOutput::ground_acceleration},
-    {"effective_force", &EftOutput::effective_force},
-    {"compensation", &EftOutput::compensation},
-    {"compensation_opening", &EftOutput::compensation_opening},
-    {"command", &EftOutput::command}};
-
-const std::pair<const char*, double RpsdOutput::*> kRpsdFields[] = {
-    {"ground_acceleration", &RpsdOutput::ground_acceleration},
-    {"external_force", &RpsdOutput::external_force},
-    {"measured_restoring_force", &RpsdOutput::measured_restoring_force},
-    {"restoring_force", &RpsdOutput::restoring_force},
-    {"calc_displacement", &RpsdOutput::calc_displacement},
-    {"calc_velocity", &RpsdOutput::calc_velocity},
-    {"calc_acceleration", &RpsdOutput::calc_acceleration},
-    {"target_displacement", &RpsdOutput::target_displacement},
-    {"command", &RpsdOutput::command}};
-
-template <class Row, std::size_t N>
-py::dict to_dict(const std::vector<Row>& rows, std::size_t n, const std::pair<const char*, double Row::*> (&extra)[N]) {
+template <class Row, class Channel, std::size_t N>
+py::dict to_dict(const std::vector<Row>& rows, std::size_t n, const Channel (&extra)[N]) {
   py::dict out;
   for (const auto& [name, mp] : kPlantFields) {
     py::array_t<double> a(static_cast<py::ssize_t>(n));
@@ -49,13 +34,20 @@ py::dict to_dict(const std::vector<Row>& rows, std::size_t n, const std::pair<co
   py::array_t<std::uint32_t> flags(static_cast<py::ssize_t>(n));
   for (std::size_t k = 0; k < n; ++k) flags.mutable_data()[k] = rows[k].plant.flags;
   out["flags"] = flags;
-  for (const auto& [name, mp] : extra) {
+  for (const auto& ch : extra) {
     py::array_t<double> a(static_cast<py::ssize_t>(n));
     double* d = a.mutable_data();
-    for (std::size_t k = 0; k < n; ++k) d[k] = rows[k].*mp;
-    out[name] = a;
+    for (std::size_t k = 0; k < n; ++k) d[k] = rows[k].*(ch.member);
+    out[ch.name] = a;
   }
   return out;
+}
+
+template <class Channel, std::size_t N>
+py::tuple channel_table(const Channel (&table)[N]) {
+  py::tuple t(N);
+  for (std::size_t i = 0; i < N; ++i) t[i] = py::make_tuple(table[i].name, table[i].unit);
+  return t;
 }
 
 const double* optional_input(const std::optional<Arr>& a, std::size_t n, const char* name) {
@@ -67,18 +59,24 @@ const double* optional_input(const std::optional<Arr>& a, std::size_t n, const c
 }  // namespace
 
 void expose_loops(py::module_& m) {
-  // --- solvers ---------------------------------------------------------------
-  py::class_<ModelSDOF>(m, "ModelSDOF", "Modelled SDOF system of Eq (15): m_m [kg], c_m [N s/m]")
-      .def(py::init<>())
+  // --- integration schemes of Eq (15) ---------------------------------------------------------------
+  py::class_<ModelSDOF> model(m, "ModelSDOF", "Modelled SDOF system of Eq (15): m_m [kg], c_m [N s/m]");
+  model.def(py::init<>())
       .def(py::init([](double m_m, double c_m) { return ModelSDOF{m_m, c_m}; }), py::arg("m_m"), py::arg("c_m"))
       .def_readwrite("m_m", &ModelSDOF::m_m)
       .def_readwrite("c_m", &ModelSDOF::c_m)
       .def("validate", &ModelSDOF::validate);
-  py::class_<SolverState>(m, "SolverState")
-      .def_readonly("displacement", &SolverState::displacement)
-      .def_readonly("velocity", &SolverState::velocity)
-      .def_readonly("acceleration", &SolverState::acceleration)
-      .def_readonly("next_displacement", &SolverState::next_displacement);
+  add_protocol(model, {"m_m", "c_m"});
+  py::class_<IntegratorState>(m, "IntegratorState")
+      .def_readonly("displacement", &IntegratorState::displacement)
+      .def_readonly("velocity", &IntegratorState::velocity)
+      .def_readonly("acceleration", &IntegratorState::acceleration)
+      .def_readonly("next_displacement", &IntegratorState::next_displacement);
+  m.attr("SolverState") = m.attr("IntegratorState");  // the name before issue 11
+  py::enum_<IntegrationScheme>(m, "IntegrationScheme")
+      .value("CentralDifference", IntegrationScheme::CentralDifference)
+      .value("ExplicitNewmark", IntegrationScheme::ExplicitNewmark);
+  m.attr("SolverKind") = m.attr("IntegrationScheme");  // the name before issue 11
   py::class_<CentralDifference>(m, "CentralDifference", "Explicit central-difference solver of Eq (15)")
       .def(py::init<const ModelSDOF&, double>(), py::arg("model"), py::arg("dt"))
       .def("reset", &CentralDifference::reset, py::arg("d0") = 0.0)
@@ -91,8 +89,8 @@ void expose_loops(py::module_& m) {
       .def_property_readonly("state", &ExplicitNewmark::state);
 
   // --- EFT -------------------------------------------------------------------
-  py::class_<EftConfig>(m, "EftConfig")
-      .def(py::init<>())
+  py::class_<EftConfig> eft_config(m, "EftConfig");
+  eft_config.def(py::init<>())
       .def_readwrite("dt", &EftConfig::dt)
       .def_readwrite("mass", &EftConfig::mass)
       .def_readwrite("compensation", &EftConfig::compensation)
@@ -101,6 +99,7 @@ void expose_loops(py::module_& m) {
       .def_readwrite("compute_delay", &EftConfig::compute_delay)
       .def_readwrite("plant_options", &EftConfig::plant_options)
       .def("validate", &EftConfig::validate);
+  add_protocol(eft_config, {"dt", "mass", "compensation", "lead_T", "alpha", "compute_delay", "plant_options"});
   py::class_<EftOutput>(m, "EftOutput")
       .def_readonly("plant", &EftOutput::plant)
       .def_readonly("ground_acceleration", &EftOutput::ground_acceleration)
@@ -108,11 +107,27 @@ void expose_loops(py::module_& m) {
       .def_readonly("compensation", &EftOutput::compensation)
       .def_readonly("compensation_opening", &EftOutput::compensation_opening)
       .def_readonly("command", &EftOutput::command);
+  m.attr("EFT_CHANNELS") = channel_table(kEftChannels);
+  py::class_<EftController>(m, "EftController",
+                            "EFT controller (Fig 1a): sensors at t_k and a_g -> force command [N]")
+      .def(py::init<const EftConfig&, const Rig&>(), py::arg("config"), py::arg("model"))
+      .def("reset", &EftController::reset)
+      .def("command", [](EftController& c, const Output& s, double ag) { return c.command(s, ag); },
+           py::arg("sensors"), py::arg("ground_acceleration"))
+      .def(
+          "command_output",
+          [](EftController& c, const Output& s, double ag) {
+            EftOutput o;
+            c.command(s, ag, &o);
+            return o;
+          },
+          py::arg("sensors"), py::arg("ground_acceleration"), "As command(), returning every channel (EftOutput)")
+      .def_property_readonly("config", &EftController::config)
+      .def_property_readonly("mass", &EftController::mass)
+      .def_property_readonly("compensator", &EftController::compensator, py::return_value_policy::reference_internal);
   py::class_<EffectiveForceTest>(m, "EffectiveForceTest", "Effective force testing loop (force control, Fig 1a)")
-      .def(py::init([](const Rig& rig, const EftConfig& cfg, std::optional<Rig> model) {
-             return std::make_unique<EffectiveForceTest>(rig, cfg, model ? &*model : nullptr);
-           }),
-           py::arg("rig"), py::arg("config"), py::arg("model") = py::none())
+      .def(py::init<const Rig&, const EftConfig&, const std::optional<Rig>&>(), py::arg("rig"), py::arg("config"),
+           py::arg("model") = py::none())
       .def("reset", &EffectiveForceTest::reset)
       .def(
           "step",
@@ -134,12 +149,14 @@ void expose_loops(py::module_& m) {
               py::gil_scoped_release release;
               sum = run_eft(t, a, n, rows.data());
             }
-            return py::make_tuple(to_dict(rows, sum.rows, kEftFields), sum);
+            return py::make_tuple(to_dict(rows, sum.rows, kEftChannels), sum);
           },
           py::arg("ground_acceleration"),
           "Runs one sample per element from the current state; returns (channels dict, RunSummary). Releases the GIL.")
       .def_property_readonly("plant", &EffectiveForceTest::plant, py::return_value_policy::reference_internal)
       .def_property_readonly("compensator", &EffectiveForceTest::compensator,
+                             py::return_value_policy::reference_internal)
+      .def_property_readonly("controller", &EffectiveForceTest::controller,
                              py::return_value_policy::reference_internal);
 
   // --- RPsD ------------------------------------------------------------------
@@ -148,18 +165,15 @@ void expose_loops(py::module_& m) {
       .value("MeasuredDisplacement", RestoringForce::MeasuredDisplacement)
       .value("MeasuredForce", RestoringForce::MeasuredForce)
       .value("MeasuredForceCorrected", RestoringForce::MeasuredForceCorrected);
-  py::enum_<SolverKind>(m, "SolverKind")
-      .value("CentralDifference", SolverKind::CentralDifference)
-      .value("ExplicitNewmark", SolverKind::ExplicitNewmark);
   py::enum_<ForceMeasurement>(m, "ForceMeasurement")
       .value("LoadCell", ForceMeasurement::LoadCell)
       .value("ActuatorPressure", ForceMeasurement::ActuatorPressure);
-  py::class_<RpsdConfig>(m, "RpsdConfig")
-      .def(py::init<>())
+  py::class_<RpsdConfig> rpsd_config(m, "RpsdConfig");
+  rpsd_config.def(py::init<>())
       .def_readwrite("dt", &RpsdConfig::dt)
       .def_readwrite("model", &RpsdConfig::model)
       .def_readwrite("k_m", &RpsdConfig::k_m)
-      .def_readwrite("solver", &RpsdConfig::solver)
+      .def_readwrite("scheme", &RpsdConfig::scheme)
       .def_readwrite("restoring_force", &RpsdConfig::restoring_force)
       .def_readwrite("force_measurement", &RpsdConfig::force_measurement)
       .def_readwrite("amplitude_T", &RpsdConfig::amplitude_T)
@@ -171,6 +185,9 @@ void expose_loops(py::module_& m) {
       .def_readwrite("compute_delay", &RpsdConfig::compute_delay)
       .def_readwrite("plant_options", &RpsdConfig::plant_options)
       .def("validate", &RpsdConfig::validate);
+  add_protocol(rpsd_config, {"dt", "model", "k_m", "scheme", "restoring_force", "force_measurement", "amplitude_T",
+                             "delay_T", "alpha", "physical_mass_fraction", "subtract_mass", "subtract_damping",
+                             "compute_delay", "plant_options"});
   py::class_<RpsdOutput>(m, "RpsdOutput")
       .def_readonly("plant", &RpsdOutput::plant)
       .def_readonly("ground_acceleration", &RpsdOutput::ground_acceleration)
@@ -182,6 +199,29 @@ void expose_loops(py::module_& m) {
       .def_readonly("calc_acceleration", &RpsdOutput::calc_acceleration)
       .def_readonly("target_displacement", &RpsdOutput::target_displacement)
       .def_readonly("command", &RpsdOutput::command);
+  m.attr("RPSD_CHANNELS") = channel_table(kRpsdChannels);
+  py::class_<RpsdController>(m, "RpsdController",
+                             "RPsD controller (Figs 1b, 7): sensors at t_k, a_g, P_ext -> displacement command [m]")
+      .def(py::init<const RpsdConfig&, const Rig&>(), py::arg("config"), py::arg("physical"))
+      .def("reset", &RpsdController::reset)
+      .def("command",
+           [](RpsdController& c, const Output& s, double ag, double pe, double fe) { return c.command(s, ag, pe, fe); },
+           py::arg("sensors"), py::arg("ground_acceleration"), py::arg("external_force") = 0.0,
+           py::arg("restoring_force_error") = 0.0)
+      .def(
+          "command_output",
+          [](RpsdController& c, const Output& s, double ag, double pe, double fe) {
+            RpsdOutput o;
+            c.command(s, ag, pe, fe, &o);
+            return o;
+          },
+          py::arg("sensors"), py::arg("ground_acceleration"), py::arg("external_force") = 0.0,
+          py::arg("restoring_force_error") = 0.0, "As command(), returning every channel (RpsdOutput)")
+      .def_property_readonly("config", &RpsdController::config)
+      .def_property_readonly("integrator_state", &RpsdController::integrator_state)
+      .def_property_readonly("k_m", &RpsdController::k_m)
+      .def_property_readonly("subtract_mass", &RpsdController::subtract_mass)
+      .def_property_readonly("subtract_damping", &RpsdController::subtract_damping);
   py::class_<RealTimePseudoDynamicTest>(m, "RealTimePseudoDynamicTest",
                                         "Real-time pseudodynamic testing loop (displacement control, Figs 1b, 7)")
       .def(py::init<const Rig&, const RpsdConfig&>(), py::arg("rig"), py::arg("config"))
@@ -208,13 +248,17 @@ void expose_loops(py::module_& m) {
               py::gil_scoped_release release;
               sum = run_rpsd(t, a, pp, pf, n, rows.data());
             }
-            return py::make_tuple(to_dict(rows, sum.rows, kRpsdFields), sum);
+            return py::make_tuple(to_dict(rows, sum.rows, kRpsdChannels), sum);
           },
           py::arg("ground_acceleration"), py::arg("external_force") = py::none(),
           py::arg("restoring_force_error") = py::none(),
           "Runs one sample per element from the current state; returns (channels dict, RunSummary). Releases the GIL.")
       .def_property_readonly("plant", &RealTimePseudoDynamicTest::plant, py::return_value_policy::reference_internal)
-      .def_property_readonly("solver_state", &RealTimePseudoDynamicTest::solver_state)
+      .def_property_readonly("controller", &RealTimePseudoDynamicTest::controller,
+                             py::return_value_policy::reference_internal)
+      .def_property_readonly("integrator_state", &RealTimePseudoDynamicTest::integrator_state)
+      .def_static("physical_rig", &RealTimePseudoDynamicTest::physical_rig, py::arg("rig"), py::arg("config"),
+                  "The rig the plant simulates: rig with m = physical_mass_fraction * m_m")
       .def_property_readonly("k_m", &RealTimePseudoDynamicTest::k_m)
       .def_property_readonly("subtract_mass", &RealTimePseudoDynamicTest::subtract_mass)
       .def_property_readonly("subtract_damping", &RealTimePseudoDynamicTest::subtract_damping);

@@ -1,11 +1,51 @@
+#include <string>
+#include <vector>
+
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include "servohydraulics/presets.hpp"
+#include "protocol.hpp"
+#include "servohydraulics/parameters.hpp"
 #include "servohydraulics/rig.hpp"
+#include "servohydraulics/zhao2003.hpp"
 
 namespace py = pybind11;
 using namespace servohydraulics;
+using servohydraulics::bindings::add_protocol;
+
+namespace {
+// _core.RIG_PARAMETERS: one dict per row of kRigParameters, with the default
+// (Rig's, i.e. the calibrated preset's) and the bound as text.
+py::list rig_parameters() {
+  const Rig d;
+  py::list out;
+  for (const ParameterInfo& p : kRigParameters) {
+    py::dict row;
+    row["section"] = p.section;
+    row["key"] = p.key;
+    row["unit"] = p.unit;
+    row["doc"] = p.doc;
+    row["source"] = p.source;
+    row["default"] = d.*p.member;
+    row["bound"] = bound_text(p.bound);
+    out.append(row);
+  }
+  return out;
+}
+
+py::list effects_table() {
+  const Effects d;
+  py::list out;
+  for (const EffectInfo& e : kEffects) {
+    py::dict row;
+    row["key"] = e.key;
+    row["doc"] = e.doc;
+    row["default"] = d.*e.member;
+    out.append(row);
+  }
+  return out;
+}
+}  // namespace
 
 void expose_rig(py::module_& m) {
   py::class_<FlowCurve> fc(m, "FlowCurve", "Normalised flow-spool opening curve g(x_v) of Fig 4(a)");
@@ -19,55 +59,45 @@ void expose_rig(py::module_& m) {
       .def("slope", &FlowCurve::slope, py::arg("x"))
       .def("inverse", &FlowCurve::inverse, py::arg("q"))
       .def("validate", &FlowCurve::validate);
+  add_protocol(fc, {"kind", "b", "opening", "flow"});
 
-  py::class_<Effects>(m, "Effects", "Switches of the physical effects")
-      .def(py::init<>())
-      .def_readwrite("servovalve_dynamics", &Effects::servovalve_dynamics)
-      .def_readwrite("load_pressure", &Effects::load_pressure)
-      .def_readwrite("flow_nonlinearity", &Effects::flow_nonlinearity)
-      .def_readwrite("coulomb_friction", &Effects::coulomb_friction)
-      .def_readwrite("spring_softening", &Effects::spring_softening)
-      .def_readwrite("piston_mass", &Effects::piston_mass)
-      .def_readwrite("drive_saturation", &Effects::drive_saturation)
-      .def_readwrite("spool_saturation", &Effects::spool_saturation)
-      .def_readwrite("lugre_friction", &Effects::lugre_friction);
+  py::class_<Effects> effects(m, "Effects", "Switches of the physical effects");
+  effects.def(py::init<>());
+  std::vector<std::string> effect_names;
+  for (const EffectInfo& e : kEffects) {
+    effects.def_readwrite(e.key, e.member, e.doc);
+    effect_names.emplace_back(e.key);
+  }
+  add_protocol(effects, effect_names);
+  m.attr("EFFECTS") = effects_table();
 
-  py::class_<Rig>(m, "Rig", "Parameters of the rig, SI units, named after the paper's symbols")
-      .def(py::init<>())
-      .def_readwrite("m", &Rig::m)
-      .def_readwrite("c", &Rig::c)
-      .def_readwrite("k", &Rig::k)
-      .def_readwrite("k_2", &Rig::k_2)
-      .def_readwrite("x_contact", &Rig::x_contact)
-      .def_readwrite("F_c", &Rig::F_c)
-      .def_readwrite("v_stick", &Rig::v_stick)
-      .def_readwrite("stribeck_ratio", &Rig::stribeck_ratio)
-      .def_readwrite("v_s", &Rig::v_s)
-      .def_readwrite("sigma_0", &Rig::sigma_0)
-      .def_readwrite("sigma_1", &Rig::sigma_1)
-      .def_readwrite("m_p", &Rig::m_p)
-      .def_readwrite("A", &Rig::A)
-      .def_readwrite("K_a", &Rig::K_a)
-      .def_readwrite("C_l", &Rig::C_l)
-      .def_readwrite("p_s", &Rig::p_s)
-      .def_readwrite("F_cap", &Rig::F_cap)
-      .def_readwrite("stroke", &Rig::stroke)
-      .def_readwrite("K_v", &Rig::K_v)
-      .def_readwrite("K_s", &Rig::K_s)
-      .def_readwrite("f_v", &Rig::f_v)
-      .def_readwrite("zeta_v", &Rig::zeta_v)
-      .def_readwrite("x_v_max", &Rig::x_v_max)
-      .def_readwrite("flow_curve", &Rig::flow_curve)
-      .def_readwrite("C_F_disp", &Rig::C_F_disp)
-      .def_readwrite("C_F_force", &Rig::C_F_force)
-      .def_readwrite("G_p", &Rig::G_p)
-      .def_readwrite("G_d", &Rig::G_d)
-      .def_readwrite("v_max", &Rig::v_max)
+  py::class_<Rig> rig(m, "Rig", "Parameters of the rig, SI units, named after the paper's symbols");
+  rig.def(py::init<>());
+  std::vector<std::string> rig_names;
+  for (const ParameterInfo& p : kRigParameters) {
+    rig.def_readwrite(p.key, p.member, p.doc);
+    rig_names.emplace_back(p.key);
+  }
+  rig.def_readwrite("flow_curve", &Rig::flow_curve)
       .def_readwrite("effects", &Rig::effects)
       .def("validate", &Rig::validate);
+  rig_names.emplace_back("flow_curve");
+  rig_names.emplace_back("effects");
+  add_protocol(rig, rig_names);
+  m.attr("RIG_PARAMETERS") = rig_parameters();
 
   py::enum_<Zhao2003Variant>(m, "Zhao2003Variant")
       .value("Calibrated", Zhao2003Variant::Calibrated)
       .value("Printed", Zhao2003Variant::Printed);
+  py::class_<Zhao2003TestMethods>(m, "Zhao2003TestMethods",
+                                  "Constants of the paper's test methods (Table I and text), SI")
+      .def(py::init<>())
+      .def_readonly("dt", &Zhao2003TestMethods::dt)
+      .def_readonly("eft_lead_T", &Zhao2003TestMethods::eft_lead_T)
+      .def_readonly("amplitude_T", &Zhao2003TestMethods::amplitude_T)
+      .def_readonly("delay_T", &Zhao2003TestMethods::delay_T)
+      .def_readonly("alpha", &Zhao2003TestMethods::alpha)
+      .def_readonly("model", &Zhao2003TestMethods::model);
+  m.attr("ZHAO2003_TEST_METHODS") = Zhao2003TestMethods{};
   m.def("zhao2003", &zhao2003, py::arg("variant") = Zhao2003Variant::Calibrated, py::arg("actuator_attached") = true);
 }

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
+
+#include "servohydraulics/parameters.hpp"
 
 namespace servohydraulics {
 
@@ -61,14 +64,6 @@ double FlowCurve::inverse(double q) const noexcept {
   return std::copysign(x, q);
 }
 
-FlowCurve zhao2003_flow_curve() {
-  FlowCurve fc;
-  fc.kind = FlowCurve::Kind::Table;
-  fc.opening = {0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.7, 1.0};
-  fc.flow = {0.0, 0.1, 0.19, 0.265, 0.33, 0.385, 0.47, 0.56};
-  return fc;
-}
-
 void FlowCurve::validate() const {
   if (kind == Kind::Rational) {
     require(std::isfinite(b) && b >= 0.0, "flow_curve.b", b, "must be finite and >= 0");
@@ -88,36 +83,31 @@ void FlowCurve::validate() const {
   }
 }
 
+const char* bound_text(Bound b) noexcept {
+  switch (b) {
+    case Bound::Positive: return "finite and > 0";
+    case Bound::NonNegative: return "finite and >= 0";
+    case Bound::AtLeastOne: return "finite and >= 1";
+  }
+  return "";
+}
+
+bool within(Bound b, double v) noexcept {
+  switch (b) {
+    case Bound::Positive: return finite_positive(v);
+    case Bound::NonNegative: return finite_nonneg(v);
+    case Bound::AtLeastOne: return std::isfinite(v) && v >= 1.0;
+  }
+  return false;
+}
+
 void Rig::validate() const {
-  require(finite_positive(m), "m", m, "structure mass must be finite and > 0 [kg]");
-  require(finite_nonneg(c), "c", c, "viscous damping must be finite and >= 0 [N s/m]");
-  require(finite_positive(k), "k", k, "stiffness must be finite and > 0 [N/m]");
-  require(finite_nonneg(k_2), "k_2", k_2, "softened stiffness must be finite and >= 0 [N/m]");
-  require(finite_positive(x_contact), "x_contact", x_contact, "contact displacement must be finite and > 0 [m]");
-  require(finite_nonneg(F_c), "F_c", F_c, "Coulomb friction must be finite and >= 0 [N]");
-  require(finite_positive(v_stick), "v_stick", v_stick, "friction regularisation velocity must be finite and > 0 [m/s]");
-  require(std::isfinite(stribeck_ratio) && stribeck_ratio >= 1.0, "stribeck_ratio", stribeck_ratio,
-          "static to sliding friction ratio F_s / F_c must be finite and >= 1");
-  require(finite_positive(v_s), "v_s", v_s, "Stribeck velocity must be finite and > 0 [m/s]");
-  require(finite_positive(sigma_0), "sigma_0", sigma_0, "LuGre bristle stiffness must be finite and > 0 [N/m]");
-  require(finite_nonneg(sigma_1), "sigma_1", sigma_1, "LuGre bristle damping must be finite and >= 0 [N s/m]");
-  require(finite_nonneg(m_p), "m_p", m_p, "piston mass must be finite and >= 0 [kg]");
-  require(finite_positive(A), "A", A, "piston area must be finite and > 0 [m^2]");
-  require(finite_positive(K_a), "K_a", K_a, "compressibility coefficient must be finite and > 0 [m^5/N]");
-  require(finite_nonneg(C_l), "C_l", C_l, "leakage coefficient must be finite and >= 0 [m^3/(s Pa)]");
-  require(finite_positive(p_s), "p_s", p_s, "supply pressure must be finite and > 0 [Pa]");
-  require(finite_positive(stroke), "stroke", stroke, "actuator half-stroke must be finite and > 0 [m]");
-  require(finite_positive(F_cap), "F_cap", F_cap, "actuator capacity must be finite and > 0 [N]");
-  require(finite_positive(K_v), "K_v", K_v, "flow gain must be finite and > 0 [m^3/s]");
-  require(finite_positive(K_s), "K_s", K_s, "valve gain must be finite and > 0 [1/V]");
-  require(finite_positive(f_v), "f_v", f_v, "servovalve natural frequency must be finite and > 0 [Hz]");
-  require(finite_positive(zeta_v), "zeta_v", zeta_v, "servovalve damping ratio must be finite and > 0");
-  require(finite_positive(x_v_max), "x_v_max", x_v_max, "spool opening limit must be finite and > 0 [-]");
-  require(finite_positive(C_F_disp), "C_F_disp", C_F_disp, "conversion factor must be finite and > 0 [V/m]");
-  require(finite_positive(C_F_force), "C_F_force", C_F_force, "conversion factor must be finite and > 0 [V/N]");
-  require(finite_nonneg(G_p), "G_p", G_p, "proportional gain must be finite and >= 0");
-  require(finite_nonneg(G_d), "G_d", G_d, "derivative gain must be finite and >= 0 [s]");
-  require(finite_positive(v_max), "v_max", v_max, "drive limit must be finite and > 0 [V]");
+  for (const ParameterInfo& p : kRigParameters) {
+    const double v = this->*p.member;
+    if (within(p.bound, v)) continue;
+    const std::string requirement = std::string(p.doc) + " must be " + bound_text(p.bound) + " [" + p.unit + "]";
+    require(false, p.key, v, requirement.c_str());
+  }
   flow_curve.validate();
 }
 

@@ -35,6 +35,7 @@ except ImportError as e:  # pragma: no cover - only without a built core
     ) from e
 
 from ._core import ControlMode, Dynamics, FlowCurve, Plant, SolverOptions  # noqa: E402
+from .controllers import EftController, RpsdController  # noqa: E402
 from .loops import run_eft, run_rpsd, run_tracking  # noqa: E402
 from .records import read_record, write_record  # noqa: E402
 from .response import Response, SimulationError  # noqa: E402
@@ -130,11 +131,15 @@ __all__ = [
     "ControlMode",
     "Diagnosis",
     "Dynamics",
+    "EftController",
+    "EftController",
     "Error",
     "FlowCurve",
     "Plant",
     "Response",
+    "RpsdController",
     "Rig",
+    "RpsdController",
     "SimulationError",
     "SolverOptions",
     "copy_rig",

@@ -14,13 +14,17 @@ The loops run in C++ (``_core.EffectiveForceTest``, ``_core.RealTimePseudoDynami
 this module mirrors loops.hpp); it only builds configurations and wraps the arrays
 in a :class:`~servohydraulics.response.Response`.  The paper's constants (5 ms,
 68 ms, 11.2 ms, alpha = 0.1, 7084 kg, 3.5 kN s/m, 0.5 ms) are the defaults of
-the core's ``EftConfig`` and ``RpsdConfig``: a keyword left at None takes them.
+the core's ``EftConfig`` and ``RpsdConfig`` (``_core.ZHAO2003_TEST_METHODS``,
+zhao2003.hpp): a keyword left at None takes them.  The controllers alone, for
+stepping by hand against a plant or a real rig, are in
+:mod:`servohydraulics.controllers` (``sh.EftController``, ``sh.RpsdController``)
+and are built from the same ``eft_config`` / ``rpsd_config``.
 """
 
 from __future__ import annotations
 
-import copy
 import math
+import warnings
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -28,7 +32,8 @@ from numpy.typing import ArrayLike
 from . import _core
 from .response import Response, finish
 from .rig import Rig
-from .simulate import simulate, solver_options
+from .simulate import simulate
+from .simulate import solver_options as _solver_options
 
 COMPENSATION = {"none": _core.VelocityFeedbackCompensator.Kind.None_,
                 "linear": _core.VelocityFeedbackCompensator.Kind.Linear,
@@ -37,8 +42,8 @@ RESTORING_FORCE = {"calculated_displacement": _core.RestoringForce.CalculatedDis
                    "measured_displacement": _core.RestoringForce.MeasuredDisplacement,
                    "measured_force": _core.RestoringForce.MeasuredForce,
                    "measured_force_corrected": _core.RestoringForce.MeasuredForceCorrected}
-SOLVERS = {"central_difference": _core.SolverKind.CentralDifference,
-           "explicit_newmark": _core.SolverKind.ExplicitNewmark}
+SCHEMES = {"central_difference": _core.IntegrationScheme.CentralDifference,
+           "explicit_newmark": _core.IntegrationScheme.ExplicitNewmark}
 FORCE_MEASUREMENT = {"load_cell": _core.ForceMeasurement.LoadCell,
                      "actuator_pressure": _core.ForceMeasurement.ActuatorPressure}
 
@@ -66,17 +71,48 @@ def _nonneg(name: str, v: float) -> float:
     return float(v)
 
 
+def _renamed(old: str, old_value, new: str, new_value):
+    """The value of a keyword renamed in issue 11; the old name warns (DeprecationWarning)."""
+    if old_value is None:
+        return new_value
+    warnings.warn(f"{old}= is deprecated, use {new}=", DeprecationWarning, stacklevel=3)
+    if new_value is not None:
+        raise ValueError(f"give {new}= or its deprecated alias {old}=, not both")
+    return old_value
+
+
+def _set(cfg: object, **values) -> None:
+    """Set the config fields that were given (None keeps the core's default)."""
+    for name, v in values.items():
+        if v is not None:
+            setattr(cfg, name, v)
+
+
 def _choice(name: str, v: str, table: dict):
     if v not in table:
         raise ValueError(f"invalid {name} = {v!r}: expected one of {sorted(table)}")
     return table[v]
 
 
+def eft_config(dt: float | None = None, compensation: str = "linear", lead_T: float | None = None,
+               alpha: float | None = None, mass: float | None = None, compute_delay: int = 0,
+               solver_options: _core.SolverOptions | None = None) -> _core.EftConfig:
+    """The core's EftConfig (validated); a keyword left at None keeps the core's default
+    (mass: None = the rig's m)."""
+    cfg = _core.EftConfig()
+    _set(cfg, dt=dt, alpha=alpha, mass=mass, plant_options=solver_options)
+    cfg.compensation = _choice("compensation", compensation, COMPENSATION)
+    cfg.lead_T = _nonneg("lead_T", _default(lead_T, cfg, "lead_T"))
+    cfg.compute_delay = int(compute_delay)
+    cfg.validate()
+    return cfg
+
+
 def run_eft(rig: Rig, ground_acceleration: ArrayLike | None = None, effective_force: ArrayLike | None = None,
             dt: float | None = None, compensation: str = "linear", lead_T: float | None = None,
             alpha: float | None = None, mass: float | None = None, compute_delay: int = 0,
-            model: Rig | None = None, options: _core.SolverOptions | None = None,
-            raise_on_failure: bool = True) -> Response:
+            model: Rig | None = None, solver_options: _core.SolverOptions | None = None,
+            raise_on_failure: bool = True, options: _core.SolverOptions | None = None) -> Response:
     """Effective force testing (force control) of ``rig``.
 
     Args:
@@ -90,6 +126,8 @@ def run_eft(rig: Rig, ground_acceleration: ArrayLike | None = None, effective_fo
         mass: m in P_eff = -m a_g [kg] (default rig.m).
         compute_delay: samples of compute delay on the command.
         model: the controller's rig model for the compensator (default: ``rig``).
+        solver_options: the plant's ODE integrator (``solver_options(...)``); ``options=`` is
+            its deprecated alias.
         raise_on_failure: raise SimulationError (with the partial Response) if the loop fails.
 
     Returns:
@@ -99,30 +137,54 @@ def run_eft(rig: Rig, ground_acceleration: ArrayLike | None = None, effective_fo
     """
     if (ground_acceleration is None) == (effective_force is None):
         raise ValueError("give exactly one of ground_acceleration [m/s^2] or effective_force [N]")
-    cfg = _core.EftConfig()
-    cfg.dt = _default(dt, cfg, "dt")
-    cfg.mass = _nonneg("mass", 0.0 if mass is None else mass)
-    m = cfg.mass if cfg.mass > 0 else rig.m
+    opts = _renamed("options", options, "solver_options", solver_options)
+    cfg = eft_config(dt, compensation, lead_T, alpha, mass, compute_delay, opts or _solver_options())
+    m = rig.m if cfg.mass is None else cfg.mass
     ag = (_array("ground_acceleration", ground_acceleration) if effective_force is None
           else -_array("effective_force", effective_force) / m)
-    cfg.compensation = _choice("compensation", compensation, COMPENSATION)
-    cfg.lead_T = _nonneg("lead_T", _default(lead_T, cfg, "lead_T"))
-    cfg.alpha = _default(alpha, cfg, "alpha")
-    cfg.compute_delay = int(compute_delay)
-    cfg.plant_options = options or solver_options()
     test = _core.EffectiveForceTest(rig, cfg, model)
     d, s = test.run(ag)
     return finish(Response(d, kind="eft", mode="force", dt=cfg.dt, rig=rig, work=s), raise_on_failure)
 
 
+def rpsd_config(dt: float | None = None, m_m: float | None = None, c_m: float | None = None,
+                k_m: float | None = None, scheme: str = "central_difference",
+                restoring_force: str = "measured_displacement", amplitude_T: float | None = None,
+                delay_T: float | None = None, alpha: float | None = None, physical_mass_fraction: float = 1.0,
+                force_measurement: str = "load_cell", subtract_mass: float | None = None,
+                subtract_damping: float | None = None, compute_delay: int = 0,
+                solver_options: _core.SolverOptions | None = None) -> _core.RpsdConfig:
+    """The core's RpsdConfig (validated); a keyword left at None keeps the core's default
+    (delay_T: 11.2 ms, or 0 for ``"calculated_displacement"``; k_m, subtract_mass,
+    subtract_damping: None = from the physical rig)."""
+    cfg = _core.RpsdConfig()
+    _set(cfg, dt=dt, alpha=alpha, plant_options=solver_options)
+    cfg.model = _core.ModelSDOF(_default(m_m, cfg.model, "m_m"), _default(c_m, cfg.model, "c_m"))
+    cfg.k_m = None if k_m is None else _nonneg("k_m", k_m)
+    cfg.scheme = _choice("scheme", scheme, SCHEMES)
+    cfg.restoring_force = _choice("restoring_force", restoring_force, RESTORING_FORCE)
+    cfg.force_measurement = _choice("force_measurement", force_measurement, FORCE_MEASUREMENT)
+    cfg.amplitude_T = _nonneg("amplitude_T", _default(amplitude_T, cfg, "amplitude_T"))
+    if delay_T is None and restoring_force == "calculated_displacement":
+        delay_T = 0.0
+    cfg.delay_T = _nonneg("delay_T", _default(delay_T, cfg, "delay_T"))
+    cfg.physical_mass_fraction = physical_mass_fraction
+    cfg.subtract_mass = None if subtract_mass is None else _nonneg("subtract_mass", subtract_mass)
+    cfg.subtract_damping = None if subtract_damping is None else _nonneg("subtract_damping", subtract_damping)
+    cfg.compute_delay = int(compute_delay)
+    cfg.validate()
+    return cfg
+
+
 def run_rpsd(rig: Rig, ground_acceleration: ArrayLike | None = None, external_force: ArrayLike | None = None,
              restoring_force_error: ArrayLike | None = None, dt: float | None = None, m_m: float | None = None,
-             c_m: float | None = None, k_m: float | None = None, solver: str = "central_difference",
+             c_m: float | None = None, k_m: float | None = None, scheme: str | None = None,
              restoring_force: str = "measured_displacement", amplitude_T: float | None = None,
              delay_T: float | None = None, alpha: float | None = None, physical_mass_fraction: float = 1.0,
              force_measurement: str = "load_cell", subtract_mass: float | None = None,
              subtract_damping: float | None = None, compute_delay: int = 0,
-             options: _core.SolverOptions | None = None, raise_on_failure: bool = True) -> Response:
+             solver_options: _core.SolverOptions | None = None, raise_on_failure: bool = True,
+             solver: str | None = None, options: _core.SolverOptions | None = None) -> Response:
     """Real-time pseudodynamic testing (displacement control) of ``rig``.
 
     The solver integrates m_m a + c_m v + f = -m_m a_g + P_ext (Eq 15) online.
@@ -135,7 +197,8 @@ def run_rpsd(rig: Rig, ground_acceleration: ArrayLike | None = None, external_fo
         dt: controller sample time [s] (0.5 ms).
         m_m, c_m: modelled mass [kg] and damping [N s/m] (Table I: 7084 kg, 3.5 kN s/m).
         k_m: stiffness for the displacement-based restoring forces [N/m] (default rig.k).
-        solver: ``"central_difference"`` or ``"explicit_newmark"``.
+        scheme: the Eq (15) integration scheme, ``"central_difference"`` (default) or
+            ``"explicit_newmark"``; ``solver=`` is its deprecated alias.
         restoring_force: ``"calculated_displacement"`` (a), ``"measured_displacement"`` (b),
             ``"measured_force"`` (c) or ``"measured_force_corrected"`` (d: minus m a and c v).
         amplitude_T: amplitude compensation T_d on the command [s] (68 ms; 0 = none).
@@ -145,6 +208,7 @@ def run_rpsd(rig: Rig, ground_acceleration: ArrayLike | None = None, external_fo
         physical_mass_fraction: the rig's structural mass is set to this times m_m (0.02 = 140 kg).
         force_measurement: ``"load_cell"`` or ``"actuator_pressure"`` (p A, includes the piston inertia).
         subtract_mass, subtract_damping: for (d) [kg], [N s/m]; default the physical values.
+        solver_options: the plant's ODE integrator; ``options=`` is its deprecated alias.
         raise_on_failure: raise SimulationError (with the partial Response) if the loop fails.
 
     Returns:
@@ -154,6 +218,8 @@ def run_rpsd(rig: Rig, ground_acceleration: ArrayLike | None = None, external_fo
         restoring_force, calc_displacement, calc_velocity, calc_acceleration,
         target_displacement, command).
     """
+    scheme = _renamed("solver", solver, "scheme", scheme) or "central_difference"
+    opts = _renamed("options", options, "solver_options", solver_options)
     n = None
     for a in (ground_acceleration, external_force, restoring_force_error):
         if a is not None:
@@ -163,34 +229,18 @@ def run_rpsd(rig: Rig, ground_acceleration: ArrayLike | None = None, external_fo
     ag = np.zeros(n) if ground_acceleration is None else _array("ground_acceleration", ground_acceleration, n)
     pe = None if external_force is None else _array("external_force", external_force, n)
     fe = None if restoring_force_error is None else _array("restoring_force_error", restoring_force_error, n)
-    cfg = _core.RpsdConfig()
-    cfg.dt = _default(dt, cfg, "dt")
-    m_m, c_m = _default(m_m, cfg.model, "m_m"), _default(c_m, cfg.model, "c_m")
-    cfg.model = _core.ModelSDOF(m_m, c_m)
-    cfg.k_m = _nonneg("k_m", 0.0 if k_m is None else k_m)
-    cfg.solver = _choice("solver", solver, SOLVERS)
-    cfg.restoring_force = _choice("restoring_force", restoring_force, RESTORING_FORCE)
-    cfg.force_measurement = _choice("force_measurement", force_measurement, FORCE_MEASUREMENT)
-    cfg.amplitude_T = _nonneg("amplitude_T", _default(amplitude_T, cfg, "amplitude_T"))
-    if delay_T is None and restoring_force == "calculated_displacement":
-        delay_T = 0.0
-    cfg.delay_T = _nonneg("delay_T", _default(delay_T, cfg, "delay_T"))
-    cfg.alpha = _default(alpha, cfg, "alpha")
-    cfg.physical_mass_fraction = physical_mass_fraction
-    cfg.subtract_mass = -1.0 if subtract_mass is None else _nonneg("subtract_mass", subtract_mass)
-    cfg.subtract_damping = -1.0 if subtract_damping is None else _nonneg("subtract_damping", subtract_damping)
-    cfg.compute_delay = int(compute_delay)
-    cfg.plant_options = options or solver_options()
+    cfg = rpsd_config(dt, m_m, c_m, k_m, scheme, restoring_force, amplitude_T, delay_T, alpha,
+                      physical_mass_fraction, force_measurement, subtract_mass, subtract_damping, compute_delay,
+                      opts or _solver_options())
     test = _core.RealTimePseudoDynamicTest(rig, cfg)
     d, s = test.run(ag, pe, fe)
-    phys = copy.deepcopy(rig)
-    phys.m = physical_mass_fraction * m_m
+    phys = _core.RealTimePseudoDynamicTest.physical_rig(rig, cfg)
     return finish(Response(d, kind="rpsd", mode="displacement", dt=cfg.dt, rig=phys, work=s), raise_on_failure)
 
 
 def run_tracking(rig: Rig, displacement: ArrayLike, dt: float | None = None, amplitude_T: float | None = None,
-                 alpha: float | None = None, options: _core.SolverOptions | None = None,
-                 raise_on_failure: bool = True) -> Response:
+                 alpha: float | None = None, solver_options: _core.SolverOptions | None = None,
+                 raise_on_failure: bool = True, options: _core.SolverOptions | None = None) -> Response:
     """Displacement control of a given displacement [m] through the amplitude compensation
     (T_d phase lead on the command, Fig 1b / Fig 5b).
 
@@ -198,12 +248,13 @@ def run_tracking(rig: Rig, displacement: ArrayLike, dt: float | None = None, amp
     Returns a Response of kind ``"tracking"`` (the plant's channels; ``command`` is
     the lead-filtered command; ``.warnings()`` reports capacity and supply-pressure limits).
     """
+    opts = _renamed("options", options, "solver_options", solver_options)
     cfg = _core.RpsdConfig()
     dt = _default(dt, cfg, "dt")
     d = _array("displacement", displacement)
     lead = _core.PhaseLead(_nonneg("amplitude_T", _default(amplitude_T, cfg, "amplitude_T")),
                            _default(alpha, cfg, "alpha"), dt)
     lead.reset(float(d[0]))
-    res = simulate(rig, "displacement", lead.filter(d), dt, x0=float(d[0]), options=options, raise_on_failure=False)
+    res = simulate(rig, "displacement", lead.filter(d), dt, x0=float(d[0]), options=opts, raise_on_failure=False)
     out = Response(res.channels, kind="tracking", mode="displacement", dt=dt, rig=rig, work=res.work)
     return finish(out, raise_on_failure)

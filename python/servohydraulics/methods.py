@@ -13,7 +13,7 @@ from .loops import (  # noqa: F401
     COMPENSATION,
     FORCE_MEASUREMENT,
     RESTORING_FORCE,
-    SOLVERS,
+    SCHEMES,
     run_eft,
     run_rpsd,
     run_tracking,

@@ -2,13 +2,15 @@
 
 A rig file is TOML with one table per subsystem and keys named after the
 symbols of Zhao et al. (2003), Table I, in SI units.  Unknown keys are an
-error.  ``PARAMETERS`` is the single list of keys, units and sources; the
+error.  ``PARAMETERS`` (keys, units, sources) and ``EFFECTS`` come from the
+core's one parameter table (``_core.RIG_PARAMETERS``, ``_core.EFFECTS``); the
 README's key table is generated from it (``python -m servohydraulics.rig``).
+``Rig`` has ``==``, ``repr``, ``copy.copy`` and pickle from the binding.
 """
 
 from __future__ import annotations
 
-import copyreg
+import copy
 import math
 import sys
 from dataclasses import dataclass
@@ -37,57 +39,13 @@ class Parameter:
     source: str
 
 
-PARAMETERS: tuple[Parameter, ...] = (
-    Parameter("structure", "m", "kg", "mass of the structure", "Table I (7084 kg)"),
-    Parameter("structure", "c", "N s/m", "viscous damping", "Table I: 2.1 kN s/m attached, 1.1 free"),
-    Parameter("structure", "k", "N/m", "initial stiffness", "Table I; p. 1777: 4 x 175.2 kN/m"),
-    Parameter("structure", "k_2", "N/m", "stiffness beyond +-x_contact", "p. 1777: 350.4 kN/m"),
-    Parameter("structure", "x_contact", "m", "displacement where a spring pair loses contact", "p. 1777: 2.5 cm"),
-    Parameter("structure", "F_c", "N", "Coulomb friction", "Table I: 31.6 N attached, 95.7 N free"),
-    Parameter("structure", "v_stick", "m/s", "friction regularisation: F = g(v) tanh(v/v_stick)",
-              "modelling choice, docs/model.md"),
-    Parameter("structure", "stribeck_ratio", "-", "static to sliding friction F_s/F_c (Stribeck peak; 1: none)",
-              "not in the paper: 1"),
-    Parameter("structure", "v_s", "m/s", "Stribeck velocity", "not in the paper: 0.01 m/s"),
-    Parameter("structure", "sigma_0", "N/m", "LuGre bristle (presliding) stiffness (effects.lugre_friction)",
-              "not in the paper: 1e6 N/m"),
-    Parameter("structure", "sigma_1", "N s/m", "LuGre bristle damping (effects.lugre_friction)",
-              "not in the paper: 0"),
-    Parameter("structure", "m_p", "kg", "actuator piston mass", "p. 1782: 54 kg"),
-    Parameter("actuator", "A", "m^2", "piston area", "Table I: 82.1 cm^2"),
-    Parameter("actuator", "K_a", "m^5/N", "compressibility coefficient V_t/(4 beta_e)",
-              "calibrated, docs/calibration.md"),
-    Parameter("actuator", "C_l", "m^3/(s Pa)", "total flow-pressure (leakage) coefficient",
-              "calibrated, docs/calibration.md"),
-    Parameter("actuator", "p_s", "Pa", "supply pressure", "Table I: 1.7e4 kN/m^2"),
-    Parameter("actuator", "F_cap", "N", "rated actuator capacity (reported when exceeded)", "p. 1777: 170 kN"),
-    Parameter("actuator", "stroke", "m", "half-stroke (reported when exceeded; no end stop modelled)",
-              "C_F = 78.74 V/m: 10 V at 127 mm"),
-    Parameter("servovalve", "K_v", "m^3/s", "main-stage flow gain at null", "Table I: 1.6e-2 m^3/s"),
-    Parameter("servovalve", "K_s", "1/V", "static valve gain 1/k_ev", "Table I: 0.1"),
-    Parameter("servovalve", "f_v", "Hz", "servovalve natural frequency (Eq 2)",
-              "chosen, docs/calibration.md"),
-    Parameter("servovalve", "zeta_v", "-", "servovalve damping ratio (Eq 2)",
-              "chosen: 'highly damped', docs/calibration.md"),
-    Parameter("servovalve", "x_v_max", "-", "spool opening limit (end stops)", "Eq (2): |x_v| <= 1"),
-    Parameter("controller", "C_F_disp", "V/m", "conversion factor, displacement control", "Table I: 78.74 V/m"),
-    Parameter("controller", "C_F_force", "V/N", "conversion factor, force control", "Table I: 0.056 V/kN"),
-    Parameter("controller", "G_p", "-", "proportional gain", "Table I: 0.8059"),
-    Parameter("controller", "G_d", "s", "derivative gain", "Table I: 0.0"),
-    Parameter("controller", "v_max", "V", "valve drive limit", "MTS 407: +-10 V"),
-)
+#: Every numeric key of a rig file, from the core's one table (parameters.hpp:
+#: kRigParameters, which also drives Rig.validate() and the binding).
+PARAMETERS: tuple[Parameter, ...] = tuple(
+    Parameter(p["section"], p["key"], p["unit"], p["doc"], p["source"]) for p in _core.RIG_PARAMETERS)
 
-EFFECTS: tuple[str, ...] = (
-    "servovalve_dynamics",
-    "load_pressure",
-    "flow_nonlinearity",
-    "coulomb_friction",
-    "spring_softening",
-    "piston_mass",
-    "drive_saturation",
-    "spool_saturation",
-    "lugre_friction",
-)
+#: The switches of [effects], from the core's table (parameters.hpp: kEffects).
+EFFECTS: tuple[str, ...] = tuple(e["key"] for e in _core.EFFECTS)
 
 FLOW_CURVE_KEYS = ("kind", "b", "opening", "flow")
 
@@ -197,8 +155,8 @@ def _flow_curve_from_dict(table: Any) -> _core.FlowCurve:
 
 
 def copy_rig(rig: Rig) -> Rig:
-    """An independent copy of a rig."""
-    return rig_from_dict(rig_to_dict(rig))
+    """An independent copy of a rig (``copy.copy(rig)``: every field is a value)."""
+    return copy.copy(rig)
 
 
 def load_rig(path: str | Path) -> Rig:
@@ -244,9 +202,6 @@ def parameter_table() -> str:
                      "switch the effect on/off | |")
     return "\n".join(lines)
 
-
-# Rigs cross process boundaries (sweeps with a process pool or Dask).
-copyreg.pickle(_core.Rig, lambda r: (rig_from_dict, (rig_to_dict(r),)))
 
 if __name__ == "__main__":  # pragma: no cover
     print(parameter_table())

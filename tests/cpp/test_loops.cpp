@@ -8,7 +8,7 @@
 #include "alloc_counter.hpp"
 #include "check.hpp"
 #include "servohydraulics/loops.hpp"
-#include "servohydraulics/presets.hpp"
+#include "servohydraulics/zhao2003.hpp"
 
 using namespace servohydraulics;
 constexpr double kPi = 3.14159265358979323846;
@@ -118,7 +118,7 @@ static void loops_do_not_allocate() {
       RpsdConfig rc;
       rc.plant_options.method = method;
       rc.restoring_force = rf;
-      rc.solver = rf == RestoringForce::MeasuredForce ? SolverKind::ExplicitNewmark : SolverKind::CentralDifference;
+      rc.scheme = rf == RestoringForce::MeasuredForce ? IntegrationScheme::ExplicitNewmark : IntegrationScheme::CentralDifference;
       rc.compute_delay = 1;
       RealTimePseudoDynamicTest rp(rig, rc);
       RpsdOutput ro;

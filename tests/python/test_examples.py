@@ -1,13 +1,16 @@
-"""The examples run: the C++ controller builds against an INSTALLED package
-(cmake --install into a temporary prefix, then find_package(servohydraulics))
-and keeps a 2 kHz loop on the host clock for 1 s; the Python examples run.
+"""The examples run: the C++ examples (01_plant_step, 02_rpsd_controller) build
+against an INSTALLED package (cmake --install into a temporary prefix, then
+find_package(servohydraulics)) and keep a 2 kHz loop on the host clock; the
+Python examples run, the pairs with the same numbers as their C++ twins.
 
 Oracles: the displacement loop is, at 1 Hz, the first-order lag of Eq (13)
 (omega_c = K_v C_F K_s G_p / A), so a 10 mm sine comes out at
 10 mm * omega_c / sqrt(omega^2 + omega_c^2); the load cell then carries
 |k - m omega^2| x (spring and inertia of the structure in phase opposition).
 The C++ program and the Python binding step the same library with the same
-commands, so their physical results agree to the printed digits.
+commands, so their physical results agree to the printed digits.  The RPsD
+pair's oracles: the held displacement P/k of the modelled structure and its
+damped natural frequency sqrt(k/m_m) sqrt(1 - zeta^2) / 2 pi (Eq 15).
 
 The build reuses a configured build tree when one is at hand ($SH_BUILD_DIR,
 $SERVOHYDRAULICS_CORE_DIR or build/ctest of scripts/run.sh test), otherwise
@@ -68,7 +71,7 @@ def _build_tree(cmake: str) -> Path:
 
 
 @pytest.fixture(scope="module")
-def controller(tmp_path_factory) -> Path:
+def cpp_examples(tmp_path_factory) -> Path:
     cmake = shutil.which("cmake")
     if cmake is None:
         pytest.skip("cmake is not installed")
@@ -78,12 +81,17 @@ def controller(tmp_path_factory) -> Path:
     prefix = tmp / "prefix"
     _run([cmake, "--install", str(tree), "--prefix", str(prefix), "--component", "dev"])
     gen = ["-G", "Ninja"] if shutil.which("ninja") else []
-    _run([cmake, "-S", str(EXAMPLES / "cpp"), "-B", str(tmp / "build"), *gen, "-DCMAKE_BUILD_TYPE=Release",
+    _run([cmake, "-S", str(EXAMPLES), "-B", str(tmp / "build"), *gen, "-DCMAKE_BUILD_TYPE=Release",
           f"-DCMAKE_PREFIX_PATH={prefix}", "-DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF"])
     _run([cmake, "--build", str(tmp / "build")])
     cache = (tmp / "build" / "CMakeCache.txt").read_text()
     assert str(prefix) in cache  # found the installed package, not a build tree
-    return tmp / "build" / "controller"
+    return tmp / "build"
+
+
+@pytest.fixture(scope="module")
+def controller(cpp_examples) -> Path:
+    return cpp_examples / "01_plant_step"
 
 
 def test_cpp_controller_keeps_a_2khz_loop_with_sane_physics(controller):
@@ -119,7 +127,7 @@ def run_example(name: str, *args: str) -> str:
     # or a dev build through the caller's PYTHONPATH / SERVOHYDRAULICS_CORE_DIR.
     env = dict(os.environ)
     env["MPLBACKEND"] = "Agg"
-    return _run([sys.executable, str(EXAMPLES / "python" / name), *args], env=env, timeout=120).stdout
+    return _run([sys.executable, str(EXAMPLES / name), *args], env=env, timeout=120).stdout
 
 
 def test_python_plant_step_matches_cpp(controller):
@@ -140,17 +148,37 @@ def g_xu(frequency: float) -> float:
     return abs(gain / ((r.C_l + r.K_a * s) * (r.k + r.c * s + m * s * s) + r.A**2 * s + gain))
 
 
+def test_rpsd_controller_pair_meets_its_oracles_and_agrees(cpp_examples):
+    cpp = parse(_run([str(cpp_examples / "02_rpsd_controller")], timeout=60).stdout)
+    py = parse(run_example("02_rpsd_controller.py"))
+    assert cpp["steps"] == py["steps"] == 10000
+    assert cpp["solver_failures"] == py["solver_failures"] == 0
+    assert 0 <= cpp["deadline_misses"] <= cpp["steps"]
+    assert cpp["step_us_median"] < 500.0  # controller + plant fit the 0.5 ms period
+    # Held: P/k, up to the residual oscillation of the ramp (zeta = 2.5 %) over 1.6 periods.
+    assert cpp["held_displacement_mm"] == pytest.approx(cpp["held_displacement_oracle_mm"], rel=0.05)
+    # Free: the modelled structure's damped frequency, shifted by the loop's residual lag.
+    assert cpp["free_frequency_Hz"] == pytest.approx(cpp["free_frequency_oracle_Hz"], rel=0.03)
+    for key in ("held_displacement_mm", "peak_command_mm", "free_frequency_Hz", "final_calc_displacement_mm"):
+        assert py[key] == pytest.approx(cpp[key], abs=2e-6), key
+
+
+def test_cpp_rpsd_controller_rejects_bad_arguments(cpp_examples):
+    res = subprocess.run([str(cpp_examples / "02_rpsd_controller"), "0"], capture_output=True, text=True, timeout=30)
+    assert res.returncode == 2 and "usage" in res.stderr
+
+
 def test_python_simulate_record_follows_eq12():
-    s = parse(run_example("02_simulate_record.py"))
+    s = parse(run_example("03_simulate_record.py"))
     assert s["amplitude_ratio_0.5Hz"] == pytest.approx(g_xu(0.5), rel=0.02)
     # 5 Hz: the valve lag and the flow/pressure nonlinearities start to show.
     assert s["amplitude_ratio_5Hz"] == pytest.approx(g_xu(5.0), rel=0.1)
 
 
 def test_python_sweep_examples_run():
-    out = run_example("03_sweep_gain_mass.py")
+    out = run_example("04_sweep_gain_mass.py")
     assert "controller.G_p" in out and "structure.m" in out
-    out = run_example("04_uncertainty.py", "4")
+    out = run_example("05_uncertainty.py", "4")
     s = parse(out.replace(" ", "\n"))
     assert s["runs"] == 4
     assert s["min"] <= s["rms_tracking_error_mm_mean"] <= s["max"]

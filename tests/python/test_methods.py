@@ -200,8 +200,8 @@ def test_rpsd_ignoring_piston_mass_slightly_lowers_frequency():
 
 
 def test_rpsd_solvers_agree():
-    a, _, _ = free_vibration(restoring_force="calculated_displacement", solver="central_difference")
-    b, _, _ = free_vibration(restoring_force="calculated_displacement", solver="explicit_newmark")
+    a, _, _ = free_vibration(restoring_force="calculated_displacement", scheme="central_difference")
+    b, _, _ = free_vibration(restoring_force="calculated_displacement", scheme="explicit_newmark")
     assert a.frequency == pytest.approx(b.frequency, rel=1e-3)
     assert a.damping_ratio == pytest.approx(b.damping_ratio, abs=5e-4)
 

@@ -121,9 +121,9 @@ def test_failure_raises_simulation_error_with_the_partial_response(calibrated, r
     """Every runner raises by default; the error carries the status and the rows
     up to the failure, the same rows raise_on_failure=False returns."""
     call = {"simulate": lambda **kw: sh.simulate(calibrated, command=np.full(N, 1e-3), options=_overrun(), **kw),
-            "run_eft": lambda **kw: sh.run_eft(calibrated, ground_acceleration=_ag(), options=_overrun(), **kw),
-            "run_rpsd": lambda **kw: sh.run_rpsd(calibrated, ground_acceleration=_ag(), options=_overrun(), **kw),
-            "run_tracking": lambda **kw: sh.run_tracking(calibrated, np.full(N, 1e-3), options=_overrun(), **kw)}[run]
+            "run_eft": lambda **kw: sh.run_eft(calibrated, ground_acceleration=_ag(), solver_options=_overrun(), **kw),
+            "run_rpsd": lambda **kw: sh.run_rpsd(calibrated, ground_acceleration=_ag(), solver_options=_overrun(), **kw),
+            "run_tracking": lambda **kw: sh.run_tracking(calibrated, np.full(N, 1e-3), solver_options=_overrun(), **kw)}[run]
     with pytest.raises(sh.SimulationError, match=r"failed at t = [0-9.e-]+ s: overrun") as info:
         call()
     err = info.value

@@ -4,7 +4,7 @@ Fig 6b and Eq 13: a higher G_p raises the roll-off frequency, but the largest
 stable G_p decays as the physical mass grows).  Runs in parallel on local processes; pass a Dask
 client's executor instead (``executor=client.get_executor()``) to use a cluster.
 
-    python3 examples/python/03_sweep_gain_mass.py
+    python3 examples/04_sweep_gain_mass.py
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@ certain) parameters, the compressibility K_a and the leakage C_l, +-20 %
 uniform, and what they do to the displacement tracking error of a 1 Hz,
 10 mm sine.
 
-    python3 examples/python/04_uncertainty.py [n = 12]
+    python3 examples/05_uncertainty.py [n = 12]
 """
 
 from __future__ import annotations

@@ -1,6 +1,14 @@
-#include "servohydraulics/presets.hpp"
+#include "servohydraulics/zhao2003.hpp"
 
 namespace servohydraulics {
+
+FlowCurve zhao2003_flow_curve() {
+  FlowCurve fc;
+  fc.kind = FlowCurve::Kind::Table;
+  fc.opening = {0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.7, 1.0};
+  fc.flow = {0.0, 0.1, 0.19, 0.265, 0.33, 0.385, 0.47, 0.56};
+  return fc;
+}
 
 Rig zhao2003(Zhao2003Variant variant, bool actuator_attached) {
   Rig r;  // the defaults of Rig are the calibrated preset, actuator attached

@@ -7,7 +7,7 @@ amplitude ratio of the displacement response to the command over the last
 2 s of each segment: the loop tracks at 0.5 Hz and rolls off above its ~2 Hz
 crossover (Eq 13), and the run's speed as a multiple of real time.
 
-    python3 examples/python/02_simulate_record.py
+    python3 examples/03_simulate_record.py
 """
 
 from __future__ import annotations

@@ -1,8 +1,8 @@
 // A 2 kHz digital controller on the host clock driving the simulated rig: the
 // way the plant is embedded in a real-time loop (pairs with
-// examples/python/01_plant_step.py).
+// examples/01_plant_step.py).
 //
-//   controller [duration_s = 2] [amplitude_m = 0.01] [frequency_Hz = 1] [cvode|rk4]
+//   01_plant_step [duration_s = 2] [amplitude_m = 0.01] [frequency_Hz = 1] [cvode|rk4]
 //
 // Each period: sleep to an absolute deadline (clock_nanosleep, CLOCK_MONOTONIC,
 // TIMER_ABSTIME), read the sensors of the last sample, compute the next
@@ -24,23 +24,18 @@
 #include <string>
 #include <vector>
 
+#include "realtime_clock.hpp"
 #include "servohydraulics/plant.hpp"
-#include "servohydraulics/presets.hpp"
+#include "servohydraulics/zhao2003.hpp"
 
 namespace sh = servohydraulics;
 
 namespace {
-constexpr long kNsPerS = 1000000000L;
+using examples::add_ns;
+using examples::kNsPerS;
+using examples::seconds;
 constexpr double kPi = 3.14159265358979323846;
 
-void add_ns(timespec& t, long ns) {
-  t.tv_nsec += ns;
-  while (t.tv_nsec >= kNsPerS) {
-    t.tv_nsec -= kNsPerS;
-    ++t.tv_sec;
-  }
-}
-double seconds(const timespec& t) { return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec); }
 double percentile(std::vector<double> v, double q) {
   std::sort(v.begin(), v.end());
   const std::size_t i = static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size())));

@@ -1,11 +1,11 @@
 """Step the plant one controller sample at a time, as a controller would
-(the Python pair of examples/cpp/controller.cpp, same rig, same command).
+(the Python pair of examples/01_plant_step.cpp, same rig, same command).
 
 A 10 mm, 1 Hz sine displacement command at 2 kHz for ``duration`` seconds.
 Python does not keep a 2 kHz deadline (no clock_nanosleep loop here): this
 measures the cost of one ``Plant.step`` call through the binding.
 
-    python3 examples/python/01_plant_step.py [duration_s = 2]
+    python3 examples/01_plant_step.py [duration_s = 2]
 """
 
 from __future__ import annotations

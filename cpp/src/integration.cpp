@@ -1,4 +1,4 @@
-#include "servohydraulics/solvers.hpp"
+#include "servohydraulics/integration.hpp"
 
 #include <cmath>
 
@@ -13,13 +13,13 @@ void ModelSDOF::validate() const {
 
 CentralDifference::CentralDifference(const ModelSDOF& model, double dt) : mdl_(model), dt_(dt) {
   mdl_.validate();
-  require(std::isfinite(dt) && dt > 0.0, "dt", dt, "solver time step must be finite and > 0 [s]");
+  require(std::isfinite(dt) && dt > 0.0, "dt", dt, "integration time step must be finite and > 0 [s]");
 }
 
 void CentralDifference::reset(double d0) noexcept {
   d_prev_ = d0;
   started_ = false;
-  s_ = SolverState{};
+  s_ = IntegratorState{};
   s_.displacement = d0;
   s_.next_displacement = d0;
 }
@@ -45,13 +45,13 @@ double CentralDifference::step(double load, double f) noexcept {
 ExplicitNewmark::ExplicitNewmark(const ModelSDOF& model, double dt, double gamma)
     : mdl_(model), dt_(dt), gamma_(gamma) {
   mdl_.validate();
-  require(std::isfinite(dt) && dt > 0.0, "dt", dt, "solver time step must be finite and > 0 [s]");
+  require(std::isfinite(dt) && dt > 0.0, "dt", dt, "integration time step must be finite and > 0 [s]");
   require(std::isfinite(gamma) && gamma >= 0.5 && gamma <= 1.0, "gamma", gamma, "must be in [0.5, 1]");
 }
 
 void ExplicitNewmark::reset(double d0) noexcept {
   first_ = true;
-  s_ = SolverState{};
+  s_ = IntegratorState{};
   s_.displacement = d0;
   s_.next_displacement = d0;
 }

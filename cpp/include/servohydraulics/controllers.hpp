@@ -1,0 +1,194 @@
+// The controller side of the paper's two real-time test methods (Zhao et al.
+// 2003, Figs 1 and 7), apart from the plant: the part a laboratory deploys on its
+// own actuator.  Each controller reads the sensors at t_k and returns the command
+// to hold over [t_k, t_k + dt]:
+//
+//   Output sensors;                 // from the rig's I/O (or Plant::observe/step)
+//   double u = ctrl.command(sensors, ground_acceleration);
+//   // write u to the servo controller; wait for the next sample
+//
+// Construct once (validates, throws Error, allocates the compute-delay buffer);
+// reset() and command() are noexcept and allocation-free.  The simulated loops
+// of loops.hpp are a controller composed with a Plant.
+//
+// Symbols of the phase-lead time constants: Table I and the text of the paper
+// swap T_d and T_ld.  We follow the text: T_d = 68 ms is the amplitude
+// compensation (on the displacement command), T_ld = 11.2 ms the delay
+// compensation (on the restoring force).  The EFT lead is Table I's T_d-hat = 5 ms.
+#pragma once
+
+#include <optional>
+#include <variant>
+
+#include "servohydraulics/compensators.hpp"
+#include "servohydraulics/integration.hpp"
+#include "servohydraulics/plant.hpp"
+#include "servohydraulics/zhao2003.hpp"
+
+namespace servohydraulics {
+
+// ---------------------------------------------------------------------------
+// Effective force testing (force control, Fig 1a)
+// ---------------------------------------------------------------------------
+
+struct EftConfig {
+  double dt = Zhao2003TestMethods{}.dt;  //!< controller sample time [s] (2 kHz DSP)
+  std::optional<double> mass;            //!< m in P_eff = -m a_g [kg]; none = the rig's structural mass
+  VelocityFeedbackCompensator::Kind compensation = VelocityFeedbackCompensator::Kind::Linear;
+  double lead_T = Zhao2003TestMethods{}.eft_lead_T;  //!< phase lead on the compensation [s]; 0 = none
+  double alpha = Zhao2003TestMethods{}.alpha;        //!< phase-lead constant (Table I)
+  int compute_delay = 0;  //!< samples of compute delay on the command (0 or 1 usually)
+  SolverOptions plant_options;  //!< the simulated plant's ODE integrator (loops.hpp only)
+  void validate() const;
+};
+
+//! Every channel of one EFT sample.
+struct EftOutput {
+  Output plant;                      //!< sensors at t_k (force = load cell) [SI]
+  double ground_acceleration = 0.0;  //!< a_g(t_k) [m/s^2]
+  double effective_force = 0.0;      //!< P_eff = -m a_g [N]
+  double compensation = 0.0;         //!< velocity feedback compensation du [N]
+  double compensation_opening = 0.0; //!< nonlinear compensator: total spool opening x_t [-]
+  double command = 0.0;              //!< force command sent to the servo controller [N]
+};
+
+//! A channel of EftOutput beyond the plant's sensors: name, unit, member.
+struct EftChannel {
+  const char* name;
+  const char* unit;
+  double EftOutput::*member;
+};
+inline constexpr EftChannel kEftChannels[] = {
+    {"ground_acceleration", "m/s^2", &EftOutput::ground_acceleration},
+    {"effective_force", "N", &EftOutput::effective_force},
+    {"compensation", "N", &EftOutput::compensation},
+    {"compensation_opening", "-", &EftOutput::compensation_opening},
+    {"command", "N", &EftOutput::command},
+};
+
+//! The EFT controller: P_eff = -m a_g plus the velocity feedback compensation
+//! (Eqs 9-10), through the optional compute delay.
+class EftController {
+ public:
+  //! model: the controller's model of the rig, used by the compensator (A, K_v,
+  //! K_s, C_F_force, G_p, flow curve and pressure factor) and, when
+  //! config.mass is none, for m in P_eff = -m a_g.  config.plant_options is unused.
+  EftController(const EftConfig& config, const Rig& model);
+
+  void reset() noexcept;  //!< at rest
+  //! sensors at t_k (velocity, load-cell force, pressure are read), a_g(t_k)
+  //! [m/s^2]; returns the force command [N] to hold until t_{k+1}.  out, if
+  //! given, receives every channel of the sample (out->plant = sensors).
+  double command(const Output& sensors, double ground_acceleration, EftOutput* out = nullptr) noexcept;
+
+  const EftConfig& config() const noexcept { return cfg_; }
+  double mass() const noexcept { return mass_; }  //!< m in P_eff [kg]
+  const VelocityFeedbackCompensator& compensator() const noexcept { return vfc_; }
+
+ private:
+  EftConfig cfg_;
+  VelocityFeedbackCompensator vfc_;
+  SampleDelay delay_;
+  double mass_;
+};
+
+// ---------------------------------------------------------------------------
+// Real-time pseudodynamic testing (displacement control, Figs 1b, 7)
+// ---------------------------------------------------------------------------
+
+enum class RestoringForce {
+  CalculatedDisplacement,  //!< (a) f = k_m d_k, the solver's own displacement (Fig 9a)
+  MeasuredDisplacement,    //!< (b) f = k_m x_meas (Fig 7a, Figs 8, 9b)
+  MeasuredForce,           //!< (c) f = F_meas directly (Fig 10b, c)
+  MeasuredForceCorrected,  //!< (d) f = F_meas - m_s a_meas - c_s v_meas (Fig 7b)
+};
+enum class ForceMeasurement {
+  LoadCell,          //!< the plant's load cell between piston and structure
+  ActuatorPressure,  //!< p A, the force on the piston (includes the piston's inertia: the paper's "pA")
+};
+
+struct RpsdConfig {
+  double dt = Zhao2003TestMethods{}.dt;     //!< controller sample time [s]
+  ModelSDOF model = Zhao2003TestMethods{}.model;  //!< m_m, c_m of Eq (15) (Table I)
+  std::optional<double> k_m;                //!< stiffness for options (a), (b) [N/m]; none = the physical rig's k
+  IntegrationScheme scheme = IntegrationScheme::CentralDifference;  //!< integrates Eq (15) online
+  RestoringForce restoring_force = RestoringForce::MeasuredDisplacement;
+  ForceMeasurement force_measurement = ForceMeasurement::LoadCell;
+  double amplitude_T = Zhao2003TestMethods{}.amplitude_T;  //!< amplitude compensation T_d on the command [s]; 0 = none
+  double delay_T = Zhao2003TestMethods{}.delay_T;  //!< delay compensation T_ld on the restoring force [s]; 0 = none
+  double alpha = Zhao2003TestMethods{}.alpha;      //!< phase-lead constant of both networks
+  double physical_mass_fraction = 1.0;  //!< simulation (loops.hpp): the plant's structural mass = fraction * m_m
+  std::optional<double> subtract_mass;  //!< (d): mass times measured acceleration removed [kg]; none = the physical mass behind the force measurement
+  std::optional<double> subtract_damping;  //!< (d): damping times measured velocity removed [N s/m]; none = the physical rig's c
+  int compute_delay = 0;                //!< samples of compute delay on the command
+  SolverOptions plant_options;          //!< the simulated plant's ODE integrator (loops.hpp only)
+  void validate() const;
+};
+
+//! Every channel of one RPsD sample.
+struct RpsdOutput {
+  Output plant;                        //!< sensors at t_k
+  double ground_acceleration = 0.0;    //!< a_g [m/s^2]
+  double external_force = 0.0;         //!< P_ext into the solver [N] (Fig 9 ramp)
+  double measured_restoring_force = 0.0;  //!< f from the chosen option, before delay compensation [N]
+  double restoring_force = 0.0;        //!< f used by the solver: after delay compensation, plus the error input [N]
+  double calc_displacement = 0.0;      //!< solver d_k [m]
+  double calc_velocity = 0.0;          //!< solver v_k [m/s]
+  double calc_acceleration = 0.0;      //!< solver a_k [m/s^2]
+  double target_displacement = 0.0;    //!< d_{k+1} [m]
+  double command = 0.0;                //!< displacement command after amplitude compensation (and compute delay) [m]
+};
+
+//! A channel of RpsdOutput beyond the plant's sensors: name, unit, member.
+struct RpsdChannel {
+  const char* name;
+  const char* unit;
+  double RpsdOutput::*member;
+};
+inline constexpr RpsdChannel kRpsdChannels[] = {
+    {"ground_acceleration", "m/s^2", &RpsdOutput::ground_acceleration},
+    {"external_force", "N", &RpsdOutput::external_force},
+    {"measured_restoring_force", "N", &RpsdOutput::measured_restoring_force},
+    {"restoring_force", "N", &RpsdOutput::restoring_force},
+    {"calc_displacement", "m", &RpsdOutput::calc_displacement},
+    {"calc_velocity", "m/s", &RpsdOutput::calc_velocity},
+    {"calc_acceleration", "m/s^2", &RpsdOutput::calc_acceleration},
+    {"target_displacement", "m", &RpsdOutput::target_displacement},
+    {"command", "m", &RpsdOutput::command},
+};
+
+//! The RPsD controller: the restoring force from the sensors (options a-d), the
+//! delay compensation T_ld on it, the Eq (15) integration scheme, and the
+//! amplitude compensation T_d on the displacement command.
+class RpsdController {
+ public:
+  //! physical: the rig under test as built (its m is the structural mass behind
+  //! the load cell).  The controller reads from it only what its defaults need:
+  //! k (k_m), m, m_p and effects.piston_mass (subtract_mass), c
+  //! (subtract_damping) and A (force from the actuator pressure, p A).
+  //! config.physical_mass_fraction and plant_options are unused here.
+  RpsdController(const RpsdConfig& config, const Rig& physical);
+
+  void reset() noexcept;  //!< at rest, solver at d = 0
+  //! sensors at t_k, a_g [m/s^2], external force P_ext into the solver [N],
+  //! restoring_force_error added to f [N]; returns the displacement command [m]
+  //! to hold until t_{k+1}.  out, if given, receives every channel of the sample.
+  double command(const Output& sensors, double ground_acceleration, double external_force = 0.0,
+                 double restoring_force_error = 0.0, RpsdOutput* out = nullptr) noexcept;
+
+  const RpsdConfig& config() const noexcept { return cfg_; }
+  const IntegratorState& integrator_state() const noexcept;
+  double k_m() const noexcept { return k_m_; }
+  double subtract_mass() const noexcept { return m_sub_; }
+  double subtract_damping() const noexcept { return c_sub_; }
+
+ private:
+  double restoring_force(const Output& sensors) const noexcept;
+  RpsdConfig cfg_;
+  std::variant<CentralDifference, ExplicitNewmark> scheme_;
+  PhaseLead amplitude_, delay_comp_;
+  SampleDelay delay_;
+  double k_m_, m_sub_, c_sub_, A_;
+};
+
+}  // namespace servohydraulics

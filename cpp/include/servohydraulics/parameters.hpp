@@ -1,0 +1,101 @@
+// The rig's parameters, one table: section and key of the rig file, unit, meaning,
+// source, the bound that Rig::validate() checks, and the member of Rig.  The
+// bindings (def_readwrite, _core.RIG_PARAMETERS), Python's rig.PARAMETERS, the
+// rig-file reader and the README's key table are all generated from it.
+// Adding a parameter = one field in Rig (rig.hpp) + one row here.
+#pragma once
+
+#include "servohydraulics/rig.hpp"
+
+namespace servohydraulics {
+
+//! What Rig::validate() requires of a parameter (finite, always).
+enum class Bound {
+  Positive,     //!< > 0
+  NonNegative,  //!< >= 0
+  AtLeastOne,   //!< >= 1
+};
+
+struct ParameterInfo {
+  const char* section;  //!< rig-file table: structure, actuator, servovalve, controller
+  const char* key;      //!< the field's name (the paper's symbol)
+  const char* unit;     //!< SI unit
+  const char* doc;      //!< meaning
+  const char* source;   //!< where the default comes from (Table I, page, calibration)
+  Bound bound;          //!< validation
+  double Rig::*member;
+};
+
+inline constexpr ParameterInfo kRigParameters[] = {
+    {"structure", "m", "kg", "mass of the structure", "Table I (7084 kg)", Bound::Positive, &Rig::m},
+    {"structure", "c", "N s/m", "viscous damping", "Table I: 2.1 kN s/m attached, 1.1 free", Bound::NonNegative,
+     &Rig::c},
+    {"structure", "k", "N/m", "initial stiffness", "Table I; p. 1777: 4 x 175.2 kN/m", Bound::Positive, &Rig::k},
+    {"structure", "k_2", "N/m", "stiffness beyond +-x_contact", "p. 1777: 350.4 kN/m", Bound::NonNegative,
+     &Rig::k_2},
+    {"structure", "x_contact", "m", "displacement where a spring pair loses contact", "p. 1777: 2.5 cm",
+     Bound::Positive, &Rig::x_contact},
+    {"structure", "F_c", "N", "Coulomb friction", "Table I: 31.6 N attached, 95.7 N free", Bound::NonNegative,
+     &Rig::F_c},
+    {"structure", "v_stick", "m/s", "friction regularisation: F = g(v) tanh(v/v_stick)",
+     "modelling choice, docs/model.md", Bound::Positive, &Rig::v_stick},
+    {"structure", "stribeck_ratio", "-", "static to sliding friction F_s/F_c (Stribeck peak; 1: none)",
+     "not in the paper: 1", Bound::AtLeastOne, &Rig::stribeck_ratio},
+    {"structure", "v_s", "m/s", "Stribeck velocity", "not in the paper: 0.01 m/s", Bound::Positive, &Rig::v_s},
+    {"structure", "sigma_0", "N/m", "LuGre bristle (presliding) stiffness (effects.lugre_friction)",
+     "not in the paper: 1e6 N/m", Bound::Positive, &Rig::sigma_0},
+    {"structure", "sigma_1", "N s/m", "LuGre bristle damping (effects.lugre_friction)", "not in the paper: 0",
+     Bound::NonNegative, &Rig::sigma_1},
+    {"structure", "m_p", "kg", "actuator piston mass", "p. 1782: 54 kg", Bound::NonNegative, &Rig::m_p},
+    {"actuator", "A", "m^2", "piston area", "Table I: 82.1 cm^2", Bound::Positive, &Rig::A},
+    {"actuator", "K_a", "m^5/N", "compressibility coefficient V_t/(4 beta_e)", "calibrated, docs/calibration.md",
+     Bound::Positive, &Rig::K_a},
+    {"actuator", "C_l", "m^3/(s Pa)", "total flow-pressure (leakage) coefficient", "calibrated, docs/calibration.md",
+     Bound::NonNegative, &Rig::C_l},
+    {"actuator", "p_s", "Pa", "supply pressure", "Table I: 1.7e4 kN/m^2", Bound::Positive, &Rig::p_s},
+    {"actuator", "F_cap", "N", "rated actuator capacity (reported when exceeded)", "p. 1777: 170 kN",
+     Bound::Positive, &Rig::F_cap},
+    {"actuator", "stroke", "m", "half-stroke (reported when exceeded; no end stop modelled)",
+     "C_F = 78.74 V/m: 10 V at 127 mm", Bound::Positive, &Rig::stroke},
+    {"servovalve", "K_v", "m^3/s", "main-stage flow gain at null", "Table I: 1.6e-2 m^3/s", Bound::Positive,
+     &Rig::K_v},
+    {"servovalve", "K_s", "1/V", "static valve gain 1/k_ev", "Table I: 0.1", Bound::Positive, &Rig::K_s},
+    {"servovalve", "f_v", "Hz", "servovalve natural frequency (Eq 2)", "chosen, docs/calibration.md",
+     Bound::Positive, &Rig::f_v},
+    {"servovalve", "zeta_v", "-", "servovalve damping ratio (Eq 2)", "chosen: 'highly damped', docs/calibration.md",
+     Bound::Positive, &Rig::zeta_v},
+    {"servovalve", "x_v_max", "-", "spool opening limit (end stops)", "Eq (2): |x_v| <= 1", Bound::Positive,
+     &Rig::x_v_max},
+    {"controller", "C_F_disp", "V/m", "conversion factor, displacement control", "Table I: 78.74 V/m",
+     Bound::Positive, &Rig::C_F_disp},
+    {"controller", "C_F_force", "V/N", "conversion factor, force control", "Table I: 0.056 V/kN", Bound::Positive,
+     &Rig::C_F_force},
+    {"controller", "G_p", "-", "proportional gain", "Table I: 0.8059", Bound::NonNegative, &Rig::G_p},
+    {"controller", "G_d", "s", "derivative gain", "Table I: 0.0", Bound::NonNegative, &Rig::G_d},
+    {"controller", "v_max", "V", "valve drive limit", "MTS 407: +-10 V", Bound::Positive, &Rig::v_max},
+};
+
+struct EffectInfo {
+  const char* key;  //!< the switch's name in [effects] of a rig file
+  const char* doc;  //!< what it switches
+  bool Effects::*member;
+};
+
+inline constexpr EffectInfo kEffects[] = {
+    {"servovalve_dynamics", "Eq (2) second-order valve; off: static valve (Eq 6)", &Effects::servovalve_dynamics},
+    {"load_pressure", "square-root load-pressure term of Eq (3); off: Eq (7)", &Effects::load_pressure},
+    {"flow_nonlinearity", "flow gain falling with opening (Fig 4a); off: g(x) = x", &Effects::flow_nonlinearity},
+    {"coulomb_friction", "F_c term of Eq (5)", &Effects::coulomb_friction},
+    {"spring_softening", "stiffness k_2 beyond +-x_contact", &Effects::spring_softening},
+    {"piston_mass", "piston mass m_p moves with the structure", &Effects::piston_mass},
+    {"drive_saturation", "valve drive limited to +-v_max", &Effects::drive_saturation},
+    {"spool_saturation", "spool opening limited to +-x_v_max", &Effects::spool_saturation},
+    {"lugre_friction", "LuGre presliding friction instead of the static law", &Effects::lugre_friction},
+};
+
+//! The requirement of a bound, for messages and docs: "finite and > 0".
+const char* bound_text(Bound b) noexcept;
+//! Whether v meets the bound (finite, and the bound).
+bool within(Bound b, double v) noexcept;
+
+}  // namespace servohydraulics

@@ -1,0 +1,154 @@
+#include "servohydraulics/controllers.hpp"
+
+#include <cmath>
+
+namespace servohydraulics {
+
+namespace {
+void require_dt(double dt) {
+  require(std::isfinite(dt) && dt > 0.0, "dt", dt, "controller sample time must be finite and > 0 [s]");
+}
+void require_delay(int n) {
+  require(n >= 0 && n <= 1000, "compute_delay", n, "must be 0..1000 samples");
+}
+void require_lead(double T, const char* field) {
+  require(std::isfinite(T) && T >= 0.0, field, T, "phase-lead time constant must be finite and >= 0 [s]");
+}
+void require_alpha(double alpha) {
+  require(std::isfinite(alpha) && alpha > 0.0 && alpha <= 1.0, "alpha", alpha, "must be in (0, 1]");
+}
+// An optional value, when given, must be finite and >= 0 (> 0 if positive).
+void require_given(const std::optional<double>& v, const char* field, bool positive, const char* requirement) {
+  if (v) require(std::isfinite(*v) && (positive ? *v > 0.0 : *v >= 0.0), field, *v, requirement);
+}
+}  // namespace
+
+// ----------------------------------------------------------------------- EFT
+
+void EftConfig::validate() const {
+  require_dt(dt);
+  require_given(mass, "mass", true, "EFT mass must be finite and > 0 when given (none = rig m) [kg]");
+  require_lead(lead_T, "lead_T");
+  require_alpha(alpha);
+  require_delay(compute_delay);
+  plant_options.validate();
+}
+
+EftController::EftController(const EftConfig& config, const Rig& model)
+    : cfg_((config.validate(), config)),
+      vfc_(model, config.compensation, config.lead_T, config.alpha, config.dt),
+      delay_(config.compute_delay),
+      mass_(config.mass.value_or(model.m)) {
+  reset();
+}
+
+void EftController::reset() noexcept {
+  vfc_.reset();
+  delay_.reset(0.0);
+}
+
+double EftController::command(const Output& s, double ground_acceleration, EftOutput* out) noexcept {
+  const double P = -mass_ * ground_acceleration;  // effective force
+  const double du = vfc_.step(s.velocity, P - s.force, s.pressure);
+  const double u = delay_.step(P + du);
+  if (out) {
+    out->plant = s;
+    out->ground_acceleration = ground_acceleration;
+    out->effective_force = P;
+    out->compensation = du;
+    out->compensation_opening = vfc_.last_opening();
+    out->command = u;
+  }
+  return u;
+}
+
+// ---------------------------------------------------------------------- RPsD
+
+void RpsdConfig::validate() const {
+  require_dt(dt);
+  model.validate();
+  require_given(k_m, "k_m", false, "must be finite and >= 0 when given (none = rig k) [N/m]");
+  require_lead(amplitude_T, "amplitude_T");
+  require_lead(delay_T, "delay_T");
+  require_alpha(alpha);
+  require(std::isfinite(physical_mass_fraction) && physical_mass_fraction > 0.0, "physical_mass_fraction",
+          physical_mass_fraction, "must be finite and > 0");
+  require_given(subtract_mass, "subtract_mass", false,
+                "must be finite and >= 0 when given (none = the physical mass) [kg]");
+  require_given(subtract_damping, "subtract_damping", false,
+                "must be finite and >= 0 when given (none = rig c) [N s/m]");
+  require_delay(compute_delay);
+  plant_options.validate();
+}
+
+namespace {
+std::variant<CentralDifference, ExplicitNewmark> make_scheme(const RpsdConfig& cfg) {
+  cfg.validate();
+  if (cfg.scheme == IntegrationScheme::CentralDifference) return CentralDifference(cfg.model, cfg.dt);
+  return ExplicitNewmark(cfg.model, cfg.dt);
+}
+}  // namespace
+
+RpsdController::RpsdController(const RpsdConfig& config, const Rig& r)
+    : cfg_(config),
+      scheme_(make_scheme(config)),
+      amplitude_(config.amplitude_T, config.alpha, config.dt),
+      delay_comp_(config.delay_T, config.alpha, config.dt),
+      delay_(config.compute_delay) {
+  r.validate();
+  k_m_ = cfg_.k_m.value_or(r.k);
+  // The mass behind the force measurement: the structure, plus the piston when
+  // the measurement is the actuator force pA.
+  const bool piston = cfg_.force_measurement == ForceMeasurement::ActuatorPressure && r.effects.piston_mass;
+  m_sub_ = cfg_.subtract_mass.value_or(r.m + (piston ? r.m_p : 0.0));
+  c_sub_ = cfg_.subtract_damping.value_or(r.c);
+  A_ = r.A;
+  reset();
+}
+
+const IntegratorState& RpsdController::integrator_state() const noexcept {
+  return std::visit([](const auto& s) -> const IntegratorState& { return s.state(); }, scheme_);
+}
+
+void RpsdController::reset() noexcept {
+  std::visit([](auto& s) { s.reset(0.0); }, scheme_);
+  amplitude_.reset(0.0);
+  delay_comp_.reset(0.0);
+  delay_.reset(0.0);
+}
+
+double RpsdController::restoring_force(const Output& s) const noexcept {
+  const double F = cfg_.force_measurement == ForceMeasurement::LoadCell ? s.force : s.pressure * A_;
+  switch (cfg_.restoring_force) {
+    case RestoringForce::CalculatedDisplacement: return k_m_ * integrator_state().next_displacement;  // d_k
+    case RestoringForce::MeasuredDisplacement: return k_m_ * s.displacement;
+    case RestoringForce::MeasuredForce: return F;
+    case RestoringForce::MeasuredForceCorrected: return F - m_sub_ * s.acceleration - c_sub_ * s.velocity;
+  }
+  return 0.0;
+}
+
+double RpsdController::command(const Output& s, double ground_acceleration, double external_force,
+                               double restoring_force_error, RpsdOutput* out) noexcept {
+  const double f = restoring_force(s);
+  const double f_used = delay_comp_.step(f) + restoring_force_error;  // delay compensation T_ld
+  const double load = -cfg_.model.m_m * ground_acceleration + external_force;  // Eq (15)
+  const double d_next = std::visit([&](auto& sc) { return sc.step(load, f_used); }, scheme_);
+  const double u = delay_.step(amplitude_.step(d_next));  // amplitude compensation T_d
+  if (out) {
+    const IntegratorState& st = integrator_state();
+    out->plant = s;
+    out->ground_acceleration = ground_acceleration;
+    out->external_force = external_force;
+    out->measured_restoring_force = f;
+    out->restoring_force = f_used;
+    out->calc_displacement = st.displacement;
+    out->calc_velocity = st.velocity;
+    out->calc_acceleration = st.acceleration;
+    out->target_displacement = d_next;
+    out->command = u;
+  }
+  return u;
+}
+
+}  // namespace servohydraulics
