@@ -28,7 +28,7 @@ std::vector<double> ground_motion(double amplitude, double f, double dt) {
 
 // Every field of the sensors (exact equality: the same arithmetic in the same order).
 bool same(const Output& a, const Output& b) {
-  return a.t == b.t && a.displacement == b.displacement && a.velocity == b.velocity &&
+  return a.time == b.time && a.displacement == b.displacement && a.velocity == b.velocity &&
          a.acceleration == b.acceleration && a.force == b.force && a.pressure == b.pressure && a.spool == b.spool &&
          a.drive == b.drive && a.flow == b.flow && a.flags == b.flags;
 }
