@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "check.hpp"
+#include "same_output.hpp"
 #include "servohydraulics/plant.hpp"
 #include "servohydraulics/presets.hpp"
 #include "servohydraulics/record.hpp"
@@ -19,11 +20,7 @@ namespace {
 constexpr double kDt = 5e-4;
 constexpr int kN = 2000;
 
-bool same(const Output& a, const Output& b) {
-  return a.time == b.time && a.displacement == b.displacement && a.velocity == b.velocity &&
-         a.acceleration == b.acceleration && a.force == b.force && a.pressure == b.pressure && a.spool == b.spool &&
-         a.drive == b.drive && a.flow == b.flow && a.flags == b.flags;
-}
+using sh_test::same;
 
 std::vector<double> command(ControlMode mode) {
   const double amp = mode == ControlMode::Displacement ? 0.02 : 3e4;
