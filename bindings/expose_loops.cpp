@@ -6,6 +6,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "channels_py.hpp"
 #include "protocol.hpp"
 #include "servohydraulics/controllers.hpp"
 #include "servohydraulics/loops.hpp"
@@ -17,37 +18,23 @@ using servohydraulics::bindings::add_protocol;
 namespace {
 using Arr = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-const std::pair<const char*, double Output::*> kPlantFields[] = {
-    {"time", &Output::t},         {"displacement", &Output::displacement}, {"velocity", &Output::velocity},
-    {"acceleration", &Output::acceleration}, {"force", &Output::force},   {"pressure", &Output::pressure},
-    {"spool", &Output::spool},    {"drive", &Output::drive},               {"flow", &Output::flow}};
-
-template <class Row, class Channel, std::size_t N>
-py::dict to_dict(const std::vector<Row>& rows, std::size_t n, const Channel (&extra)[N]) {
+//! Every channel of the loop's rows: the plant's (kPlantChannels of row.plant), flags, then the loop's own table.
+template <class Row, std::size_t N>
+py::dict to_dict(const std::vector<Row>& rows, std::size_t n, const ChannelInfoOf<Row> (&table)[N]) {
   py::dict out;
-  for (const auto& [name, mp] : kPlantFields) {
-    py::array_t<double> a(static_cast<py::ssize_t>(n));
-    double* d = a.mutable_data();
-    for (std::size_t k = 0; k < n; ++k) d[k] = rows[k].plant.*mp;
-    out[name] = a;
-  }
-  py::array_t<std::uint32_t> flags(static_cast<py::ssize_t>(n));
-  for (std::size_t k = 0; k < n; ++k) flags.mutable_data()[k] = rows[k].plant.flags;
-  out["flags"] = flags;
-  for (const auto& ch : extra) {
-    py::array_t<double> a(static_cast<py::ssize_t>(n));
-    double* d = a.mutable_data();
-    for (std::size_t k = 0; k < n; ++k) d[k] = rows[k].*(ch.member);
-    out[ch.name] = a;
-  }
+  sh_py::rows_to_dict(out, kPlantChannels, rows, n, [](const Row& r) -> const Output& { return r.plant; });
+  std::uint32_t* flags = sh_py::add_column<std::uint32_t>(out, "flags", n);
+  for (std::size_t k = 0; k < n; ++k) flags[k] = rows[k].plant.flags;
+  sh_py::rows_to_dict(out, table, rows, n);
   return out;
 }
 
-template <class Channel, std::size_t N>
-py::tuple channel_table(const Channel (&table)[N]) {
-  py::tuple t(N);
-  for (std::size_t i = 0; i < N; ++i) t[i] = py::make_tuple(table[i].name, table[i].unit);
-  return t;
+//! A loop's per-sample struct in Python: .plant, then one read-only attribute per entry of its table.
+template <class Row, std::size_t N>
+void expose_row(py::module_& m, const char* name, const ChannelInfoOf<Row> (&table)[N]) {
+  py::class_<Row> cls(m, name);
+  cls.def_readonly("plant", &Row::plant, "the plant's sensors at t_k (Output)");
+  for (const auto& c : table) cls.def_readonly(c.name, c.member, c.doc);
 }
 
 const double* optional_input(const std::optional<Arr>& a, std::size_t n, const char* name) {
@@ -100,14 +87,8 @@ void expose_loops(py::module_& m) {
       .def_readwrite("plant_options", &EftConfig::plant_options)
       .def("validate", &EftConfig::validate);
   add_protocol(eft_config, {"dt", "mass", "compensation", "lead_T", "alpha", "compute_delay", "plant_options"});
-  py::class_<EftOutput>(m, "EftOutput")
-      .def_readonly("plant", &EftOutput::plant)
-      .def_readonly("ground_acceleration", &EftOutput::ground_acceleration)
-      .def_readonly("effective_force", &EftOutput::effective_force)
-      .def_readonly("compensation", &EftOutput::compensation)
-      .def_readonly("compensation_opening", &EftOutput::compensation_opening)
-      .def_readonly("command", &EftOutput::command);
-  m.attr("EFT_CHANNELS") = channel_table(kEftChannels);
+  expose_row(m, "EftOutput", kEftChannels);
+  m.attr("EFT_CHANNELS") = sh_py::channel_units(kEftChannels);
   py::class_<EftController>(m, "EftController",
                             "EFT controller (Fig 1a): sensors at t_k and a_g -> force command [N]")
       .def(py::init<const EftConfig&, const Rig&>(), py::arg("config"), py::arg("model"))
@@ -188,18 +169,8 @@ void expose_loops(py::module_& m) {
   add_protocol(rpsd_config, {"dt", "model", "k_m", "scheme", "restoring_force", "force_measurement", "amplitude_T",
                              "delay_T", "alpha", "physical_mass_fraction", "subtract_mass", "subtract_damping",
                              "compute_delay", "plant_options"});
-  py::class_<RpsdOutput>(m, "RpsdOutput")
-      .def_readonly("plant", &RpsdOutput::plant)
-      .def_readonly("ground_acceleration", &RpsdOutput::ground_acceleration)
-      .def_readonly("external_force", &RpsdOutput::external_force)
-      .def_readonly("measured_restoring_force", &RpsdOutput::measured_restoring_force)
-      .def_readonly("restoring_force", &RpsdOutput::restoring_force)
-      .def_readonly("calc_displacement", &RpsdOutput::calc_displacement)
-      .def_readonly("calc_velocity", &RpsdOutput::calc_velocity)
-      .def_readonly("calc_acceleration", &RpsdOutput::calc_acceleration)
-      .def_readonly("target_displacement", &RpsdOutput::target_displacement)
-      .def_readonly("command", &RpsdOutput::command);
-  m.attr("RPSD_CHANNELS") = channel_table(kRpsdChannels);
+  expose_row(m, "RpsdOutput", kRpsdChannels);
+  m.attr("RPSD_CHANNELS") = sh_py::channel_units(kRpsdChannels);
   py::class_<RpsdController>(m, "RpsdController",
                              "RPsD controller (Figs 1b, 7): sensors at t_k, a_g, P_ext -> displacement command [m]")
       .def(py::init<const RpsdConfig&, const Rig&>(), py::arg("config"), py::arg("physical"))

@@ -3,6 +3,7 @@
 #include <pybind11/stl.h>
 
 #include "channels_py.hpp"
+#include "protocol.hpp"
 #include "servohydraulics/plant.hpp"
 
 namespace py = pybind11;
@@ -24,9 +25,9 @@ void expose_plant(py::module_& m) {
   m.attr("STATES") = states;
   m.attr("NUM_STATES") = static_cast<int>(kNumStates);
 
-  // Output: one read-only attribute per channel of kPlantChannels ("t" kept as an alias of "time").
+  // Output: one read-only attribute per channel of kPlantChannels, and the flags.
   py::class_<Output> output(m, "Output");
-  output.def(py::init<>()).def_readonly("t", &Output::t).def_readonly("flags", &Output::flags);
+  output.def(py::init<>()).def_readonly("flags", &Output::flags);
   for (const ChannelInfo& c : kPlantChannels) output.def_readonly(c.name, c.member, c.doc);
   m.attr("PLANT_CHANNELS") = sh_py::channel_units(kPlantChannels);
 
@@ -55,6 +56,8 @@ void expose_plant(py::module_& m) {
       .def_readwrite("rk4_h_rho", &SolverOptions::rk4_h_rho)
       .def_readwrite("rk4_v_ref", &SolverOptions::rk4_v_ref)
       .def("validate", &SolverOptions::validate);
+  bindings::add_protocol(so, {"method", "restart", "rtol", "atol_scale", "max_order", "max_steps_per_sample",
+                              "max_internal_step", "rk4_substeps", "rk4_h_rho", "rk4_v_ref"});
 
   py::class_<Status> st(m, "Status");
   py::enum_<Status::Code>(st, "Code")

@@ -9,7 +9,7 @@ namespace {
 void account(RunSummary& sum, const Output& o, double F_cap) noexcept {
   sum.flags_any |= o.flags;
   sum.peak_force = std::fmax(sum.peak_force, std::fabs(o.force));
-  if (sum.first_capacity_time < 0.0 && std::fabs(o.force) > F_cap) sum.first_capacity_time = o.t;
+  if (sum.first_capacity_time < 0.0 && std::fabs(o.force) > F_cap) sum.first_capacity_time = o.time;
 }
 
 EftConfig with_mass(const EftConfig& config, const Rig& rig) {

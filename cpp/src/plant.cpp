@@ -118,7 +118,7 @@ Status Plant::step(double command, Output& out) noexcept {
 }
 
 void Plant::observe(Output& out) const noexcept {
-  out.t = impl_->t;
+  out.time = impl_->t;
   impl_->dyn.outputs(impl_->y.data(), impl_->input, out);
 }
 

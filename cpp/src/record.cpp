@@ -23,7 +23,7 @@ RunSummary run_record(Plant& plant, const double* command, std::size_t n, const 
     put(out.flags, k, o.flags);
     sum.flags_any |= o.flags;
     sum.peak_force = std::fmax(sum.peak_force, std::fabs(o.force));
-    if (sum.first_capacity_time < 0.0 && std::fabs(o.force) > F_cap) sum.first_capacity_time = o.t;
+    if (sum.first_capacity_time < 0.0 && std::fabs(o.force) > F_cap) sum.first_capacity_time = o.time;
     sum.rows = k + 1;
     if (k + 1 == n) break;  // the last command is held but its effect is past the record
     const Status st = plant.step(command[k], o);

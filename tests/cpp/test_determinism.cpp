@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "check.hpp"
+#include "same_output.hpp"
 #include "servohydraulics/plant.hpp"
 #include "servohydraulics/presets.hpp"
 #include "servohydraulics/record.hpp"
@@ -19,11 +20,7 @@ namespace {
 constexpr double kDt = 5e-4;
 constexpr int kN = 2000;
 
-bool same(const Output& a, const Output& b) {
-  return a.t == b.t && a.displacement == b.displacement && a.velocity == b.velocity &&
-         a.acceleration == b.acceleration && a.force == b.force && a.pressure == b.pressure && a.spool == b.spool &&
-         a.drive == b.drive && a.flow == b.flow && a.flags == b.flags;
-}
+using sh_test::same;
 
 std::vector<double> command(ControlMode mode) {
   const double amp = mode == ControlMode::Displacement ? 0.02 : 3e4;
@@ -51,7 +48,7 @@ void check_clock() {
   for (long k = 0; k < n; ++k) ok = plant.step(0.0, o).ok() && ok;
   CHECK(ok);
   CHECK(plant.time() == t0 + static_cast<double>(n) * kDt);
-  CHECK(o.t == plant.time());
+  CHECK(o.time == plant.time());
   CHECK_NEAR(plant.time(), t0 + 3600.0, 1e-10);
   std::printf("clock after %ld samples: %.12f s\n", n, plant.time() - t0);
 }
@@ -100,7 +97,7 @@ int main() {
       CHECK(sum.rows == static_cast<std::size_t>(kN));
       bool rows = true;
       for (int k = 1; k < kN; ++k)
-        rows = rows && x[k] == first[k - 1].displacement && f[k] == first[k - 1].force && t[k] == first[k - 1].t;
+        rows = rows && x[k] == first[k - 1].displacement && f[k] == first[k - 1].force && t[k] == first[k - 1].time;
       CHECK(rows);
       CHECK(t[0] == 0.0 && x[0] == 0.0);
     }

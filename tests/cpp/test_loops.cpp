@@ -158,7 +158,7 @@ static void eft_follows_eq10() {
     const double t = k * ec.dt;
     eft.step(-1e3 * std::sin(w * t) / rig.m, o);  // P_eff = 1 kN sin(w t)
     if (k < 8000) continue;
-    const double s = std::sin(w * o.plant.t), c = std::cos(w * o.plant.t);
+    const double s = std::sin(w * o.plant.time), c = std::cos(w * o.plant.time);
     ss += s * s, sc += s * c, cc += c * c, ys += o.plant.force * s, yc += o.plant.force * c;
   }
   const double det = ss * cc - sc * sc;

@@ -45,7 +45,7 @@ void check_free_vibration(const SolverOptions& opt, double tol, const char* name
   Output o;
   for (int k = 1; k <= n; ++k) {
     CHECK(plant.step(0.0, o).ok());
-    const double t = o.t;
+    const double t = o.time;
     const double exact =
         x0 * std::exp(-zeta * w * t) * (std::cos(wd * t) + zeta / std::sqrt(1.0 - zeta * zeta) * std::sin(wd * t));
     worst = std::fmax(worst, std::fabs(o.displacement - exact));

@@ -10,6 +10,7 @@
 
 #include "alloc_counter.hpp"
 #include "check.hpp"
+#include "same_output.hpp"
 #include "servohydraulics/controllers.hpp"
 #include "servohydraulics/loops.hpp"
 #include "servohydraulics/zhao2003.hpp"
@@ -26,12 +27,7 @@ std::vector<double> ground_motion(double amplitude, double f, double dt) {
   return a;
 }
 
-// Every field of the sensors (exact equality: the same arithmetic in the same order).
-bool same(const Output& a, const Output& b) {
-  return a.t == b.t && a.displacement == b.displacement && a.velocity == b.velocity &&
-         a.acceleration == b.acceleration && a.force == b.force && a.pressure == b.pressure && a.spool == b.spool &&
-         a.drive == b.drive && a.flow == b.flow && a.flags == b.flags;
-}
+using sh_test::same;
 
 // Steps the plant by hand, command(k, sensors) at each sample, and counts the
 // rows where the sensors or the command differ from the runner's rows.

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "check.hpp"
+#include "same_output.hpp"
 #include "servohydraulics/plant.hpp"
 #include "servohydraulics/presets.hpp"
 #include "servohydraulics/record.hpp"
@@ -26,11 +27,7 @@ constexpr double kDt = 5e-4;
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kCvTooMuchWork = -1;  // CV_TOO_MUCH_WORK in cvode/cvode.h
 
-bool same(const Output& a, const Output& b) {
-  return a.t == b.t && a.displacement == b.displacement && a.velocity == b.velocity &&
-         a.acceleration == b.acceleration && a.force == b.force && a.pressure == b.pressure && a.spool == b.spool &&
-         a.drive == b.drive && a.flow == b.flow && a.flags == b.flags;
-}
+using sh_test::same;
 
 // Runs f and returns the Error's message, or "" if nothing was thrown.
 template <class F>
@@ -54,7 +51,7 @@ void overrun() {
   CHECK(st.cvode_flag == kCvTooMuchWork);
   CHECK(st.internal_steps == 1);
   CHECK(st.t > 0.0 && st.t < kDt);  // stopped inside the sample, at the time it reached
-  CHECK(out.t == st.t);
+  CHECK(out.time == st.t);
   CHECK(std::strlen(st.message()) > 10);
   const Status again = plant.step(0.01, out);
   CHECK(again.code == Status::NotReady);

@@ -74,7 +74,7 @@ def test_channel_and_state_tables_name_what_the_core_returns(dt: float) -> None:
     assert list(channels) == names + ["flags", "internal_steps", "rhs_evals"]
     out = plant.observe()
     assert [getattr(out, n) for n in names[1:]] == [channels[n][-1] for n in names[1:]]
-    assert out.time == out.t == channels["time"][-1]
+    assert out.time == channels["time"][-1] and not hasattr(out, "t")  # Output.t was renamed time
     states = [name for name, _ in _core.STATES]
     assert states == list(_core.StateIndex.__members__)
     assert [int(_core.StateIndex.__members__[s]) for s in states] == list(range(_core.NUM_STATES))

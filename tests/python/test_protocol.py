@@ -106,3 +106,16 @@ def test_parameter_table_drives_validation_and_binding():
                 r.validate()
     assert [e["key"] for e in _core.EFFECTS] == list(sh.rig.EFFECTS)
     assert all(getattr(default.effects, e["key"]) == e["default"] for e in _core.EFFECTS)
+
+
+@pytest.mark.parametrize("obj", configs(), ids=lambda o: type(o).__name__)
+def test_protocol_covers_every_writable_field(obj):
+    """The protocol's hand-written field list names every settable attribute of the binding
+    (a field added to the struct and bound but left out of add_protocol would fail here)."""
+    cls = type(obj)
+    writable = [n for n in dir(cls) if isinstance(getattr(cls, n), property) and getattr(cls, n).fset is not None]
+    assert writable
+    state = obj.__getstate__()
+    assert sorted(state) == sorted(writable)
+    text = repr(obj)
+    assert all(f"{n}=" in text for n in writable)

@@ -31,7 +31,7 @@ def by_hand(plant, command) -> dict:
     for k in range(N):
         u = command(k, sensors)
         for name in PLANT_CHANNELS:
-            rows[name][k] = getattr(sensors, "t" if name == "time" else name)
+            rows[name][k] = getattr(sensors, name)
         rows["command"][k] = u
         status, sensors = plant.step(u)
         assert status.ok(), status.message

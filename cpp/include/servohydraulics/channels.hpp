@@ -23,7 +23,7 @@ using ChannelInfo = ChannelInfoOf<Output>;
 enum class Channel : int { Time, Displacement, Velocity, Acceleration, Force, Pressure, Spool, Drive, Flow };
 
 constexpr ChannelInfo kPlantChannels[] = {
-    {"time", "s", "time of the sample", &Output::t},
+    {"time", "s", "time of the sample", &Output::time},
     {"displacement", "m", "structure (and piston) displacement x", &Output::displacement},
     {"velocity", "m/s", "velocity dx/dt", &Output::velocity},
     {"acceleration", "m/s^2", "acceleration d2x/dt2", &Output::acceleration},
@@ -37,7 +37,7 @@ constexpr std::size_t kNumPlantChannels = sizeof(kPlantChannels) / sizeof(kPlant
 
 constexpr const ChannelInfo& channel_info(Channel c) noexcept { return kPlantChannels[static_cast<int>(c)]; }
 
-static_assert(channel_info(Channel::Time).member == &Output::t, "kPlantChannels out of order");
+static_assert(channel_info(Channel::Time).member == &Output::time, "kPlantChannels out of order");
 static_assert(channel_info(Channel::Force).member == &Output::force, "kPlantChannels out of order");
 static_assert(channel_info(Channel::Flow).member == &Output::flow, "kPlantChannels out of order");
 static_assert(static_cast<std::size_t>(Channel::Flow) + 1 == kNumPlantChannels, "Channel and kPlantChannels differ");

@@ -20,6 +20,7 @@
 #include <optional>
 #include <variant>
 
+#include "servohydraulics/channels.hpp"
 #include "servohydraulics/compensators.hpp"
 #include "servohydraulics/integration.hpp"
 #include "servohydraulics/plant.hpp"
@@ -52,18 +53,13 @@ struct EftOutput {
   double command = 0.0;              //!< force command sent to the servo controller [N]
 };
 
-//! A channel of EftOutput beyond the plant's sensors: name, unit, member.
-struct EftChannel {
-  const char* name;
-  const char* unit;
-  double EftOutput::*member;
-};
-inline constexpr EftChannel kEftChannels[] = {
-    {"ground_acceleration", "m/s^2", &EftOutput::ground_acceleration},
-    {"effective_force", "N", &EftOutput::effective_force},
-    {"compensation", "N", &EftOutput::compensation},
-    {"compensation_opening", "-", &EftOutput::compensation_opening},
-    {"command", "N", &EftOutput::command},
+//! The channels of EftOutput beyond the plant's sensors (those are kPlantChannels of .plant).
+inline constexpr ChannelInfoOf<EftOutput> kEftChannels[] = {
+    {"ground_acceleration", "m/s^2", "ground acceleration a_g(t_k)", &EftOutput::ground_acceleration},
+    {"effective_force", "N", "effective force P_eff = -m a_g", &EftOutput::effective_force},
+    {"compensation", "N", "velocity feedback compensation du", &EftOutput::compensation},
+    {"compensation_opening", "-", "nonlinear compensator: total spool opening x_t", &EftOutput::compensation_opening},
+    {"command", "N", "force command sent to the servo controller", &EftOutput::command},
 };
 
 //! The EFT controller: P_eff = -m a_g plus the velocity feedback compensation
@@ -139,22 +135,19 @@ struct RpsdOutput {
   double command = 0.0;                //!< displacement command after amplitude compensation (and compute delay) [m]
 };
 
-//! A channel of RpsdOutput beyond the plant's sensors: name, unit, member.
-struct RpsdChannel {
-  const char* name;
-  const char* unit;
-  double RpsdOutput::*member;
-};
-inline constexpr RpsdChannel kRpsdChannels[] = {
-    {"ground_acceleration", "m/s^2", &RpsdOutput::ground_acceleration},
-    {"external_force", "N", &RpsdOutput::external_force},
-    {"measured_restoring_force", "N", &RpsdOutput::measured_restoring_force},
-    {"restoring_force", "N", &RpsdOutput::restoring_force},
-    {"calc_displacement", "m", &RpsdOutput::calc_displacement},
-    {"calc_velocity", "m/s", &RpsdOutput::calc_velocity},
-    {"calc_acceleration", "m/s^2", &RpsdOutput::calc_acceleration},
-    {"target_displacement", "m", &RpsdOutput::target_displacement},
-    {"command", "m", &RpsdOutput::command},
+//! The channels of RpsdOutput beyond the plant's sensors (those are kPlantChannels of .plant).
+inline constexpr ChannelInfoOf<RpsdOutput> kRpsdChannels[] = {
+    {"ground_acceleration", "m/s^2", "ground acceleration a_g(t_k)", &RpsdOutput::ground_acceleration},
+    {"external_force", "N", "external force P_ext into the solver", &RpsdOutput::external_force},
+    {"measured_restoring_force", "N", "f from the chosen option, before delay compensation",
+     &RpsdOutput::measured_restoring_force},
+    {"restoring_force", "N", "f used by the solver: after delay compensation, plus the error input",
+     &RpsdOutput::restoring_force},
+    {"calc_displacement", "m", "solver displacement d_k", &RpsdOutput::calc_displacement},
+    {"calc_velocity", "m/s", "solver velocity v_k", &RpsdOutput::calc_velocity},
+    {"calc_acceleration", "m/s^2", "solver acceleration a_k", &RpsdOutput::calc_acceleration},
+    {"target_displacement", "m", "solver target d_{k+1}", &RpsdOutput::target_displacement},
+    {"command", "m", "displacement command after amplitude compensation (and compute delay)", &RpsdOutput::command},
 };
 
 //! The RPsD controller: the restoring force from the sensors (options a-d), the

@@ -16,7 +16,7 @@ enum OutputFlag : std::uint32_t {
 
 //! Every channel of the plant at one instant (names and units: channels.hpp).
 struct Output {
-  double t = 0.0;             //!< time [s] (channel "time")
+  double time = 0.0;          //!< time of the sample [s]
   double displacement = 0.0;  //!< x [m]
   double velocity = 0.0;      //!< dx/dt [m/s]
   double acceleration = 0.0;  //!< d2x/dt2 [m/s^2]
