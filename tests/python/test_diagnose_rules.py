@@ -77,7 +77,10 @@ def test_candidate_log_keys() -> None:
     assert fitted["refit"] == {"tried": False, "kept": False}
 
 
-def test_lag1_autocorrelation_of_an_ar1_process() -> None:
+def test_ar1_coefficient_of_an_ar1_process() -> None:
+    """The diagnosis's AR(1) coefficient is identify's lag-1 autocorrelation, clipped to [0, 0.999]."""
+    from servohydraulics.identify import ar1_coefficient, ar1_effective_n, lag1_autocorrelation
+
     rng = np.random.default_rng(5)
     phi, n = 0.6, 200_000
     w = rng.normal(size=n)
@@ -86,6 +89,9 @@ def test_lag1_autocorrelation_of_an_ar1_process() -> None:
     for i in range(1, n):
         e[i] = phi * e[i - 1] + w[i]
     # the estimate's standard deviation is about sqrt((1 - phi^2) / n) = 0.0018
-    assert abs(engine.lag1_autocorrelation(e) - phi) < 0.01
-    assert engine.lag1_autocorrelation(np.cumsum(w)) == 0.999  # a random walk: clipped below 1
-    assert engine.lag1_autocorrelation(np.resize([1.0, -1.0], 100)) == 0.0  # negative: clipped at 0
+    assert abs(ar1_coefficient(e) - phi) < 0.01
+    assert ar1_coefficient(e) == lag1_autocorrelation(e)
+    assert ar1_coefficient(np.cumsum(w)) == 0.999  # a random walk: clipped below 1
+    alternating = np.resize([1.0, -1.0], 100)
+    assert lag1_autocorrelation(alternating) < -0.9 and ar1_coefficient(alternating) == 0.0  # clipped at 0
+    assert ar1_effective_n(1000, 0.6) == pytest.approx(1000 * 0.4 / 1.6)

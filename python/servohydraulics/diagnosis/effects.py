@@ -242,17 +242,12 @@ def _max_stable(rig: Rig, mode: str, key: str, upper: float) -> float:
     loop, linearised at rest with friction off, is stable (bisection in log scale on
     the largest real part of the active states' eigenvalues); ``upper`` if stable there,
     the current value if the current model is not stable at rest."""
-    from .. import _core
-    from ..analysis import hold_command, linear_analysis_rig
+    from ..analysis import linearize
 
     def stable(v: float) -> bool:
-        r = linear_analysis_rig(rig, "off")
+        r = copy.copy(rig)
         setattr(r, key, float(v))
-        dyn = _core.Dynamics(r, _core.ControlMode.Displacement if mode == "displacement" else _core.ControlMode.Force)
-        y0 = list(dyn.equilibrium(0.0))
-        lm = _core.linearize(dyn, y0, hold_command(dyn, y0))
-        keep = np.flatnonzero(np.asarray(lm.active, dtype=bool))
-        return bool(np.max(np.linalg.eigvals(np.asarray(lm.A)[np.ix_(keep, keep)]).real) < 0.0)
+        return bool(np.max(np.linalg.eigvals(linearize(r, mode, friction="off").A).real) < 0.0)
 
     cur = float(getattr(rig, key))
     if stable(upper):
