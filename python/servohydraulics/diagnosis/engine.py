@@ -443,7 +443,7 @@ def balance_screen(rig: Rig, cases: list[Case], signature) -> float:
         x, v, a, F = d["displacement"], d["velocity"], d["acceleration"], d["force"]
         structure = _core.Dynamics(rig, MODES[case.mode]).structure_forces(x, v)
         e = F - (rig.m * a + structure)
-        s = signature(rig, {"displacement": x, "velocity": v, "acceleration": a, "rms_v": d["rms_v"]})
+        s = signature(rig, d)  # the record's derived channels (and rms_v)
         n = x.size
         cut = slice(n // 50, n - n // 50)  # drop the filter's edge samples
         es.append(e[cut] / max(np.sqrt(np.mean(F ** 2)), rig.k * np.sqrt(np.mean(x ** 2)), 1e-9))
