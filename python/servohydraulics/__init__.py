@@ -57,16 +57,14 @@ __version__ = "0.1.0"
 #: Lazily imported submodules (first attribute access imports them).
 _SUBMODULES = ("analysis", "identify", "excitations", "sweep", "plots", "diagnosis", "paper")
 
-#: Lazily resolved names: name -> candidate (module, attribute) pairs, the first
-#: that exists wins (so both the old flat layout and the diagnosis/ and paper/
-#: packages work).
+#: Lazily resolved names: name -> (module, attribute).
 _LAZY = {
-    "linearize": ((".analysis", "linearize"),),
-    "sweep": ((".sweep", "sweep"),),
-    "summary_run": ((".sweep", "summary_run"),),
-    "diagnose": ((".diagnosis", "diagnose"), (".diagnose", "diagnose")),
-    "Diagnosis": ((".diagnosis", "Diagnosis"), (".diagnose", "Diagnosis")),
-    "reproduce": ((".paper.reproduce", "reproduce"), (".reproduce", "reproduce")),
+    "linearize": (".analysis", "linearize"),
+    "sweep": (".sweep", "sweep"),
+    "summary_run": (".sweep", "summary_run"),
+    "diagnose": (".diagnosis", "diagnose"),
+    "Diagnosis": (".diagnosis", "Diagnosis"),
+    "reproduce": (".paper.reproduce", "reproduce"),
 }
 
 #: Deprecated names, kept for one release: name -> (replacement, object).
@@ -78,15 +76,8 @@ _DEPRECATED = {
 
 
 def _resolve(name: str):
-    for module, attr in _LAZY[name]:
-        try:
-            mod = _importlib.import_module(module, __name__)
-        except ModuleNotFoundError as e:
-            if e.name is None or not (__name__ + module).startswith(e.name):
-                raise
-            continue
-        return getattr(mod, attr)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")  # pragma: no cover
+    module, attr = _LAZY[name]
+    return getattr(_importlib.import_module(module, __name__), attr)
 
 
 def __getattr__(name: str):
@@ -109,21 +100,15 @@ def __dir__():
 
 
 class _Package(_types.ModuleType):
-    """``sh.diagnose``, ``sh.reproduce`` and ``sh.sweep`` are functions even where a
-    submodule of the same name exists (``sweep.py``; ``diagnose/`` and
-    ``reproduce.py`` before the diagnosis/ and paper/ packages): importing that
-    submodule must not rebind the package attribute to the module.  The
-    submodules stay importable by their names (``importlib.import_module``,
-    ``from servohydraulics.sweep import ...``)."""
+    """``sh.sweep`` is the function although a submodule of the same name
+    exists (``sweep.py``): importing that submodule must not rebind the package
+    attribute to the module.  The submodule stays importable by its name
+    (``importlib.import_module``, ``from servohydraulics.sweep import ...``)."""
+
+    sweep = property(lambda self: _resolve("sweep"), lambda self, value: None,
+                     doc="servohydraulics.sweep, resolved on first use")
 
 
-def _function_property(name: str) -> property:
-    return property(lambda self: _resolve(name), lambda self, value: None,
-                    doc=f"servohydraulics.{name}, resolved on first use")
-
-
-for _name in ("diagnose", "reproduce", "sweep"):
-    setattr(_Package, _name, _function_property(_name))
 _sys.modules[__name__].__class__ = _Package
 
 __all__ = [
@@ -132,12 +117,10 @@ __all__ = [
     "Diagnosis",
     "Dynamics",
     "EftController",
-    "EftController",
     "Error",
     "FlowCurve",
     "Plant",
     "Response",
-    "RpsdController",
     "Rig",
     "RpsdController",
     "SimulationError",

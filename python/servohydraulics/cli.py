@@ -7,6 +7,8 @@ import argparse
 import sys
 from collections.abc import Sequence
 
+from .simulate import MODES
+
 
 def _demo(args: argparse.Namespace) -> int:
     from .paper.demo import run_demo
@@ -69,7 +71,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("simulate", help="simulate a sine command and write the record CSV")
     s.add_argument("--rig", help="rig TOML file (default: the calibrated Zhao 2003 preset)")
-    s.add_argument("--mode", choices=["displacement", "force", "free"], default="displacement")
+    s.add_argument("--mode", choices=list(MODES), default="displacement")
     s.add_argument("--amplitude", type=float, default=0.00127, help="command amplitude [m or N]")
     s.add_argument("--frequency", type=float, default=1.0, help="command frequency [Hz]")
     s.add_argument("--duration", type=float, default=5.0, help="[s]")
@@ -86,7 +88,7 @@ def build_parser() -> argparse.ArgumentParser:
     g = sub.add_parser("diagnose", help="name the effect the model is missing in lab records, fit it, show the gap")
     g.add_argument("records", nargs="+", help="record CSV file(s) of the same rig (time, command, displacement, force)")
     g.add_argument("--rig", required=True, help="the nominal rig TOML file")
-    g.add_argument("--mode", required=True, choices=["displacement", "force", "free"],
+    g.add_argument("--mode", required=True, choices=list(MODES),
                    help="control mode of the records")
     g.add_argument("--out", required=True, help="output directory (diagnosis.json, rig_updated.toml, report.md)")
     g.add_argument("--quiet", action="store_true", help="no progress bar")

@@ -102,10 +102,17 @@ def lag1_autocorrelation(x: ArrayLike) -> float:
     return float(e[:-1] @ e[1:]) / den if den > 0 else 0.0
 
 
-def _ar1_effective_n(res: np.ndarray) -> tuple[float, float]:
-    """(effective sample size, lag-1 autocorrelation) of residuals, AR(1) model."""
-    rho = min(max(lag1_autocorrelation(res), 0.0), 0.999)
-    return res.size * (1.0 - rho) / (1.0 + rho), rho
+def ar1_coefficient(x: ArrayLike) -> float:
+    """The lag-1 autocorrelation clipped to [0, 0.999]: the AR(1) coefficient of
+    a residual series as the effective-sample-size and bandwidth rules use it
+    (they need 0 <= rho < 1)."""
+    return min(max(lag1_autocorrelation(x), 0.0), 0.999)
+
+
+def ar1_effective_n(n: float, rho: float) -> float:
+    """Effective sample size of n samples of an AR(1) series with coefficient rho:
+    n (1 - rho) / (1 + rho)."""
+    return n * (1.0 - rho) / (1.0 + rho)
 
 
 def identify_damping_friction(time: ArrayLike, displacement: ArrayLike, rig: Rig,
@@ -163,7 +170,8 @@ def identify_damping_friction(time: ArrayLike, displacement: ArrayLike, rig: Rig
     J = sol.jac / scale  # d res / d (c, F_c[, x0])
     p = J.shape[1]
     s2 = float(res @ res) / (n - p)
-    n_eff, rho = _ar1_effective_n(res)
+    rho = ar1_coefficient(res)
+    n_eff = ar1_effective_n(res.size, rho)
     inflate = (n - p) / max(n_eff - p, 1.0)
     cov_all = s2 * inflate * np.linalg.pinv(J.T @ J)
     cov = cov_all[:2, :2]
@@ -305,6 +313,6 @@ def identify_free_vibration(x: ArrayLike, dt: float, start: int = 0, duration: f
                          rms_error=rms)
 
 
-__all__ = ["FirstOrderEstimate", "FreeVibration", "FrictionEstimate", "fourier_ratio", "frequency_response",
-           "identify_damping_friction", "identify_first_order", "identify_free_vibration", "lag1_autocorrelation",
-           "linear_chirp", "simulate_structure"]
+__all__ = ["FirstOrderEstimate", "FreeVibration", "FrictionEstimate", "ar1_coefficient", "ar1_effective_n",
+           "fourier_ratio", "frequency_response", "identify_damping_friction", "identify_first_order",
+           "identify_free_vibration", "lag1_autocorrelation", "linear_chirp", "simulate_structure"]

@@ -47,18 +47,7 @@ DEPRECATED_COLUMNS = {"ground_accel": "ground_acceleration"}
 
 def _core_tables() -> tuple[tuple[tuple[str, str], ...], ...]:
     """(plant, EFT, RPsD) channel tables as ((name, unit), ...) from the C++ core."""
-    if all(hasattr(_core, n) for n in ("PLANT_CHANNELS", "EFT_CHANNELS", "RPSD_CHANNELS")):
-        return (tuple(map(tuple, _core.PLANT_CHANNELS)), tuple(map(tuple, _core.EFT_CHANNELS)),
-                tuple(map(tuple, _core.RPSD_CHANNELS)))
-    # TEMPORARY until the core tables land (_core.PLANT_CHANNELS, EFT_CHANNELS, RPSD_CHANNELS).
-    plant = (("time", "s"), ("displacement", "m"), ("velocity", "m/s"), ("acceleration", "m/s^2"),
-             ("force", "N"), ("pressure", "Pa"), ("spool", "-"), ("drive", "V"), ("flow", "m^3/s"))
-    eft = (("ground_acceleration", "m/s^2"), ("effective_force", "N"), ("compensation", "N"),
-           ("compensation_opening", "-"), ("command", "N"))
-    rpsd = (("ground_acceleration", "m/s^2"), ("external_force", "N"), ("measured_restoring_force", "N"),
-            ("restoring_force", "N"), ("calc_displacement", "m"), ("calc_velocity", "m/s"),
-            ("calc_acceleration", "m/s^2"), ("target_displacement", "m"), ("command", "m"))
-    return plant, eft, rpsd
+    return tuple(tuple(map(tuple, t)) for t in (_core.PLANT_CHANNELS, _core.EFT_CHANNELS, _core.RPSD_CHANNELS))
 
 
 def _command_unit(mode: str | None) -> str:

@@ -96,9 +96,7 @@ def rig_from_dict(data: dict[str, Any], base: Rig | None = None) -> Rig:
     """Builds a rig from nested dicts (a parsed rig file) over ``base``
     (default: the calibrated preset).  Unknown sections or keys are an error;
     the result is validated (ValueError naming the field and value)."""
-    rig = zhao2003()
-    if base is not None:
-        _apply(rig, rig_to_dict(base))
+    rig = copy.copy(base) if base is not None else zhao2003()
     _apply(rig, data)
     rig.validate()
     return rig

@@ -23,8 +23,10 @@ RESTARTS = {"on_input_change": _core.SolverOptions.Restart.OnInputChange, "never
 
 def solver_options(method: str = "cvode", rtol: float = 1e-6, restart: str = "on_input_change",
                    rk4_substeps: int = 0, max_steps_per_sample: int = 2000,
-                   max_order: int = 5) -> _core.SolverOptions:
-    """Builds solver options; see ``SolverOptions`` in plant.hpp."""
+                   max_order: int = 5, rk4_h_rho: float | None = None,
+                   rk4_v_ref: float | None = None) -> _core.SolverOptions:
+    """Builds solver options; see ``SolverOptions`` in solver_options.hpp
+    (``rk4_h_rho``, ``rk4_v_ref``: None keeps the core's default)."""
     if method not in METHODS:
         raise ValueError(f"invalid method = {method!r}: expected one of {sorted(METHODS)}")
     if restart not in RESTARTS:
@@ -36,6 +38,10 @@ def solver_options(method: str = "cvode", rtol: float = 1e-6, restart: str = "on
     o.rk4_substeps = rk4_substeps
     o.max_steps_per_sample = max_steps_per_sample
     o.max_order = max_order
+    if rk4_h_rho is not None:
+        o.rk4_h_rho = rk4_h_rho
+    if rk4_v_ref is not None:
+        o.rk4_v_ref = rk4_v_ref
     o.validate()
     return o
 

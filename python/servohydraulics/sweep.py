@@ -45,7 +45,7 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from .excitations import sine
-from .rig import EFFECTS, PARAMETERS, Rig, rig_from_dict, rig_to_dict, zhao2003
+from .rig import EFFECTS, PARAMETERS, Rig, rig_from_dict, zhao2003
 from .simulate import simulate, solver_options
 
 _RIG_KEYS = {f"{p.section}.{p.key}" for p in PARAMETERS} | {f"effects.{e}" for e in EFFECTS} | {
@@ -159,18 +159,10 @@ def _split(point: Mapping[str, Any]) -> tuple[dict[str, dict[str, Any]], dict[st
     return rig_part, kwargs
 
 
-def _merged(base: dict[str, Any], rig_part: dict[str, Any]) -> dict[str, Any]:
-    """The base rig's dict with one point's overrides (a complete rig file)."""
-    out = {section: dict(table) for section, table in base.items()}
-    for section, table in rig_part.items():
-        out.setdefault(section, {}).update(table)
-    return out
-
-
-def _job(run: Callable[..., Mapping[str, Any]], base: dict[str, Any], rig_part: dict[str, Any],
+def _job(run: Callable[..., Mapping[str, Any]], base: Rig, rig_part: dict[str, Any],
          kwargs: dict[str, Any]) -> dict[str, Any]:
-    """One run in a worker: build the rig from plain dicts, call the run function."""
-    rig = rig_from_dict(_merged(base, rig_part))
+    """One run in a worker: the base rig (pickled) with the point's overrides, then the run function."""
+    rig = rig_from_dict(rig_part, base=base)
     try:
         return dict(run(rig, **kwargs))
     except Exception as e:  # a failed run is a row, not a failed sweep
@@ -218,15 +210,14 @@ def sweep(grid: Mapping[str, Sequence[Any]] | None = None, *,
     fixed = dict(fixed or {})
     if not callable(run):
         raise ValueError(f"invalid run = {run!r}: expected a callable run(rig, **kwargs) -> dict")
-    base_rig = rig if rig is not None else zhao2003()
-    base = rig_to_dict(base_rig)
+    base = rig if rig is not None else zhao2003()
     jobs = []
     for p in points:
         rig_part, kwargs = _split({**fixed, **p})
         if keep_records and run is summary_run:
             kwargs["keep_record"] = True
         if rig_part:  # validate here: a bad name or value fails before anything is submitted
-            rig_from_dict(_merged(base, rig_part))
+            rig_from_dict(rig_part, base=base)
         jobs.append((rig_part, kwargs))
 
     own = executor is None

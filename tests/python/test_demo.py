@@ -25,10 +25,17 @@ def test_demo_writes_outputs_matching_physics(tmp_path):
     assert s["force_gain_min"] < 0.15 and abs(s["force_gain_min_at_hz"] - f_d) < 0.2
 
 
-def test_old_demo_module_reexports():
-    from servohydraulics import demo
+def test_cli_demo_runs_the_paper_demo(tmp_path, monkeypatch):
+    """`servohydraulics demo` calls servohydraulics.paper.demo.run_demo (the one home; the old
+    top-level ``servohydraulics.demo`` re-export is gone)."""
+    import servohydraulics.paper.demo as paper_demo
 
-    assert demo.run_demo is run_demo
+    calls = []
+    monkeypatch.setattr(paper_demo, "run_demo", lambda **kw: calls.append(kw))
+    assert main(["demo", "--out", str(tmp_path), "--quick"]) == 0
+    assert calls == [{"out": str(tmp_path), "quick": True}]
+    with pytest.raises(ModuleNotFoundError):
+        __import__("servohydraulics.demo")
 
 
 def test_cli_reports_bad_input_without_traceback(tmp_path, capsys):

@@ -77,7 +77,10 @@ def test_candidate_log_keys() -> None:
     assert fitted["refit"] == {"tried": False, "kept": False}
 
 
-def test_lag1_autocorrelation_of_an_ar1_process() -> None:
+def test_ar1_coefficient_of_an_ar1_process() -> None:
+    """The diagnosis's AR(1) coefficient is identify's lag-1 autocorrelation, clipped to [0, 0.999]."""
+    from servohydraulics.identify import ar1_coefficient, ar1_effective_n, lag1_autocorrelation
+
     rng = np.random.default_rng(5)
     phi, n = 0.6, 200_000
     w = rng.normal(size=n)
@@ -86,6 +89,32 @@ def test_lag1_autocorrelation_of_an_ar1_process() -> None:
     for i in range(1, n):
         e[i] = phi * e[i - 1] + w[i]
     # the estimate's standard deviation is about sqrt((1 - phi^2) / n) = 0.0018
-    assert abs(engine.lag1_autocorrelation(e) - phi) < 0.01
-    assert engine.lag1_autocorrelation(np.cumsum(w)) == 0.999  # a random walk: clipped below 1
-    assert engine.lag1_autocorrelation(np.resize([1.0, -1.0], 100)) == 0.0  # negative: clipped at 0
+    assert abs(ar1_coefficient(e) - phi) < 0.01
+    assert ar1_coefficient(e) == lag1_autocorrelation(e)
+    assert ar1_coefficient(np.cumsum(w)) == 0.999  # a random walk: clipped below 1
+    alternating = np.resize([1.0, -1.0], 100)
+    assert lag1_autocorrelation(alternating) < -0.9 and ar1_coefficient(alternating) == 0.0  # clipped at 0
+    assert ar1_effective_n(1000, 0.6) == pytest.approx(1000 * 0.4 / 1.6)
+
+
+def test_balance_screen_has_the_stribeck_level() -> None:
+    """The balance screen's structure forces are Eq (5)'s with the Stribeck level (the core's):
+    a force record made by the closed form m a + k x + c v + g(v) tanh(v / v_stick), g(v) =
+    F_c (1 + (r - 1) exp(-(v / v_s)^2)), plus a known extra force w leaves exactly w as the
+    residual, so w's signature explains all of it (without the Stribeck level it would not)."""
+    from types import SimpleNamespace
+
+    rig = sh.zhao2003()
+    rig.effects.coulomb_friction, rig.effects.lugre_friction, rig.effects.spring_softening = True, False, False
+    rig.stribeck_ratio, rig.v_s, rig.F_c = 2.0, 0.01, 300.0
+    t = np.arange(20000) * 5e-4
+    w0 = 2 * math.pi * 1.0
+    x, v, a = 0.01 * np.sin(w0 * t), 0.01 * w0 * np.cos(w0 * t), -0.01 * w0 ** 2 * np.sin(w0 * t)
+    g = rig.F_c * (1.0 + (rig.stribeck_ratio - 1.0) * np.exp(-(v / rig.v_s) ** 2))
+    extra = 50.0 * np.sin(3 * w0 * t) ** 3
+    F = rig.m * a + rig.k * x + rig.c * v + g * np.tanh(v / rig.v_stick) + extra
+    derived = {"displacement": x, "velocity": v, "acceleration": a, "force": F, "rms_v": float(np.std(v))}
+    case = SimpleNamespace(derived=derived, mode="force")
+    assert engine.balance_screen(rig, [case], lambda r, s: np.sin(3 * w0 * t) ** 3) > 1 - 1e-9
+    stribeck_excess = (g - rig.F_c) * np.tanh(v / rig.v_stick)
+    assert engine.balance_screen(rig, [case], lambda r, s: stribeck_excess) < 0.01

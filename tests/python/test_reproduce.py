@@ -1,5 +1,5 @@
 """The reproduction table: a fast subset of ``reproduce`` checked against the paper's numbers
-(servohydraulics.paper; ``servohydraulics.reproduce`` re-exports it)."""
+(servohydraulics.paper; ``sh.reproduce`` is its driver)."""
 
 from __future__ import annotations
 
@@ -113,13 +113,15 @@ def test_linear_rows_paper_numbers():
     assert abs(1e3 * T - 68.0) <= 3.0
 
 
-def test_old_module_reexports_the_driver():
-    """``servohydraulics.reproduce`` (the CLI's old path) and ``sh.reproduce`` are the paper driver."""
+def test_the_package_exports_the_driver():
+    """``sh.reproduce`` is the paper driver; the old top-level re-export modules are gone (one path)."""
     import servohydraulics as sh
 
-    old = importlib.import_module("servohydraulics.reproduce")
-    assert old.reproduce is rp.reproduce is sh.reproduce
-    assert old.SECTIONS is rp.SECTIONS
+    assert sh.reproduce is rp.reproduce
+    assert list(rp.SECTIONS)
+    for old in ("servohydraulics.reproduce", "servohydraulics.demo"):
+        with pytest.raises(ModuleNotFoundError):
+            importlib.import_module(old)
 
 
 def test_every_section_has_its_claims_with_unique_keys():

@@ -16,7 +16,7 @@ import servohydraulics as sh
 
 DT = 5e-4
 N = 2000  # 1 s at 2 kHz
-PLANT_CHANNELS = ("time", "displacement", "velocity", "acceleration", "force", "pressure", "spool", "drive", "flow")
+PLANT_CHANNELS = tuple(name for name, _ in sh._core.PLANT_CHANNELS)
 
 
 def ground_motion(amplitude: float, f: float) -> np.ndarray:

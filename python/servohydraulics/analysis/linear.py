@@ -31,16 +31,16 @@ import control as ct
 import numpy as np
 
 from .. import _core
-from ..response import channel_units
 from ..rig import Rig, copy_rig
 from ..simulate import MODES
 from .closed_form import equivalent_viscous_damping, velocity_feedback_gain
 
 ALPHA = _core.RpsdConfig().alpha  #: constant of the paper's phase-lead networks (Table I), the core's default [-]
-OUTPUT_UNITS = {n: u for n, u in channel_units("plant", "displacement").items()
-                if n not in ("time", "command", "flags", "internal_steps", "rhs_evals")}
-OUTPUTS = tuple(OUTPUT_UNITS)  #: the plant's output channels, in the order of LinearModel.C's rows
-STATES = ("x", "v", "p", "x_v", "x_v_dot", "z")
+#: the plant's output channels (the core's channel table but time) -> SI unit, in the order of LinearModel.C's rows
+OUTPUT_UNITS = {n: u for n, u in _core.PLANT_CHANNELS if n != "time"}
+OUTPUTS = tuple(OUTPUT_UNITS)
+STATE_UNITS = dict(_core.STATES)  #: the plant's states (the core's StateIndex order) -> SI unit
+STATES = tuple(STATE_UNITS)
 FRICTION_TREATMENTS = ("off", "equivalent", "tangent")
 
 
@@ -100,31 +100,6 @@ def linear_analysis_rig(rig: Rig, friction: str = "off", friction_amplitude: flo
     return r
 
 
-def hold_command(dyn: _core.Dynamics, y0: Sequence[float]) -> float:
-    """The held command u0 [m or N] for which the equilibrium state y0 is at rest.
-
-    The rate equation that u drives (the spool, or the pressure with a static
-    valve) is affine in u away from saturation: two secant steps make it exact.
-    """
-    mode = dyn.mode
-    if mode == _core.ControlMode.Free:
-        return float(dyn.spring_force(y0[0]))
-    idx = 4 if dyn.rhs(list(y0), 1.0)[4] != dyn.rhs(list(y0), 0.0)[4] else 2
-
-    def r(u: float) -> float:
-        return float(dyn.rhs(list(y0), u)[idx])
-
-    u_a = float(y0[0]) if mode == _core.ControlMode.Displacement else float(dyn.outputs(list(y0), 0.0).force)
-    scale = 1e-4 if mode == _core.ControlMode.Displacement else 10.0
-    u_b = u_a + scale
-    for _ in range(3):
-        ra, rb = r(u_a), r(u_b)
-        if rb == ra:
-            break
-        u_a, u_b = u_b, u_b - rb * (u_b - u_a) / (rb - ra)
-    return u_b
-
-
 def linearize(rig: Rig, mode: str = "displacement", x0: float = 0.0, u0: float | None = None,
               outputs: Sequence[str] = ("displacement",), compensators: Compensation | None = None,
               friction: str = "off", friction_amplitude: float = 0.0127,
@@ -136,7 +111,8 @@ def linearize(rig: Rig, mode: str = "displacement", x0: float = 0.0, u0: float |
         mode: ``"displacement"`` (input: command [m]), ``"force"`` (command [N])
             or ``"free"`` (ideal external force [N]).
         x0: operating displacement [m].
-        u0: held command [m or N]; default: the command that holds x0.
+        u0: held command [m or N]; default: the command that holds x0 at rest
+            (the core's ``Dynamics.operating_point``).
         outputs: channels among ``OUTPUTS`` (SI units, see ``OUTPUT_UNITS``).
         compensators: linear compensators in the loop (:class:`Compensation`).
         friction: treatment of the Coulomb friction (module docstring).
@@ -161,9 +137,8 @@ def linearize(rig: Rig, mode: str = "displacement", x0: float = 0.0, u0: float |
     comp = compensators or Compensation()
     r = linear_analysis_rig(rig, friction, friction_amplitude, friction_frequency)
     dyn = _core.Dynamics(r, MODES[mode])
-    y0 = list(dyn.equilibrium(float(x0)))
-    u_op = hold_command(dyn, y0) if u0 is None else float(u0)
-    lm = _core.linearize(dyn, y0, u_op)
+    y0, u_hold = dyn.operating_point(float(x0))
+    lm = _core.linearize(dyn, y0, u_hold if u0 is None else float(u0))
     keep = np.flatnonzero(np.asarray(lm.active, dtype=bool))
     need = list(dict.fromkeys(outs + (["velocity"] if comp.velocity_feedback else [])))
     rows = [OUTPUTS.index(o) for o in need]
@@ -208,5 +183,5 @@ def _close_compensators(plant: ct.StateSpace, rig: Rig, mode: str, comp: Compens
                            name="compensated")
 
 
-__all__ = ["ALPHA", "Compensation", "FRICTION_TREATMENTS", "OUTPUTS", "OUTPUT_UNITS", "STATES", "hold_command",
+__all__ = ["ALPHA", "Compensation", "FRICTION_TREATMENTS", "OUTPUTS", "OUTPUT_UNITS", "STATES", "STATE_UNITS",
            "linear_analysis_rig", "linearize", "phase_lead", "zoh_delay"]

@@ -92,11 +92,19 @@ INTERACT_SPAN = 0.25  #: bounded re-fit of interacting nominal parameters: +-25 
 
 # --- apply functions -----------------------------------------------------------------
 
-def _apply_coulomb(rig: Rig, th: np.ndarray) -> Rig:
+def _with(rig: Rig, switch: str | None = None, on: bool = True, **values: float) -> Rig:
+    """A copy of ``rig`` with ``effects.<switch>`` set to ``on`` and the given
+    parameters set (the one way the candidates' ``apply`` build a model)."""
     r = copy.copy(rig)
-    r.effects.coulomb_friction = True
-    r.F_c = float(max(th[0], 0.0))
+    if switch is not None:
+        setattr(r.effects, switch, on)
+    for key, v in values.items():
+        setattr(r, key, float(v))
     return r
+
+
+def _apply_coulomb(rig: Rig, th: np.ndarray) -> Rig:
+    return _with(rig, "coulomb_friction", F_c=max(th[0], 0.0))
 
 
 #: bristle stiffness above which lugre_friction is "absent": the static Coulomb law [N/m]
@@ -110,16 +118,11 @@ LUGRE_MIN_PRESLIDING = 1e-5
 
 def _apply_lugre(rig: Rig, th: np.ndarray) -> Rig:
     # theta = (sigma_0 [N/m], F_c [N]); sigma_0 beyond LUGRE_ABSENT_SIGMA_0 (or inf) is the static law
-    r = copy.copy(rig)
-    r.effects.coulomb_friction = True
-    r.F_c = float(max(th[1], 0.0))
-    if (not math.isfinite(th[0]) or th[0] > LUGRE_ABSENT_SIGMA_0
-            or r.F_c < LUGRE_MIN_PRESLIDING * th[0]):
-        r.effects.lugre_friction = False
-    else:
-        r.effects.lugre_friction = True
-        r.sigma_0 = float(th[0])
-    return r
+    F_c = max(th[1], 0.0)
+    r = _with(rig, "coulomb_friction", F_c=F_c)
+    if not math.isfinite(th[0]) or th[0] > LUGRE_ABSENT_SIGMA_0 or r.F_c < LUGRE_MIN_PRESLIDING * th[0]:
+        return _with(r, "lugre_friction", False)
+    return _with(r, "lugre_friction", sigma_0=th[0])
 
 
 def _lugre_absent(ctx: Context) -> np.ndarray:
@@ -133,27 +136,18 @@ def _lugre_scan(ctx: Context) -> np.ndarray:
 
 
 def _apply_viscous(rig: Rig, th: np.ndarray) -> Rig:
-    r = copy.copy(rig)
-    r.c = float(max(th[0], 0.0))
-    return r
+    return _with(rig, c=max(th[0], 0.0))
 
 
 def _apply_softening(rig: Rig, th: np.ndarray) -> Rig:
-    r = copy.copy(rig)
-    r.effects.spring_softening = True
-    r.k_2 = float(th[0])
-    return r
+    return _with(rig, "spring_softening", k_2=th[0])
 
 
 def _apply_load_pressure(rig: Rig, th: np.ndarray) -> Rig:
     # theta = p_s [Pa]; +inf (or beyond 1e12) means the effect is off.
-    r = copy.copy(rig)
     if not math.isfinite(th[0]) or th[0] > 1e12:
-        r.effects.load_pressure = False
-    else:
-        r.effects.load_pressure = True
-        r.p_s = float(th[0])
-    return r
+        return _with(rig, "load_pressure", False)
+    return _with(rig, "load_pressure", p_s=th[0])
 
 
 #: openings of the table that represents a knee-rational flow curve: dense near the knee
@@ -199,42 +193,25 @@ def _apply_delay(rig: Rig, th: np.ndarray) -> Rig:
 
 
 def _apply_valve(rig: Rig, th: np.ndarray) -> Rig:
-    r = copy.copy(rig)
     if not math.isfinite(th[0]) or th[0] > 1e5:
-        r.effects.servovalve_dynamics = False
-        return r
-    r.effects.servovalve_dynamics = True
-    r.f_v = float(th[0])
-    r.zeta_v = float(th[1])
-    return r
+        return _with(rig, "servovalve_dynamics", False)
+    return _with(rig, "servovalve_dynamics", f_v=th[0], zeta_v=th[1])
 
 
 def _apply_leakage(rig: Rig, th: np.ndarray) -> Rig:
-    r = copy.copy(rig)
-    r.C_l = float(max(th[0], 0.0))
-    return r
+    return _with(rig, C_l=max(th[0], 0.0))
 
 
 def _apply_piston_mass(rig: Rig, th: np.ndarray) -> Rig:
-    r = copy.copy(rig)
-    r.effects.piston_mass = True
-    r.m_p = float(max(th[0], 0.0))
-    return r
+    return _with(rig, "piston_mass", m_p=max(th[0], 0.0))
 
 
 def _apply_spool(rig: Rig, th: np.ndarray) -> Rig:
-    r = copy.copy(rig)
-    r.effects.spool_saturation = True
-    r.x_v_max = float(th[0])
-    return r
+    return _with(rig, "spool_saturation", x_v_max=th[0])
 
 
 def _apply_stiffness(rig: Rig, th: np.ndarray) -> Rig:
-    r = copy.copy(rig)
-    ratio = r.k_2 / r.k
-    r.k = float(th[0])
-    r.k_2 = float(th[0] * ratio)  # the softened branch keeps its ratio to k
-    return r
+    return _with(rig, k=th[0], k_2=th[0] * (rig.k_2 / rig.k))  # the softened branch keeps its ratio to k
 
 
 def _max_stable(rig: Rig, mode: str, key: str, upper: float) -> float:
@@ -242,17 +219,12 @@ def _max_stable(rig: Rig, mode: str, key: str, upper: float) -> float:
     loop, linearised at rest with friction off, is stable (bisection in log scale on
     the largest real part of the active states' eigenvalues); ``upper`` if stable there,
     the current value if the current model is not stable at rest."""
-    from .. import _core
-    from ..analysis import hold_command, linear_analysis_rig
+    from ..analysis import linearize
 
     def stable(v: float) -> bool:
-        r = linear_analysis_rig(rig, "off")
+        r = copy.copy(rig)
         setattr(r, key, float(v))
-        dyn = _core.Dynamics(r, _core.ControlMode.Displacement if mode == "displacement" else _core.ControlMode.Force)
-        y0 = list(dyn.equilibrium(0.0))
-        lm = _core.linearize(dyn, y0, hold_command(dyn, y0))
-        keep = np.flatnonzero(np.asarray(lm.active, dtype=bool))
-        return bool(np.max(np.linalg.eigvals(np.asarray(lm.A)[np.ix_(keep, keep)]).real) < 0.0)
+        return bool(np.max(np.linalg.eigvals(linearize(r, mode, friction="off").A).real) < 0.0)
 
     cur = float(getattr(rig, key))
     if stable(upper):
@@ -274,9 +246,7 @@ def _compressibility_bounds(ctx: Context) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _apply_compressibility(rig: Rig, th: np.ndarray) -> Rig:
-    r = copy.copy(rig)
-    r.K_a = float(th[0])
-    return r
+    return _with(rig, K_a=th[0])
 
 
 # --- contexts -----------------------------------------------------------------------

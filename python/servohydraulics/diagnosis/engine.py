@@ -14,17 +14,25 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.signal import savgol_filter
 
-from ..rig import Rig, rig_to_dict
-from ..simulate import SimulationError, simulate, solver_options
+from .. import _core
+from ..identify import ar1_coefficient, ar1_effective_n
+from ..rig import Error, Rig
+from ..simulate import MODES, SimulationError, simulate, solver_options
 from .effects import INTERACT_SPAN, Candidate, Context
 from .types import Case, FitResult, Screening, Sim
 
-#: channels compared, in order of preference, per mode (those present in the record are used)
-CHANNELS = {
-    "displacement": ("displacement", "force", "velocity", "acceleration", "pressure", "spool"),
-    "force": ("displacement", "force", "velocity", "acceleration", "pressure", "spool"),
-    "free": ("displacement", "velocity", "acceleration"),
-}
+#: Plant channels the diagnosis does not compare: the abscissa, the valve drive (a function of the
+#: command and the fed-back channels in closed loop) and the valve flow (not measured on a rig).
+NOT_COMPARED = frozenset({"time", "drive", "flow"})
+#: The actuator's channels, absent in free mode (a free record's force column is the applied force).
+ACTUATOR_CHANNELS = frozenset({"force", "pressure", "spool"})
+#: the channels of a diagnosis simulation (``Sim``), in the core's table order
+SIM_CHANNELS = tuple(c for c, _ in _core.PLANT_CHANNELS if c not in NOT_COMPARED)
+#: channels compared per mode (those present in the record are used)
+CHANNELS = {mode: tuple(c for c in SIM_CHANNELS if not (mode == "free" and c in ACTUATOR_CHANNELS))
+            for mode in MODES}
+#: RK4 substeps per sample beyond which a diagnosis simulation uses CVODE instead
+MAX_RK4_SUBSTEPS = 64
 N_SEGMENTS = 6  #: held-out split: contiguous segments, even ones train, odd ones test
 
 
@@ -47,8 +55,6 @@ def make_case(rec: Any, mode: str, name: str) -> Case:
         y = np.asarray(ch[c], dtype=float)
         s = float(np.sqrt(np.mean(y ** 2)))
         if s <= 0.0:
-            continue
-        if c == "force" and mode == "free":
             continue
         meas[c] = y
         scale[c] = s
@@ -116,31 +122,17 @@ def refine_x0(rig: Rig, cases: list[Case], tau: float) -> tuple[float, ...]:
 # --- simulation ---------------------------------------------------------------------
 
 def rk4_options(rig: Rig, case: Case):
-    """The solver options of a diagnosis simulation: RK4 with enough substeps
-    that h times a bound on the plant's fastest eigenvalue stays below 1.2 (at
-    least 4), or None (CVODE) if that needs more than 64.  The bound: valve
-    poles, friction regularisation, LuGre bristles at the record's peak
-    velocity, leakage and oil-column rates.
-
-    The core's automatic rule (``solver_options(method="rk4")``, rk4_substeps = 0)
-    is the one home of this rule once it covers the LuGre bristle rate; this
-    function is the one place to swap."""
-    mode = case.mode
-    M = rig.m + (rig.m_p if rig.effects.piston_mass and mode != "free" else 0.0)
-    rates = [rig.c / M]
-    if rig.effects.coulomb_friction:
-        rates.append(rig.F_c / (rig.v_stick * M))
-        if rig.effects.lugre_friction and rig.F_c > 0:
-            rates.append(rig.sigma_0 * 1.5 * case.v_peak / rig.F_c)
-    if mode != "free":
-        wv = 2 * math.pi * rig.f_v
-        z = rig.zeta_v
-        if rig.effects.servovalve_dynamics:
-            rates.append(wv * (z + math.sqrt(max(z * z - 1.0, 0.0))) if z >= 1 else wv)
-        rates.append(rig.C_l / rig.K_a)
-        rates.append(rig.A / math.sqrt(rig.K_a * M))
-    n = max(4, int(math.ceil(max(rates) * case.dt / 1.2)))
-    return solver_options(method="rk4", rk4_substeps=n) if n <= 64 else None
+    """The solver options of a diagnosis simulation: the core's automatic RK4
+    rule (``rk4_substeps = 0``: h times the spectral radius of the Jacobian at
+    rest <= ``rk4_h_rho``; with LuGre friction also h sigma_0 v_ref / F_c, the
+    bristle rate, with v_ref the record's peak velocity), or None (CVODE) if
+    that rule asks for more than ``MAX_RK4_SUBSTEPS`` substeps per sample."""
+    opts = solver_options(method="rk4", rk4_substeps=0, rk4_v_ref=case.v_peak)
+    try:
+        n = _core.rk4_automatic_substeps(_core.Dynamics(rig, MODES[case.mode]), case.dt, opts)
+    except Error:  # too stiff for any fixed step
+        return None
+    return opts if n <= MAX_RK4_SUBSTEPS else None
 
 
 def delayed(u: np.ndarray, dt: float, tau: float) -> np.ndarray:
@@ -163,7 +155,7 @@ def simulate_case(rig: Rig, case: Case, tau: float, x0: float) -> Sim:
             r = simulate(rig, case.mode, u, case.dt, x0=float(x0), options=opts)
         except (SimulationError, ValueError):
             continue
-        return {c: getattr(r, c) for c in ("displacement", "force", "velocity", "acceleration", "pressure", "spool")}
+        return {c: r.channels[c] for c in SIM_CHANNELS}
     return None
 
 
@@ -186,25 +178,16 @@ def channel_stats(sims: list, cases: list[Case], which: str = "all") -> dict:
         for c, y in case.meas.items():
             e = ((y - sim[c]) / case.scale[c] if sim is not None else np.full(y.size, 10.0))[mask]
             out[(case.name, c)] = {
-                "ssr": float(e @ e), "n": int(e.size), "rho": lag1_autocorrelation(e),
+                "ssr": float(e @ e), "n": int(e.size), "rho": ar1_coefficient(e),
                 "floor": float(e.size * (case.sigma[c] / case.scale[c]) ** 2),
             }
     return out
 
 
-def lag1_autocorrelation(e: np.ndarray) -> float:
-    """Lag-1 autocorrelation of a residual series (mean removed), clipped to
-    [0, 0.999] (the effective-sample-size and bandwidth rules need rho >= 0)."""
-    e0 = e - e.mean()
-    den = float(e0 @ e0)
-    rho = float(e0[1:] @ e0[:-1] / den) if den > 0 else 0.0
-    return min(max(rho, 0.0), 0.999)
-
-
 def n_eff(stats: dict) -> dict:
     """Effective sample size per channel from the residual's lag-1 autocorrelation:
     n (1 - rho) / (1 + rho), at least 10."""
-    return {k: max(10.0, s["n"] * (1 - s["rho"]) / (1 + s["rho"])) for k, s in stats.items()}
+    return {k: max(10.0, ar1_effective_n(s["n"], s["rho"])) for k, s in stats.items()}
 
 
 def bic(stats: dict, k: int, neff: dict) -> float:
@@ -408,37 +391,6 @@ class JointSpace:
         return rig, tau
 
 
-def _flat(d: dict, prefix: str = "") -> dict:
-    out = {}
-    for k, v in d.items():
-        if isinstance(v, dict):
-            out.update(_flat(v, f"{prefix}{k}."))
-        else:
-            out[prefix + k] = v
-    return out
-
-
-def same_rig(a: Rig, b: Rig, rtol: float = 1e-9) -> bool:
-    """True if two rigs have the same switches and parameters (numbers within ``rtol``).
-    To be replaced by the binding's ``Rig.__eq__`` (``a == b``); this is the one place."""
-    fa, fb = _flat(rig_to_dict(a)), _flat(rig_to_dict(b))
-    if fa.keys() != fb.keys():
-        return False
-    for k, va in fa.items():
-        vb = fb[k]
-        if isinstance(va, bool) or isinstance(vb, bool) or isinstance(va, str) or isinstance(vb, str):
-            if va != vb:
-                return False
-        elif isinstance(va, (int, float)) and isinstance(vb, (int, float)):
-            if not math.isclose(va, vb, rel_tol=rtol, abs_tol=0.0):
-                return False
-        else:
-            xa, xb = np.asarray(va, float), np.asarray(vb, float)
-            if xa.shape != xb.shape or not np.allclose(xa, xb, rtol=rtol, atol=0.0):
-                return False
-    return True
-
-
 def simulate_all(rig: Rig, cases: list[Case], tau: float, x0s) -> list[Sim]:
     """``simulate_case`` of every record, each from its initial displacement in ``x0s`` [m]."""
     return [simulate_case(rig, c, tau, x0) for c, x0 in zip(cases, x0s)]
@@ -476,33 +428,22 @@ def secant_screen(space: Space, cases: list[Case], x0s, r0: np.ndarray, base_tau
     return Screening(score, z0, D @ alpha_c)
 
 
-def _structure_force(rig: Rig, x: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """The structure's forces of Eq (5) but inertia, at displacement x [m] and
-    velocity v [m/s]: damping, spring (softening beyond x_contact) and Coulomb
-    friction (tanh regularisation) [N].
-
-    Eq (5) belongs to the core: this NumPy copy lacks the Stribeck level and
-    the LuGre bristle force (dynamics.cpp).  It is to be replaced by the core's
-    vectorised ``Dynamics.structure_forces(x, v, z=0)``; this is the one place."""
-    xc = rig.x_contact
-    if rig.effects.spring_softening:
-        fs = np.where(np.abs(x) <= xc, rig.k * x, np.sign(x) * (rig.k * xc + rig.k_2 * (np.abs(x) - xc)))
-    else:
-        fs = rig.k * x
-    fr = rig.F_c * np.tanh(v / rig.v_stick) if rig.effects.coulomb_friction else 0.0
-    return rig.c * v + fs + fr
-
-
 def balance_screen(rig: Rig, cases: list[Case], signature) -> float:
     """R^2 of the structure's equation-of-motion residual regressed on one effect's
-    signature: e = F - (m a + c v + f_s(x) + F_c tanh(v/v_stick)) with measured
-    (or differentiated) displacement, velocity, acceleration and force."""
+    signature: e = F - (m a + f_s(x) + c v + F_f(v, z = 0)) with measured (or
+    differentiated) displacement, velocity, acceleration and force, the
+    structure's forces from the core (``Dynamics.structure_forces``, Eq 5).
+    The friction is the static law with its Stribeck level; with LuGre friction
+    the bristle deflection z is not measured and is taken as 0, so F_f is only
+    the bristle damping sigma_1 v (the screen then sees the rest of the
+    friction as residual)."""
     es, ss = [], []
     for case in cases:
         d = case.derived
         x, v, a, F = d["displacement"], d["velocity"], d["acceleration"], d["force"]
-        e = F - (rig.m * a + _structure_force(rig, x, v))
-        s = signature(rig, {"displacement": x, "velocity": v, "acceleration": a, "rms_v": d["rms_v"]})
+        structure = _core.Dynamics(rig, MODES[case.mode]).structure_forces(x, v)
+        e = F - (rig.m * a + structure)
+        s = signature(rig, d)  # the record's derived channels (and rms_v)
         n = x.size
         cut = slice(n // 50, n - n // 50)  # drop the filter's edge samples
         es.append(e[cut] / max(np.sqrt(np.mean(F ** 2)), rig.k * np.sqrt(np.mean(x ** 2)), 1e-9))
@@ -557,7 +498,7 @@ def bartlett_bandwidth(e: np.ndarray) -> int:
     Andrews (1991) for the Bartlett kernel: 1.1447 (alpha n)^(1/3), alpha =
     4 rho^2 / ((1 - rho)^2 (1 + rho)^2), rho the lag-1 autocorrelation; at most n/2."""
     n = e.size
-    rho = lag1_autocorrelation(e)
+    rho = ar1_coefficient(e)
     alpha = 4 * rho ** 2 / ((1 - rho) ** 2 * (1 + rho) ** 2)
     return int(min(max(math.ceil(1.1447 * (alpha * n) ** (1 / 3)), 1), n // 2))
 

@@ -119,7 +119,7 @@ def joint_refit(accepted: list[Accepted], parameters: dict, current: Rig, tau: f
     js = engine.JointSpace([a.space for a in accepted], current)
     z0, base_tau = _start(accepted, js, current, tau)
     rig0, tau0 = js.rig_and_tau(z0, base_tau)
-    if not engine.same_rig(rig0, current) or not math.isclose(tau0, tau, rel_tol=1e-9, abs_tol=1e-12):
+    if rig0 != current or not math.isclose(tau0, tau, rel_tol=1e-9, abs_tol=1e-12):
         return dataclasses.replace(info, reason="not tried: the greedy model cannot be rebuilt from the effects' "
                                                 "parameters"), None
     stats0 = engine.channel_stats(sims, cases)
