@@ -65,9 +65,7 @@ def fig4b(out: Path, rng) -> dict:
     phase = 2 * np.pi * (f0 * t + 0.5 * (f1 - f0) / t[-1] * t ** 2)
     peff = 8.9e3 * np.minimum(t / 0.5, 1.0) * np.sin(phase)
     lab = sh.zhao2003()  # falling flow gain on (the preset's table, g(1) = 0.56)
-    # options given explicitly: solver_options() defaults to rk4_substeps = 0, which validate() now rejects
-    res = sh.run_eft(lab, effective_force=peff, dt=DT, compensation="linear",
-                     options=sh.solver_options(method="cvode", rk4_substeps=1))
+    res = sh.run_eft(lab, effective_force=peff, dt=DT, compensation="linear")  # CVODE, the default
     ch = res.channels
     rec = {"time": ch["time"], "command": ch["command"], "displacement": _noise(ch["displacement"], 30, rng),
            "force": _noise(ch["force"], 30, rng)}
