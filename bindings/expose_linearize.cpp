@@ -16,6 +16,4 @@ void expose_linearize(py::module_& m) {
       .def_readonly("active", &LinearModel::active);
   m.def("linearize_dynamics", &linearize, py::arg("dynamics"), py::arg("y0"), py::arg("u0") = 0.0,
         "LinearModel of the plant about state y0 with the command held at u0 (the C++ linearize)");
-  // Deprecated name, kept while the Python layer still calls it.
-  m.def("linearize", &linearize, py::arg("dynamics"), py::arg("y0"), py::arg("u0") = 0.0);
 }

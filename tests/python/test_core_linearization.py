@@ -1,4 +1,4 @@
-"""The model's linearisation (the C++ linearize, sh._core.linearize, on sh.Dynamics, from the analytic
+"""The model's linearisation (the C++ linearize, sh._core.linearize_dynamics, on sh.Dynamics, from the analytic
 Jacobian) against the paper's closed forms.
 
 Eq (9), force control, and Eq (12), displacement control, assume a static
@@ -45,13 +45,13 @@ PAPER_LINEAR = ("servovalve_dynamics", "load_pressure", "flow_nonlinearity", "pi
 
 
 def linearised(rig: sh.Rig, mode: str, output: str) -> ct.StateSpace:
-    """sh._core.linearize at the static equilibrium x = 0, command 0, reduced to the
+    """sh._core.linearize_dynamics at the static equilibrium x = 0, command 0, reduced to the
     states that take part in this mode/effect set, and balanced (a diagonal
     similarity transform, scipy.linalg.matrix_balance): the states span 1e-2 m
     to 1e7 Pa, and unbalanced (sI - A) has condition numbers up to 1e17."""
     dyn = sh.Dynamics(rig, MODES[mode])
     y0 = dyn.equilibrium(0.0)
-    lm = sh._core.linearize(dyn, y0, 0.0)
+    lm = sh._core.linearize_dynamics(dyn, y0, 0.0)
     keep = np.flatnonzero(lm.active)
     row = OUT[output]
     A, B, C = lm.A[np.ix_(keep, keep)], lm.B[keep], lm.C[row : row + 1, keep]

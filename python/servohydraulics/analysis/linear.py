@@ -138,7 +138,7 @@ def linearize(rig: Rig, mode: str = "displacement", x0: float = 0.0, u0: float |
     r = linear_analysis_rig(rig, friction, friction_amplitude, friction_frequency)
     dyn = _core.Dynamics(r, MODES[mode])
     y0, u_hold = dyn.operating_point(float(x0))
-    lm = _core.linearize(dyn, y0, u_hold if u0 is None else float(u0))
+    lm = _core.linearize_dynamics(dyn, y0, u_hold if u0 is None else float(u0))
     keep = np.flatnonzero(np.asarray(lm.active, dtype=bool))
     need = list(dict.fromkeys(outs + (["velocity"] if comp.velocity_feedback else [])))
     rows = [OUTPUTS.index(o) for o in need]
