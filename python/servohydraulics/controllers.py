@@ -23,8 +23,6 @@ from . import _core
 from .loops import eft_config, rpsd_config
 from .rig import Rig
 
-_TM = _core.ZHAO2003_TEST_METHODS
-
 
 class EftController:
     """Effective force testing (Fig 1a): P_eff = -m a_g plus the velocity feedback
@@ -35,10 +33,11 @@ class EftController:
             C_F_force, G_p, flow curve; and m when ``mass`` is None).
         compensation: ``"none"``, ``"linear"`` or ``"nonlinear"``.
         mass: m in P_eff = -m a_g [kg] (None: ``rig.m``).
+        Keywords left at None take the core's ``EftConfig`` defaults (the paper's 0.5 ms, 5 ms, 0.1).
     """
 
-    def __init__(self, rig: Rig, dt: float = _TM.dt, compensation: str = "linear",
-                 lead_T: float = _TM.eft_lead_T, alpha: float = _TM.alpha, mass: float | None = None,
+    def __init__(self, rig: Rig, dt: float | None = None, compensation: str = "linear",
+                 lead_T: float | None = None, alpha: float | None = None, mass: float | None = None,
                  compute_delay: int = 0):
         self._core = _core.EftController(eft_config(dt, compensation, lead_T, alpha, mass, compute_delay), rig)
 
@@ -73,13 +72,14 @@ class RpsdController:
         rig: the physical rig under test (its m is the structural mass behind the
             load cell); the defaults of k_m (rig.k), subtract_mass (rig.m, plus m_p
             for ``"actuator_pressure"``), subtract_damping (rig.c) and p A come from it.
-        Others as ``sh.run_rpsd`` (``scheme``: ``"central_difference"`` or ``"explicit_newmark"``).
+        Others as ``sh.run_rpsd`` (``scheme``: ``"central_difference"`` or ``"explicit_newmark"``);
+        keywords left at None take the core's ``RpsdConfig`` defaults.
     """
 
-    def __init__(self, rig: Rig, dt: float = _TM.dt, m_m: float = _TM.model.m_m, c_m: float = _TM.model.c_m,
+    def __init__(self, rig: Rig, dt: float | None = None, m_m: float | None = None, c_m: float | None = None,
                  k_m: float | None = None, scheme: str = "central_difference",
-                 restoring_force: str = "measured_displacement", amplitude_T: float = _TM.amplitude_T,
-                 delay_T: float | None = None, alpha: float = _TM.alpha, force_measurement: str = "load_cell",
+                 restoring_force: str = "measured_displacement", amplitude_T: float | None = None,
+                 delay_T: float | None = None, alpha: float | None = None, force_measurement: str = "load_cell",
                  subtract_mass: float | None = None, subtract_damping: float | None = None,
                  compute_delay: int = 0):
         cfg = rpsd_config(dt, m_m, c_m, k_m, scheme, restoring_force, amplitude_T, delay_T, alpha,

@@ -275,18 +275,6 @@ class Response:
             out.append(self.message)
         return out
 
-    @property
-    def summary(self) -> dict[str, Any]:
-        """The run's counts as a dict (kept for existing callers; ``work`` is the bound RunSummary)."""
-        w = self.work
-        if w is None:
-            return {"status": self.status, "ok": self.success, "rows": len(self)}
-        return {"status": w.status.message, "ok": self.success, "rows": w.rows,
-                "failure_time": None if self.success else w.status.t, "cvode_flag": w.status.cvode_flag,
-                "internal_steps": w.internal_steps, "rhs_evals": w.rhs_evals, "restarts": w.restarts,
-                "max_internal_steps": w.max_internal_steps, "flags_any": w.flags_any, "peak_force": w.peak_force,
-                "first_capacity_time": w.first_capacity_time}
-
     # ---- export ----------------------------------------------------------------------
     def to_pandas(self) -> pd.DataFrame:
         """One column per channel (``time`` first), units in ``df.attrs["units"]``."""

@@ -139,8 +139,8 @@ def test_diverging_run_raises_with_time_and_cause(calibrated):
     with pytest.raises(sh.SimulationError, match=r"failed at t = 0\.038 s: .*diverged"):
         sh.simulate(calibrated, mode="free", command=np.full(400, 1e9))
     partial = sh.simulate(calibrated, mode="free", command=np.full(400, 1e9), raise_on_failure=False)
-    assert not partial.summary["ok"]
-    assert partial.summary["failure_time"] == pytest.approx(0.038)
+    assert not partial.success and partial.status == "non_finite"
+    assert partial.work.status.t == pytest.approx(0.038)
     assert len(partial.time) == 76  # rows up to the failed sample (t = 0 ... 0.0375 s)
     assert np.all(np.isfinite(partial.displacement))
 
@@ -160,7 +160,7 @@ def test_printed_table_one_runs_into_the_supply_pressure(make_rig, dt):
     rig = make_rig("printed")
     n = int(round(1.0 / dt)) + 1
     res = sh.simulate(rig, mode="displacement", command=np.full(n, 1e-3), dt=dt)
-    assert res.summary["ok"]
+    assert res.success
     assert res.supply_limited
     assert any("supply pressure" in w and "t = " in w for w in res.warnings())
     late = res.displacement[res.time > 0.5]
