@@ -93,6 +93,10 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--out", required=True, help="output directory (diagnosis.json, rig_updated.toml, report.md)")
     g.add_argument("--quiet", action="store_true", help="no progress bar")
     g.set_defaults(func=_diagnose)
+
+    from .commands import register_all  # commands that live in their own module (commands/*.py)
+
+    register_all(sub)
     return p
 
 
