@@ -248,48 +248,48 @@ void add_eft(std::vector<Variable>& out) {
   add_sensors(out);
   add_outputs(out, kEftChannels, &Values::eft_out);
   add_dt(out);
-  out.push_back(resolved("mass", "kg", "m in P_eff = -m a_g",
+  out.push_back(resolved("eft.mass", "kg", "m in P_eff = -m a_g",
                          [](Values& v) -> std::optional<double>& { return v.settings.eft.mass; }));
   out.push_back(enumeration<VelocityFeedbackCompensator::Kind>(
-      "compensation", "Compensation", {"none", "linear", "nonlinear"}, "velocity feedback compensation",
+      "eft.compensation", "Compensation", {"none", "linear", "nonlinear"}, "velocity feedback compensation",
       [](Values& v) -> VelocityFeedbackCompensator::Kind& { return v.settings.eft.compensation; }));
-  out.push_back(parameter("lead_T", "s", "phase lead on the compensation (0 = none)",
+  out.push_back(parameter("eft.lead_T", "s", "phase lead on the compensation (0 = none)",
                           [](Values& v) -> double& { return v.settings.eft.lead_T; }));
-  out.push_back(parameter("alpha", "", "phase-lead constant",
+  out.push_back(parameter("eft.alpha", "", "phase-lead constant",
                           [](Values& v) -> double& { return v.settings.eft.alpha; }));
-  out.push_back(integer<int>("compute_delay", "samples of compute delay on the command",
+  out.push_back(integer<int>("eft.compute_delay", "samples of compute delay on the command",
                              [](Values& v) -> int& { return v.settings.eft.compute_delay; }));
 }
 
 void add_rpsd_config(std::vector<Variable>& out) {
   using Opt = std::optional<double>;
-  out.push_back(parameter("m_m", "kg", "modelled mass of Eq (15)",
+  out.push_back(parameter("rpsd.m_m", "kg", "modelled mass of Eq (15)",
                           [](Values& v) -> double& { return v.settings.rpsd.model.m_m; }));
-  out.push_back(parameter("c_m", "N s/m", "modelled damping of Eq (15)",
+  out.push_back(parameter("rpsd.c_m", "N s/m", "modelled damping of Eq (15)",
                           [](Values& v) -> double& { return v.settings.rpsd.model.c_m; }));
-  out.push_back(resolved("k_m", "N/m", "stiffness of the displacement-based restoring forces",
+  out.push_back(resolved("rpsd.k_m", "N/m", "stiffness of the displacement-based restoring forces",
                          [](Values& v) -> Opt& { return v.settings.rpsd.k_m; }));
   out.push_back(enumeration<IntegrationScheme>(
-      "scheme", "IntegrationScheme", {"central_difference", "explicit_newmark"}, "integration scheme of Eq (15)",
+      "rpsd.scheme", "IntegrationScheme", {"central_difference", "explicit_newmark"}, "integration scheme of Eq (15)",
       [](Values& v) -> IntegrationScheme& { return v.settings.rpsd.scheme; }));
   out.push_back(enumeration<RestoringForce>(
-      "restoring_force", "RestoringForce",
+      "rpsd.restoring_force", "RestoringForce",
       {"calculated_displacement", "measured_displacement", "measured_force", "measured_force_corrected"},
       "restoring force option (a)-(d)", [](Values& v) -> RestoringForce& { return v.settings.rpsd.restoring_force; }));
   out.push_back(enumeration<ForceMeasurement>(
-      "force_measurement", "ForceMeasurement", {"load_cell", "actuator_pressure"}, "measured force: load cell or p A",
+      "rpsd.force_measurement", "ForceMeasurement", {"load_cell", "actuator_pressure"}, "measured force: load cell or p A",
       [](Values& v) -> ForceMeasurement& { return v.settings.rpsd.force_measurement; }));
-  out.push_back(parameter("amplitude_T", "s", "amplitude compensation T_d on the command (0 = none)",
+  out.push_back(parameter("rpsd.amplitude_T", "s", "amplitude compensation T_d on the command (0 = none)",
                           [](Values& v) -> double& { return v.settings.rpsd.amplitude_T; }));
-  out.push_back(parameter("delay_T", "s", "delay compensation T_ld on the restoring force (0 = none)",
+  out.push_back(parameter("rpsd.delay_T", "s", "delay compensation T_ld on the restoring force (0 = none)",
                           [](Values& v) -> double& { return v.settings.rpsd.delay_T; }));
-  out.push_back(parameter("alpha", "", "phase-lead constant of both networks",
+  out.push_back(parameter("rpsd.alpha", "", "phase-lead constant of both networks",
                           [](Values& v) -> double& { return v.settings.rpsd.alpha; }));
-  out.push_back(resolved("subtract_mass", "kg", "option (d): mass times measured acceleration removed",
+  out.push_back(resolved("rpsd.subtract_mass", "kg", "option (d): mass times measured acceleration removed",
                          [](Values& v) -> Opt& { return v.settings.rpsd.subtract_mass; }));
-  out.push_back(resolved("subtract_damping", "N s/m", "option (d): damping times measured velocity removed",
+  out.push_back(resolved("rpsd.subtract_damping", "N s/m", "option (d): damping times measured velocity removed",
                          [](Values& v) -> Opt& { return v.settings.rpsd.subtract_damping; }));
-  out.push_back(integer<int>("compute_delay", "samples of compute delay on the command",
+  out.push_back(integer<int>("rpsd.compute_delay", "samples of compute delay on the command",
                              [](Values& v) -> int& { return v.settings.rpsd.compute_delay; }));
 }
 
