@@ -38,6 +38,7 @@ from fmpy.validation import validate_fmu  # noqa: E402
 
 import servohydraulics as sh  # noqa: E402
 from servohydraulics import _core  # noqa: E402
+from servohydraulics.fmu import cosimulate  # noqa: E402
 
 DT = 5e-4
 PLANT_OUT = [name for name, _unit in _core.PLANT_CHANNELS if name != "time"]
@@ -197,44 +198,30 @@ def test_plant_fmu_rk4_and_multi_sample_steps(rig, tmp_path):
     assert _rel(got, ref.displacement[::m]) <= RTOL
 
 
-def loop(plant: Slave, ctrl: Slave, n: int, inputs: dict[str, np.ndarray]):
-    """The co-simulation master: Gauss-Seidel at the controller rate."""
-    ctrl_out = [v.name for v in ctrl.md.modelVariables if v.causality == "output"]
-    sensors = [f"sensors.{c}" for c in PLANT_OUT]
-    rows = {n_: [] for n_ in PLANT_OUT + ctrl_out}
-    for k in range(n):
-        y = plant.get(PLANT_OUT)
-        ctrl.set(**{s.replace(".", "__"): v for s, v in zip(sensors, y)}, **{a: x[k] for a, x in inputs.items()})
-        out = ctrl.get(ctrl_out)
-        for name, v in zip(PLANT_OUT + ctrl_out, list(y) + list(out)):
-            rows[name].append(v)
-        plant.set(command=out[ctrl_out.index("command")])
-        plant.step()
-        ctrl.step()
-    return rows, ctrl_out
-
-
-def test_eft_fmu_with_plant_fmu_equals_run_eft(rig, fmus, tmp_path):
+def test_eft_fmu_with_plant_fmu_equals_run_eft(rig, fmus):
     n = 800
     ag = 3.0 * np.sin(2 * np.pi * 1.5 * np.arange(n) * DT)
     ref = sh.run_eft(rig, ag, dt=DT)
-    plant, ctrl = Slave(fmus["plant_force"], tmp_path / "p"), Slave(fmus["eft"], tmp_path / "c")
-    rows, ctrl_out = loop(plant, ctrl, n, {"ground_acceleration": ag})
-    _equal(rows, ref, PLANT_OUT + ctrl_out)
-    assert set(ctrl_out) == {"effective_force", "compensation", "compensation_opening", "command"}
+    rows = cosimulate(fmus["plant_force"], fmus["eft"], ag)
+    outputs = ["effective_force", "compensation", "compensation_opening", "command"]
+    assert set(rows) == {"time", *PLANT_OUT, *outputs}
+    _equal(rows, ref, PLANT_OUT + outputs)
 
 
 def test_rpsd_fmu_with_plant_fmu_equals_run_rpsd(rig, tmp_path):
     n = 800
     ag = 2.0 * np.sin(2 * np.pi * 1.2 * np.arange(n) * DT)
+    pe = np.where(np.arange(n) < 200, 1e3, 0.0)
     kw = {"restoring_force": "measured_force_corrected", "scheme": "explicit_newmark"}
-    ref = sh.run_rpsd(rig, ag, dt=DT, physical_mass_fraction=0.02, **kw)
+    ref = sh.run_rpsd(rig, ag, external_force=pe, dt=DT, physical_mass_fraction=0.02, **kw)
     phys = ref.rig  # the physical rig of the simulated test
-    plant = Slave(sh.export_fmu(phys, tmp_path / "p.fmu"), tmp_path / "p")
-    ctrl = Slave(sh.export_fmu(phys, tmp_path / "r.fmu", kind="rpsd", **kw), tmp_path / "r")
-    rows, ctrl_out = loop(plant, ctrl, n, {"ground_acceleration": ag})
-    _equal(rows, ref, PLANT_OUT + ctrl_out)
-    assert "calc_displacement" in ctrl_out and "command" in ctrl_out
+    plant = sh.export_fmu(phys, tmp_path / "p.fmu")
+    ctrl = sh.export_fmu(phys, tmp_path / "r.fmu", kind="rpsd", **kw)
+    rows = cosimulate(plant, ctrl, ag, external_force=pe)
+    outputs = ["measured_restoring_force", "restoring_force", "calc_displacement", "calc_velocity",
+               "calc_acceleration", "target_displacement", "command"]
+    assert set(rows) == {"time", *PLANT_OUT, *outputs}
+    _equal(rows, ref, PLANT_OUT + outputs)
 
 
 def test_output_reads_do_not_advance_the_controller(rig, fmus, tmp_path):
