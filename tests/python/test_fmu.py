@@ -123,6 +123,7 @@ def fmus(rig, tmp_path_factory):
     return {"plant_disp": sh.export_fmu(rig, d / "plant_disp.fmu", kind="plant", mode="displacement"),
             "plant_force": sh.export_fmu(rig, d / "plant_force.fmu", kind="plant", mode="force"),
             "eft": sh.export_fmu(rig, d / "eft.fmu", kind="eft"),
+            "rpsd": sh.export_fmu(rig, d / "rpsd.fmu", kind="rpsd"),
             "dir": d}
 
 
@@ -141,7 +142,7 @@ def run_plant(path, workdir, u, **values):
 
 
 def test_model_descriptions_validate(fmus):
-    for key in ("plant_disp", "plant_force", "eft"):
+    for key in ("plant_disp", "plant_force", "eft", "rpsd"):
         assert validate_fmu(str(fmus[key])) == [], key
 
 
