@@ -227,7 +227,8 @@ void add_plant(std::vector<Variable>& out, ControlMode mode) {
   add_dt(out);
   out.push_back(parameter("x0", "m", "initial displacement (static equilibrium there)",
                           [](Values& v) -> double& { return v.settings.x0; }));
-  // The names of SolverOptions::Method, in the enum's order.
+  // The names of SolverOptions::Method, in the enum's order (those of simulate.py's METHODS); a new
+  // method needs its name here, else exporting with it is a ValueError naming solver.method.
   out.push_back(enumeration<SolverOptions::Method>(
       "solver.method", "SolverMethod", {"cvode", "rk4"}, "the plant's ODE integrator (solver_options.hpp)",
       [](Values& v) -> SolverOptions::Method& { return v.settings.solver.method; }));
@@ -277,7 +278,8 @@ void add_rpsd_config(std::vector<Variable>& out) {
       {"calculated_displacement", "measured_displacement", "measured_force", "measured_force_corrected"},
       "restoring force option (a)-(d)", [](Values& v) -> RestoringForce& { return v.settings.rpsd.restoring_force; }));
   out.push_back(enumeration<ForceMeasurement>(
-      "rpsd.force_measurement", "ForceMeasurement", {"load_cell", "actuator_pressure"}, "measured force: load cell or p A",
+      "rpsd.force_measurement", "ForceMeasurement", {"load_cell", "actuator_pressure"},
+      "measured force: load cell or p A",
       [](Values& v) -> ForceMeasurement& { return v.settings.rpsd.force_measurement; }));
   out.push_back(parameter("rpsd.amplitude_T", "s", "amplitude compensation T_d on the command (0 = none)",
                           [](Values& v) -> double& { return v.settings.rpsd.amplitude_T; }));

@@ -72,6 +72,8 @@ def _start(var: dict):
     if var["type"] == "Integer":
         return int(v)
     if var["type"] == "Enumeration":
+        if not 0 <= int(v) < len(var["items"]):  # a core enum value the FMU's item list lacks (cpp/fmu/model.cpp)
+            raise ValueError(f"invalid {var['name']} = {int(v)}: the FMU knows only {var['items']}")
         return var["items"][int(v)]
     return float(v)
 
