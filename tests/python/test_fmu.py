@@ -368,3 +368,28 @@ def test_cli_writes_an_fmu(rig, tmp_path):
     assert validate_fmu(str(tmp_path / "p.fmu")) == []
     md = read_model_description(str(tmp_path / "p.fmu"))
     assert {v.name: v for v in md.modelVariables}["command"].unit == "N"
+
+
+def test_rig_details_travel_through_the_resources(rig, tmp_path):
+    """A tabulated flow curve (arrays), an effect switched off (Boolean), x0 and dt: the FMU equals sh.simulate."""
+    r = sh.copy_rig(rig)
+    fc = _core.FlowCurve()
+    fc.kind = _core.FlowCurve.Kind.Table
+    fc.opening, fc.flow = [0.0, 0.1, 0.5, 1.0], [0.0, 0.1, 0.42, 0.6]
+    r.flow_curve = fc
+    r.effects.coulomb_friction = False
+    r.k = 612345.678901234
+    dt, x0 = 1e-3, 0.004
+    path = sh.export_fmu(r, tmp_path / "t.fmu", dt=dt, x0=x0)
+    u = x0 + 0.02 * np.sin(2 * np.pi * 5.0 * np.arange(400) * dt)  # spool beyond 10 %: the curve matters
+    ref = sh.simulate(r, "displacement", u, dt, x0=x0)
+    assert np.max(np.abs(ref.spool)) > 0.12
+    s = Slave(path, tmp_path / "t")
+    got = []
+    for k in range(u.size):
+        got.append(s.get(["displacement"])[0])
+        s.set(command=u[k])
+        s.step(dt)
+    s.close()
+    assert _rel(got, ref.displacement) <= RTOL
+    assert s.var["effects.coulomb_friction"].start in ("false", False)
