@@ -368,6 +368,12 @@ def test_cli_writes_an_fmu(rig, tmp_path):
     assert validate_fmu(str(tmp_path / "p.fmu")) == []
     md = read_model_description(str(tmp_path / "p.fmu"))
     assert {v.name: v for v in md.modelVariables}["command"].unit == "N"
+    out = subprocess.run([sys.executable, "-m", "servohydraulics", "fmu", "--kind", "eft", "--set", "lead_T=0.002",
+                          "--set", "compensation=nonlinear", "--out", str(tmp_path / "e.fmu")],
+                         capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    v = {x.name: x for x in read_model_description(str(tmp_path / "e.fmu")).modelVariables}
+    assert float(v["eft.lead_T"].start) == 0.002 and int(v["eft.compensation"].start) == 2
 
 
 def test_rig_details_travel_through_the_resources(rig, tmp_path):
