@@ -39,7 +39,9 @@ python_env() {
 
 cxx_tests() {
   local b="$root/build/ctest"
+  # SH_BUILD_FMU: the FMU binary and its C-ABI test (the FMI headers come from the venv's fmpy)
   "$venv/bin/cmake" -S "$root" -B "$b" -G Ninja -DSH_BUILD_TESTS=ON -DCMAKE_BUILD_TYPE=Release \
+    -DSH_BUILD_FMU=ON -DPython_EXECUTABLE="$venv/bin/python" \
     -DCMAKE_MAKE_PROGRAM="$venv/bin/ninja" >/dev/null
   "$venv/bin/cmake" --build "$b" -j "$jobs"
   PATH="$venv/bin:$PATH" "$venv/bin/ctest" --test-dir "$b" --output-on-failure -j "$jobs"

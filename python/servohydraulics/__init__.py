@@ -65,6 +65,7 @@ _LAZY = {
     "diagnose": (".diagnosis", "diagnose"),
     "Diagnosis": (".diagnosis", "Diagnosis"),
     "reproduce": (".paper.reproduce", "reproduce"),
+    "export_fmu": (".fmu", "export_fmu"),
 }
 
 #: Deprecated names, kept for one release: name -> (replacement, object).
@@ -127,6 +128,7 @@ __all__ = [
     "SolverOptions",
     "copy_rig",
     "diagnose",
+    "export_fmu",
     "linearize",
     "load_rig",
     "make_plant",
