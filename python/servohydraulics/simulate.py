@@ -12,6 +12,9 @@ from .excitations import time_axis
 from .response import Response, SimulationError, finish
 from .rig import Rig
 
+#: Largest initial displacement [m]: the plant's divergence guard (plant.cpp, kMaxDisplacement).
+MAX_X0 = 100.0
+
 MODES = {
     "displacement": _core.ControlMode.Displacement,
     "force": _core.ControlMode.Force,
@@ -80,8 +83,9 @@ def make_plant(rig: Rig, mode: str, dt: float = 5e-4, options: _core.SolverOptio
     """Constructs and resets a plant (validates everything, raises ValueError)."""
     if mode not in MODES:
         raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(MODES)}")
-    if not math.isfinite(x0):
-        raise ValueError(f"invalid x0 = {x0!r}: must be finite [m]")
+    if not math.isfinite(x0) or abs(x0) > MAX_X0:
+        raise ValueError(f"invalid x0 = {x0!r}: must be finite and within +-{MAX_X0:g} m (the plant's "
+                         "divergence guard)")
     plant = _core.Plant(rig, MODES[mode], _check_dt(dt), options or _core.SolverOptions())
     plant.reset(float(x0))
     return plant
