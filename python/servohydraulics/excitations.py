@@ -65,6 +65,9 @@ def time_axis(duration: float, dt: float = DT) -> np.ndarray:
 def sine(amplitude: float, frequency: float, duration: float, dt: float = DT, phase: float = 0.0) -> np.ndarray:
     """amplitude * sin(2 pi f t + phase); frequency [Hz], duration and dt [s]."""
     _positive("frequency", frequency)
+    for name, v in (("amplitude", amplitude), ("phase", phase)):
+        if not math.isfinite(v):
+            raise ValueError(f"invalid {name} = {v!r}: must be finite")
     t = time_axis(duration, dt)
     return amplitude * np.sin(2 * np.pi * frequency * t + phase)
 

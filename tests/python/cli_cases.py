@@ -82,8 +82,8 @@ def make_cases(root: Path) -> list[tuple[str, list[str], str]]:
         ("dt_tiny", "--dt", "1e-300", "samples"), ("duration_zero", "--duration", "0", "duration = 0"),
         ("duration_negative", "--duration", "-5", "duration = -5"), ("duration_huge", "--duration", "1e300", "samples"),
         ("duration_nan", "--duration", "nan", "duration = nan"), ("frequency_zero", "--frequency", "0", "frequency"),
-        ("frequency_nan", "--frequency", "nan", "frequency"), ("amplitude_nan", "--amplitude", "nan", "command"),
-        ("amplitude_inf", "--amplitude", "inf", "command"), ("x0_nan", "--x0", "nan", "x0"),
+        ("frequency_nan", "--frequency", "nan", "frequency"), ("amplitude_nan", "--amplitude", "nan", "amplitude"),
+        ("amplitude_inf", "--amplitude", "inf", "amplitude"), ("x0_nan", "--x0", "nan", "x0"),
         ("x0_huge", "--x0", "1e300", "x0"), ("dt_text", "--dt", "abc", "--dt"), ("mode_bogus", "--mode", "bogus", "--mode"),
     ]:
         cases.append((f"simulate {name}", sim + [flag, value, "--out", out], expect))
