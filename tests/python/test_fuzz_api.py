@@ -30,7 +30,7 @@ from servohydraulics import _core
 #: a 200-sample run takes well under a second.
 RUN_BOUND_S = 30.0
 N = 200
-FUZZ = settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow], derandomize=True)
+FUZZ = settings(max_examples=600, deadline=None, suppress_health_check=[HealthCheck.too_slow], derandomize=True)
 
 #: "invalid <field> = <value>: <requirement>"; the field may be dotted, indexed or a product.  A valid
 #: but extreme rig may instead fail the integrator's setup, which names the step, the time and the flag.
@@ -189,7 +189,7 @@ def test_flow_curve_short_tables_raise_instead_of_reading_out_of_bounds(opening,
 ODD = st.sampled_from([None, 0, -1, 1.5, 2**70, math.nan, math.inf, "x", 5e-4, 0.1, 2])
 
 
-@settings(max_examples=100, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=300, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 @given(method=st.sampled_from(["eft", "rpsd"]), dt=ODD, alpha=ODD, lead_T=ODD, compute_delay=ODD,
        amplitude=st.sampled_from([0.0, 0.3, 30.0, 1e300]))
 def test_loop_keywords(method, dt, alpha, lead_T, compute_delay, amplitude):

@@ -45,7 +45,7 @@ FLOATS = st.one_of(st.sampled_from([0.0, -1.0, math.nan, math.inf, -math.inf, 1e
                    st.floats(-1e3, 1e3))
 
 
-@settings(max_examples=150, deadline=None, derandomize=True,
+@settings(max_examples=400, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(mode=st.sampled_from(["displacement", "force", "free", "bogus"]),
        dt=st.one_of(st.sampled_from([5e-4, 1e-3]), FLOATS), duration=st.one_of(st.floats(0.001, 0.05), FLOATS),

@@ -21,7 +21,7 @@ import servohydraulics as sh
 from servohydraulics.records import read_record, write_record
 from servohydraulics.response import channel_units
 
-FUZZ = settings(max_examples=400, deadline=None, derandomize=True,
+FUZZ = settings(max_examples=1000, deadline=None, derandomize=True,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 OUTCOMES: collections.Counter = collections.Counter()
 
