@@ -6,12 +6,15 @@
 // The command (displacement control) is a sum of two sines (5 mm at 1 Hz, 2 mm
 // at 3.7 Hz) for all but the last simulated minute, then 0: the structure must
 // come back to rest where it started.  Per simulated minute: step-time median,
-// p99, p99.9 and max [us], the process's resident set size [kB] (from
+// p99, p99.9 and max [us] of wall time, and the same of the thread's CPU time
+// (the step's cost without the OS preempting it on a shared machine: the
+// wall-time tail there is scheduler ticks of 4 ms), the resident set size [kB] (from
 // /proc/self/statm), failed steps.  At the end: the displacement and velocity
 // at rest, the clock against k dt.  The plant is built outside the timed
 // region; the per-minute buffer of step times is allocated once.
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -57,6 +60,12 @@ long rss_kb() {
   return resident * (sysconf(_SC_PAGESIZE) / 1024);
 }
 
+double thread_cpu_us() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return 1e6 * ts.tv_sec + 1e-3 * ts.tv_nsec;
+}
+
 double percentile(std::vector<double>& v, double q) {  // v is sorted
   const std::size_t i = std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5));
   return v[i];
@@ -74,7 +83,7 @@ int main(int argc, char** argv) {
   const long per_minute = std::lround(60.0 / a.dt);
   const long minutes = std::lround(a.minutes);
   const long n = per_minute * minutes;
-  std::vector<double> us(static_cast<std::size_t>(per_minute));
+  std::vector<double> us(static_cast<std::size_t>(per_minute)), cpu(us.size());
   sh::Output out;
   std::ofstream js(a.json);
   js << "{\"method\": \"" << a.method << "\", \"dt\": " << a.dt << ", \"samples\": " << n << ", \"minutes\": [";
@@ -87,9 +96,11 @@ int main(int argc, char** argv) {
       const long k = m * per_minute + j;
       const double t = k * a.dt;
       const double u = m + 1 < minutes ? 5e-3 * std::sin(2 * kPi * 1.0 * t) + 2e-3 * std::sin(2 * kPi * 3.7 * t) : 0.0;
+      const double c0 = thread_cpu_us();
       const auto t0 = Clock::now();
       const sh::Status st = plant.step(u, out);
       us[static_cast<std::size_t>(j)] = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
+      cpu[static_cast<std::size_t>(j)] = thread_cpu_us() - c0;
       if (!st.ok()) {
         ++failed;
         plant.reset(out.displacement, plant.time());
@@ -97,20 +108,22 @@ int main(int argc, char** argv) {
     }
     failed_total += failed;
     std::sort(us.begin(), us.end());
+    std::sort(cpu.begin(), cpu.end());
     std::fprintf(stderr, "%s minute %ld: median %.2f us, p99.9 %.2f us, RSS %ld kB\n", a.method.c_str(), m + 1,
                  percentile(us, 0.5), percentile(us, 0.999), rss_kb());
     js << (m ? ", " : "") << "{\"minute\": " << m + 1 << ", \"median_us\": " << percentile(us, 0.5)
        << ", \"p99_us\": " << percentile(us, 0.99) << ", \"p999_us\": " << percentile(us, 0.999)
-       << ", \"max_us\": " << us.back() << ", \"rss_kb\": " << rss_kb() << ", \"failed\": " << failed << "}";
+       << ", \"max_us\": " << us.back() << ", \"cpu_median_us\": " << percentile(cpu, 0.5)
+       << ", \"cpu_p999_us\": " << percentile(cpu, 0.999) << ", \"cpu_max_us\": " << cpu.back() << ", \"rss_kb\": " << rss_kb() << ", \"failed\": " << failed << "}";
   }
   const double wall = std::chrono::duration<double>(Clock::now() - wall0).count();
-  const double cpu = double(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  const double cpu_s = double(std::clock() - cpu0) / CLOCKS_PER_SEC;
   plant.observe(out);
   char buf[512];
   std::snprintf(buf, sizeof buf,
                 "], \"failed\": %ld, \"wall_s\": %.3f, \"cpu_s\": %.3f, \"end_displacement_m\": %.6g, "
                 "\"end_velocity_m_s\": %.6g, \"end_time_s\": %.17g, \"clock_error_s\": %.6g}\n",
-                failed_total, wall, cpu, out.displacement, out.velocity, plant.time(),
+                failed_total, wall, cpu_s, out.displacement, out.velocity, plant.time(),
                 plant.time() - static_cast<double>(n) * a.dt);
   js << buf;
   return failed_total == 0 ? 0 : 1;
