@@ -1,14 +1,16 @@
 // Soak benchmark of the plant: a long run at the controller rate with every
 // step timed, for benchmarks/soak.py (docs/benchmarks.md, "Soak").
 //
-//   sh_bench_soak --method rk4|cvode|default --minutes M [--dt 0.0005] --json out.json
+//   sh_bench_soak --method rk4|cvode|default --minutes M [--dt 0.0005] [--cpu-time 1] --json out.json
 //
 // The command (displacement control) is a sum of two sines (5 mm at 1 Hz, 2 mm
 // at 3.7 Hz) for all but the last simulated minute, then 0: the structure must
 // come back to rest where it started.  Per simulated minute: step-time median,
-// p99, p99.9 and max [us] of wall time, and the same of the thread's CPU time
-// (the step's cost without the OS preempting it on a shared machine: the
-// wall-time tail there is scheduler ticks of 4 ms), the resident set size [kB] (from
+// p99, p99.9 and max [us] of wall time, and with --cpu-time 1 the same of the
+// thread's CPU time (the step's cost without the OS preempting it on a shared
+// machine, where the wall-time tail is scheduler ticks of 4 ms; the CPU clock is
+// a system call of ~0.5 us, so it is for steps much longer than that), the
+// resident set size [kB] (from
 // /proc/self/statm), failed steps.  At the end: the displacement and velocity
 // at rest, the clock against k dt.  The plant is built outside the timed
 // region; the per-minute buffer of step times is allocated once.
@@ -35,6 +37,7 @@ constexpr double kPi = 3.14159265358979323846;
 struct Args {
   std::string method = "default", json;
   double minutes = 1.0, dt = 5e-4;
+  bool cpu_time = false;
 };
 
 Args parse(int argc, char** argv) {
@@ -45,6 +48,7 @@ Args parse(int argc, char** argv) {
     else if (k == "--minutes") a.minutes = std::stod(v);
     else if (k == "--dt") a.dt = std::stod(v);
     else if (k == "--json") a.json = v;
+    else if (k == "--cpu-time") a.cpu_time = v == "1";
     else throw std::runtime_error("unknown argument " + k);
   }
   if (a.json.empty()) throw std::runtime_error("--json is required");
@@ -96,11 +100,11 @@ int main(int argc, char** argv) {
       const long k = m * per_minute + j;
       const double t = k * a.dt;
       const double u = m + 1 < minutes ? 5e-3 * std::sin(2 * kPi * 1.0 * t) + 2e-3 * std::sin(2 * kPi * 3.7 * t) : 0.0;
-      const double c0 = thread_cpu_us();
+      const double c0 = a.cpu_time ? thread_cpu_us() : 0.0;
       const auto t0 = Clock::now();
       const sh::Status st = plant.step(u, out);
       us[static_cast<std::size_t>(j)] = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
-      cpu[static_cast<std::size_t>(j)] = thread_cpu_us() - c0;
+      if (a.cpu_time) cpu[static_cast<std::size_t>(j)] = thread_cpu_us() - c0;
       if (!st.ok()) {
         ++failed;
         plant.reset(out.displacement, plant.time());
@@ -108,13 +112,16 @@ int main(int argc, char** argv) {
     }
     failed_total += failed;
     std::sort(us.begin(), us.end());
-    std::sort(cpu.begin(), cpu.end());
+    if (a.cpu_time) std::sort(cpu.begin(), cpu.end());
     std::fprintf(stderr, "%s minute %ld: median %.2f us, p99.9 %.2f us, RSS %ld kB\n", a.method.c_str(), m + 1,
                  percentile(us, 0.5), percentile(us, 0.999), rss_kb());
     js << (m ? ", " : "") << "{\"minute\": " << m + 1 << ", \"median_us\": " << percentile(us, 0.5)
        << ", \"p99_us\": " << percentile(us, 0.99) << ", \"p999_us\": " << percentile(us, 0.999)
-       << ", \"max_us\": " << us.back() << ", \"cpu_median_us\": " << percentile(cpu, 0.5)
-       << ", \"cpu_p999_us\": " << percentile(cpu, 0.999) << ", \"cpu_max_us\": " << cpu.back() << ", \"rss_kb\": " << rss_kb() << ", \"failed\": " << failed << "}";
+       << ", \"max_us\": " << us.back();
+    if (a.cpu_time)
+      js << ", \"cpu_median_us\": " << percentile(cpu, 0.5) << ", \"cpu_p999_us\": " << percentile(cpu, 0.999)
+         << ", \"cpu_max_us\": " << cpu.back();
+    js << ", \"rss_kb\": " << rss_kb() << ", \"failed\": " << failed << "}";
   }
   const double wall = std::chrono::duration<double>(Clock::now() - wall0).count();
   const double cpu_s = double(std::clock() - cpu0) / CLOCKS_PER_SEC;

@@ -6,8 +6,10 @@ temporary left behind; never a traceback."""
 
 from __future__ import annotations
 
+import atexit
 import math
-import os
+import shutil
+import tempfile
 import uuid
 from pathlib import Path
 
@@ -18,7 +20,9 @@ from hypothesis import strategies as st
 
 from servohydraulics.records import read_record
 
-CASES = make_cases(Path(os.environ.get("TMPDIR", "/tmp")) / f"sh_cli_cases_{os.getpid()}")
+_CASE_DIR = Path(tempfile.mkdtemp(prefix="sh_cli_cases_"))
+atexit.register(shutil.rmtree, _CASE_DIR, True)
+CASES = make_cases(_CASE_DIR)
 
 
 @pytest.mark.parametrize("name, argv, expected", CASES, ids=[c[0] for c in CASES])
