@@ -166,11 +166,12 @@ def load_rig(path: str | Path) -> Rig:
     """Reads a TOML rig file over the calibrated preset (keys not given keep
     the preset's values)."""
     path = Path(path)
-    try:
-        with path.open("rb") as f:
-            data = tomllib.load(f)
+    try:  # utf-8-sig: an editor's byte-order mark is not TOML
+        data = tomllib.loads(path.read_bytes().decode("utf-8-sig"))
     except FileNotFoundError:
         raise FileNotFoundError(f"rig file not found: {path}") from None
+    except UnicodeDecodeError as e:
+        raise ValueError(f"rig file {path} is not UTF-8 text ({e.reason} at byte {e.start})") from None
     except (tomllib.TOMLDecodeError, ValueError) as e:  # ValueError: e.g. an integer of > 4300 digits
         raise ValueError(f"rig file {path} is not valid TOML: {e}") from None
     except IsADirectoryError:
