@@ -84,7 +84,8 @@ def make_cases(root: Path) -> list[tuple[str, list[str], str]]:
         ("duration_nan", "--duration", "nan", "duration = nan"), ("frequency_zero", "--frequency", "0", "frequency"),
         ("frequency_nan", "--frequency", "nan", "frequency"), ("amplitude_nan", "--amplitude", "nan", "amplitude"),
         ("amplitude_inf", "--amplitude", "inf", "amplitude"), ("x0_nan", "--x0", "nan", "x0"),
-        ("x0_huge", "--x0", "1e300", "x0"), ("dt_text", "--dt", "abc", "--dt"), ("mode_bogus", "--mode", "bogus", "--mode"),
+        ("x0_huge", "--x0", "1e300", "x0"), ("dt_text", "--dt", "abc", "--dt"),
+        ("mode_bogus", "--mode", "bogus", "--mode"),
     ]:
         cases.append((f"simulate {name}", sim + [flag, value, "--out", out], expect))
     a_dir = root / "a_directory"
