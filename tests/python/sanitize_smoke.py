@@ -45,7 +45,7 @@ def main() -> None:
     bad = sh.zhao2003()
     bad.flow_curve = fc
     expect(ValueError, sh.simulate, bad, "displacement", u)
-    expect(ValueError, sh.solver_options, "rk4", 1e-6, "on_input_change", -1)
+    expect(ValueError, lambda: sh.solver_options("rk4", rk4_substeps=-1))
     expect(ValueError, sh.simulate, rig, "displacement", np.array([0.0, np.nan]))
     # One plant per thread runs; one plant from two threads raises.
     results: list = [None] * 4

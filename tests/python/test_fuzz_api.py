@@ -146,7 +146,8 @@ FLOATS = [0.0, -1e-6, 1e-14, 1e-9, 1e-6, 1e-3, 0.5, 1.0, 2.0, math.nan, math.inf
        h_rho=st.sampled_from(FLOATS), v_ref=st.sampled_from(FLOATS))
 def test_solver_options(method, restart, rtol, rk4_substeps, max_steps, max_order, h_rho, v_ref):
     def run():
-        o = sh.solver_options(method, rtol, restart, rk4_substeps, max_steps, max_order, h_rho, v_ref)
+        o = sh.solver_options(method=method, rtol=rtol, restart=restart, rk4_substeps=rk4_substeps,
+                              max_steps_per_sample=max_steps, max_order=max_order, rk4_h_rho=h_rho, rk4_v_ref=v_ref)
         return sh.simulate(sh.zhao2003(), "force", 1e4 * np.ones(N), options=o)
 
     check_outcome(run)
