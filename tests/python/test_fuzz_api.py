@@ -11,15 +11,14 @@ past the stated bound (RUN_BOUND_S of wall time for 200 samples).
 
 from __future__ import annotations
 
-import collections
 import math
-import os
 import re
 import time
 
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
+from fuzz_support import Tally, counted
 from hypothesis import strategies as st
 
 import servohydraulics as sh
@@ -82,12 +81,11 @@ def commands(mode: str) -> st.SearchStrategy[np.ndarray]:
     return st.builds(build, shapes, st.floats(0.0, 20.0), st.integers(0, 10_000))
 
 
-OUTCOMES: collections.Counter = collections.Counter()
+OUTCOMES = Tally()
 
 
 def teardown_module() -> None:
-    if os.environ.get("SH_FUZZ_STATS"):  # docs/robustness.md: pytest -s with SH_FUZZ_STATS=1
-        print(f"\n{__name__}: {sum(OUTCOMES.values())} inputs: {dict(OUTCOMES)}")
+    OUTCOMES.report(__name__)
 
 
 def check_outcome(run) -> str:
@@ -119,6 +117,7 @@ def _check_outcome(run) -> str:
 @FUZZ
 @given(rig=rigs(), mode=st.sampled_from(["displacement", "force", "free"]),
        method=st.sampled_from(["cvode", "rk4"]), data=st.data())
+@counted(OUTCOMES)
 def test_random_rigs_and_commands_end_in_a_result_or_a_named_error(rig, mode, method, data):
     rig, _ = rig
     u = data.draw(commands(mode))
@@ -129,6 +128,7 @@ def test_random_rigs_and_commands_end_in_a_result_or_a_named_error(rig, mode, me
 @given(dt=st.one_of(st.sampled_from(BAD + [5e-4, 1e-3, 2e-3]), st.floats(1e-5, 0.01)),
        x0=st.one_of(st.floats(-0.05, 0.05), st.sampled_from([math.nan, math.inf, 1e300, -200.0])),
        duration=st.one_of(st.none(), st.sampled_from([0.0, -1.0, math.nan, 0.05, 1e300])))
+@counted(OUTCOMES)
 def test_dt_x0_and_duration(dt, x0, duration):
     u = None if duration is not None else np.zeros(50)
     check_outcome(lambda: sh.simulate(sh.zhao2003(), "displacement", u, dt=dt, duration=duration, x0=x0))
@@ -144,6 +144,7 @@ FLOATS = [0.0, -1e-6, 1e-14, 1e-9, 1e-6, 1e-3, 0.5, 1.0, 2.0, math.nan, math.inf
        rk4_substeps=st.sampled_from([-1, 0, 1, 3, 40, 2**31, 2**64]),
        max_steps=st.sampled_from(INTS), max_order=st.sampled_from(INTS),
        h_rho=st.sampled_from(FLOATS), v_ref=st.sampled_from(FLOATS))
+@counted(OUTCOMES)
 def test_solver_options(method, restart, rtol, rk4_substeps, max_steps, max_order, h_rho, v_ref):
     def run():
         o = sh.solver_options(method=method, rtol=rtol, restart=restart, rk4_substeps=rk4_substeps,
@@ -157,6 +158,7 @@ def test_solver_options(method, restart, rtol, rk4_substeps, max_steps, max_orde
 @given(opening=st.lists(st.one_of(st.floats(-1, 2), st.sampled_from([math.nan, math.inf])), max_size=5),
        flow=st.lists(st.one_of(st.floats(-1, 2), st.sampled_from([math.nan, math.inf])), max_size=5),
        sort=st.booleans(), x=st.floats(-3, 3))
+@counted(OUTCOMES)
 def test_flow_curve_tables(opening, flow, sort, x):
     """Any table: the curve's methods give a finite value or a ValueError naming the field;
     never an out-of-bounds read (the sanitizer build runs these too)."""
@@ -193,6 +195,7 @@ ODD = st.sampled_from([None, 0, -1, 1.5, 2**70, math.nan, math.inf, "x", 5e-4, 0
 @settings(max_examples=300, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 @given(method=st.sampled_from(["eft", "rpsd"]), dt=ODD, alpha=ODD, lead_T=ODD, compute_delay=ODD,
        amplitude=st.sampled_from([0.0, 0.3, 30.0, 1e300]))
+@counted(OUTCOMES)
 def test_loop_keywords(method, dt, alpha, lead_T, compute_delay, amplitude):
     ag = amplitude * np.sin(np.linspace(0.0, 6.0, 100))
     kw = {"dt": dt, "alpha": alpha, "compute_delay": 0 if compute_delay is None else compute_delay}

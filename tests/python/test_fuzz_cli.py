@@ -15,6 +15,7 @@ from pathlib import Path
 
 import pytest
 from cli_cases import make_cases, run_case
+from fuzz_support import Tally, counted
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -23,6 +24,11 @@ from servohydraulics.records import read_record
 _CASE_DIR = Path(tempfile.mkdtemp(prefix="sh_cli_cases_"))
 atexit.register(shutil.rmtree, _CASE_DIR, True)
 CASES = make_cases(_CASE_DIR)
+OUTCOMES = Tally()
+
+
+def teardown_module() -> None:
+    OUTCOMES.report(__name__)
 
 
 @pytest.mark.parametrize("name, argv, expected", CASES, ids=[c[0] for c in CASES])
@@ -55,6 +61,7 @@ FLOATS = st.one_of(st.sampled_from([0.0, -1.0, math.nan, math.inf, -math.inf, 1e
        dt=st.one_of(st.sampled_from([5e-4, 1e-3]), FLOATS), duration=st.one_of(st.floats(0.001, 0.05), FLOATS),
        amplitude=st.one_of(st.floats(-0.01, 0.01), FLOATS), frequency=st.one_of(st.floats(0.1, 50), FLOATS),
        x0=st.one_of(st.floats(-0.01, 0.01), FLOATS))
+@counted(OUTCOMES)
 def test_simulate_arguments(tmp_path, mode, dt, duration, amplitude, frequency, x0):
     # Keep the valid runs short (the bound on the work of one invocation: 2000 samples).
     if math.isfinite(dt) and math.isfinite(duration) and dt > 0 and duration > 0 and 2000 < duration / dt < 1e7:
@@ -63,6 +70,7 @@ def test_simulate_arguments(tmp_path, mode, dt, duration, amplitude, frequency, 
     argv = ["simulate", "--mode", mode, "--dt", _value(dt), "--duration", _value(duration),
             "--amplitude", _value(amplitude), "--frequency", _value(frequency), "--x0", _value(x0), "--out", str(out)]
     outcome, code, err = run_case(argv)
+    OUTCOMES[outcome] += 1
     assert outcome in ("ok", "error"), f"{argv}: {err}"
     assert "Traceback" not in err and "internal error" not in err, err
     leftovers = [p for p in tmp_path.iterdir() if p.name.startswith(f".{out.name}.")]

@@ -7,14 +7,13 @@ through ``to_csv``."""
 
 from __future__ import annotations
 
-import collections
 import math
-import os
 import string
 import uuid
 
 import numpy as np
 from hypothesis import HealthCheck, given, settings
+from fuzz_support import Tally, counted
 from hypothesis import strategies as st
 
 import servohydraulics as sh
@@ -23,12 +22,11 @@ from servohydraulics.response import channel_units
 
 FUZZ = settings(max_examples=1000, deadline=None, derandomize=True,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
-OUTCOMES: collections.Counter = collections.Counter()
+OUTCOMES = Tally()
 
 
 def teardown_module() -> None:
-    if os.environ.get("SH_FUZZ_STATS"):
-        print(f"\n{__name__}: {sum(OUTCOMES.values())} inputs: {dict(OUTCOMES)}")
+    OUTCOMES.report(__name__)
 
 
 def _fresh(tmp_path, name: str):
@@ -69,6 +67,7 @@ def toml_texts(draw) -> str:
 
 @FUZZ
 @given(text=toml_texts(), bom=st.booleans())
+@counted(OUTCOMES)
 def test_rig_files(tmp_path, text, bom):
     path = _fresh(tmp_path, "rig.toml")
     path.write_bytes((b"\xef\xbb\xbf" if bom else b"") + text.encode("utf-8", "surrogatepass"))
@@ -118,6 +117,7 @@ def csv_texts(draw) -> str:
 
 @FUZZ
 @given(text=csv_texts())
+@counted(OUTCOMES)
 def test_record_files(tmp_path, text):
     path = _fresh(tmp_path, "record.csv")
     path.write_text(text, encoding="utf-8")
