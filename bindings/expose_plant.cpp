@@ -2,6 +2,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "busy.hpp"
 #include "channels_py.hpp"
 #include "protocol.hpp"
 #include "servohydraulics/plant.hpp"
@@ -127,10 +128,12 @@ void expose_plant(py::module_& m) {
   py::class_<Plant>(m, "Plant", "The plant stepped at the controller rate (CVODE between samples)")
       .def(py::init<const Rig&, ControlMode, double, const SolverOptions&>(), py::arg("rig"), py::arg("mode"),
            py::arg("dt"), py::arg("options") = SolverOptions{})
-      .def("reset", &Plant::reset, py::arg("x0") = 0.0, py::arg("t0") = 0.0)
-      .def("reset_state", &Plant::reset_state, py::arg("y0"), py::arg("t0") = 0.0)
+      .def("reset", bindings::guarded(&Plant::reset, "Plant.reset"), py::arg("x0") = 0.0, py::arg("t0") = 0.0)
+      .def("reset_state", bindings::guarded(&Plant::reset_state, "Plant.reset_state"), py::arg("y0"),
+           py::arg("t0") = 0.0)
       .def("step",
            [](Plant& p, double u) {
+             bindings::require_idle(&p, "Plant.step");
              Output o;
              Status s = p.step(u, o);
              return py::make_tuple(s, o);
@@ -138,6 +141,7 @@ void expose_plant(py::module_& m) {
            py::arg("command"))
       .def("observe",
            [](const Plant& p) {
+             bindings::require_idle(&p, "Plant.observe");
              Output o;
              p.observe(o);
              return o;

@@ -1,6 +1,7 @@
 // pybind11 module servohydraulics._core: one expose_<topic>.cpp per core header.
 #include <pybind11/pybind11.h>
 
+#include "busy.hpp"
 #include "servohydraulics/error.hpp"
 
 namespace py = pybind11;
@@ -17,6 +18,8 @@ PYBIND11_MODULE(_core, m) {
   m.doc() = "C++ core of servohydraulics (SUNDIALS CVODE, Eigen)";
   // Bad input is a ValueError that names the field and the value.
   py::register_exception<servohydraulics::Error>(m, "ServoHydraulicsError", PyExc_ValueError);
+  // One object used from two threads at once (bindings/busy.hpp).
+  py::register_exception<servohydraulics::bindings::ConcurrentUse>(m, "ConcurrentUseError", PyExc_RuntimeError);
   expose_rig(m);
   expose_plant(m);
   expose_record(m);
