@@ -14,6 +14,7 @@ enum class Bound {
   Positive,     //!< > 0
   NonNegative,  //!< >= 0
   AtLeastOne,   //!< >= 1
+  PadeOrder,    //!< an integer in 1..kMaxPadeOrder
 };
 
 struct ParameterInfo {
@@ -91,6 +92,9 @@ inline constexpr EffectInfo kEffects[] = {
     {"drive_saturation", "valve drive limited to +-v_max", &Effects::drive_saturation},
     {"spool_saturation", "spool opening limited to +-x_v_max", &Effects::spool_saturation},
     {"lugre_friction", "LuGre presliding friction instead of the static law", &Effects::lugre_friction},
+    {"bouc_wen_hysteresis", "Bouc-Wen hysteretic specimen (state bw_z)", &Effects::bouc_wen_hysteresis},
+    {"mr_damper", "MR damper, Spencer et al. 1997 (states mr_y, mr_z)", &Effects::mr_damper},
+    {"loop_delay", "Pade transport delay loop_delay on the valve drive", &Effects::loop_delay},
 };
 
 //! The requirement of a bound, for messages and docs: "finite and > 0".
