@@ -238,7 +238,7 @@ double Dynamics::structure_force(double x, double v, double z) const noexcept {
 }
 
 // Specimen elements in parallel with the structure: their force and state rates.
-// Bouc-Wen (Wen 1976): F = bw_k z.  MR damper (Spencer et al. 1997, Eqs 9-11):
+// Bouc-Wen (Wen 1976): F = bw_k z.  MR damper (Spencer et al. 1997):
 // y' = (alpha z + c0 x' + k0 (x - y)) / (c0 + c1), z' = BW(x' - y', z), F = c1 y' + k1 (x - x0).
 void Dynamics::specimen(const double* y, Algebra& g) const noexcept {
   const Rig& r = rig_;

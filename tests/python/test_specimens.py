@@ -150,7 +150,7 @@ SPENCER_CM = dict(  # Spencer et al. (1997), Table 1, in the paper's units (N, c
 
 
 def _spencer_force(t_end: float, X_cm: float, f: float, u: float, rtol=1e-10):
-    """An independent transcription of Spencer et al. (1997) Eqs (9)-(11) in cm, N, s under
+    """An independent transcription of the model of Spencer et al. (1997) in cm, N, s under
     x = X sin(2 pi f t) (the paper's test signal), integrated by SciPy; returns (t, F [N])."""
     p = SPENCER_CM
     alpha, c0, c1 = p["alpha_a"] + p["alpha_b"] * u, p["c0a"] + p["c0b"] * u, p["c1a"] + p["c1b"] * u
@@ -219,8 +219,8 @@ def test_mr_damper_matches_an_independent_transcription_of_spencer_1997(volts):
 
 def test_mr_damper_bingham_limit_is_coulomb_plus_viscous():
     """k0 = k1 = 0 and c1 >> c0 (y' -> 0) with a fast-saturating n = 1 law (z -> z_u sgn v,
-    z_u = A / (beta + gamma)): the damper force tends to alpha z_u sgn(v) + c0 v (Spencer et al.
-    1997, the Bingham model of their Eq 1), checked in a closed loop away from reversals."""
+    z_u = A / (beta + gamma)): the damper force tends to alpha z_u sgn(v) + c0 v (the Bingham
+    model, Coulomb plus viscous), checked in a closed loop away from reversals."""
     r = sh.zhao2003()
     r.effects.mr_damper = True
     r.mr_k0 = r.mr_k1 = r.mr_x0 = 0.0
