@@ -468,6 +468,7 @@ void Dynamics::outputs(const double* y, const Input& in, Output& out, OutputGrad
       G[5][j] = act ? g.ds[j] : 0.0;
       G[6][j] = act ? g.ddrive[j] : 0.0;
       G[7][j] = act ? g.dQ[j] : 0.0;
+      G[8][j] = g.dFsp[j];
     }
   }
   out.displacement = y[kX];
@@ -479,6 +480,7 @@ void Dynamics::outputs(const double* y, const Input& in, Output& out, OutputGrad
   out.spool = actuator ? g.s : 0.0;
   out.drive = actuator ? g.drive : 0.0;
   out.flow = actuator ? g.Q : 0.0;
+  out.specimen_force = g.Fsp;
   std::uint32_t f = 0;
   if (std::fabs(out.force) > rig_.F_cap) f |= kCapacityExceeded;
   if (actuator) {

@@ -49,6 +49,7 @@ double scale(const Dynamics& dyn, int j) {
 // Ultimate |z| of a Bouc-Wen law, (A / (beta + gamma))^(1/n).
 double ultimate(double A, double bg, double n) { return bg > 0.0 ? std::pow(A / bg, 1.0 / n) : 0.01; }
 constexpr double kRelStep = 1e-6;
+constexpr int kOut = LinearModel::kOutputs;  // the linearised output channels
 constexpr double kScaledTol = 1e-6;
 constexpr double kElementTol = 1e-5;
 
@@ -241,20 +242,21 @@ Stats check_dynamics(const Dynamics& dyn, sh_test::Randomizer& rnd, int wanted, 
     auto channels = [&](const State& y, double u, double* out) {
       Output o;
       dyn.outputs(y.data(), {u, 0.0}, o);
-      const double v[8] = {o.displacement, o.velocity, o.acceleration, o.force, o.pressure, o.spool, o.drive, o.flow};
-      std::copy(v, v + 8, out);
+      const double v[kOut] = {o.displacement, o.velocity, o.acceleration, o.force, o.pressure,
+                              o.spool,        o.drive,    o.flow,         o.specimen_force};
+      std::copy(v, v + kOut, out);
     };
-    double o0[8];
+    double o0[kOut];
     channels(d0.y, d0.in.u, o0);
-    double To[8];
-    for (int i = 0; i < 8; ++i) {
+    double To[kOut];
+    for (int i = 0; i < kOut; ++i) {
       To[i] = std::fabs(o0[i]) + std::fabs(lm.D(i)) * (std::fabs(d0.in.u) + su);
       for (int k = 0; k < n; ++k) To[i] += std::fabs(lm.C(i, k)) * (std::fabs(d0.y[k]) + scale(dyn, k));
     }
     for (int j = 0; j < n; ++j) {
-      double col[8];
-      for (int i = 0; i < 8; ++i) col[i] = lm.C(i, j);
-      compare_column("C", j, col, 8, fd_step(dyn, d0, j), scale(dyn, j), To,
+      double col[kOut];
+      for (int i = 0; i < kOut; ++i) col[i] = lm.C(i, j);
+      compare_column("C", j, col, kOut, fd_step(dyn, d0, j), scale(dyn, j), To,
                      [&](double e, double* out) {
                        State y = d0.y;
                        y[j] += e;
@@ -262,9 +264,9 @@ Stats check_dynamics(const Dynamics& dyn, sh_test::Randomizer& rnd, int wanted, 
                      },
                      st, where);
     }
-    double Dcol[8];
-    for (int i = 0; i < 8; ++i) Dcol[i] = lm.D(i);
-    compare_column("D", n, Dcol, 8, kRelStep * su, su, To,
+    double Dcol[kOut];
+    for (int i = 0; i < kOut; ++i) Dcol[i] = lm.D(i);
+    compare_column("D", n, Dcol, kOut, kRelStep * su, su, To,
                    [&](double e, double* out) { channels(d0.y, d0.in.u + e, out); }, st, where);
     // linearize's A, B are the Jacobian at u_rate = 0; inactive states have no dynamics.
     Jacobian J0;

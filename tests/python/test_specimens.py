@@ -275,6 +275,17 @@ def test_states_table_and_simulate_with_every_element(tmp_path):
     assert np.all(np.isfinite(res.force)) and res.work.status.ok
     with pytest.raises(ValueError, match=r"invalid y \(length\) = 6: this plant has 13 states"):
         dyn.rhs(np.zeros(6), 0.0)
+    # the specimen_force channel: the Bouc-Wen and MR damper forces at every sample, in every loop
+    plant = _core.Plant(back, _core.ControlMode.Displacement, DT)
+    for k in range(200):
+        _, out = plant.step(0.01 * math.sin(2 * math.pi * 2 * k * DT))
+        y = plant.state
+        expected = back.bw_k * y[6] + (back.mr_c1_a + back.mr_c1_b * back.mr_voltage) * dyn.rhs(y, 0.0)[7] \
+            + back.mr_k1 * (y[0] - back.mr_x0)
+        assert out.specimen_force == pytest.approx(expected, rel=1e-12, abs=1e-9)
+    assert np.max(np.abs(res.specimen_force)) > 100.0
+    eft = sh.run_eft(back, ground_acceleration=np.sin(2 * np.pi * 2 * np.arange(400) * DT), dt=DT)
+    assert np.max(np.abs(eft.specimen_force)) > 0.0
 
 
 @pytest.mark.parametrize("section,key,value,match", [

@@ -31,10 +31,10 @@ class Dynamics {
     double u0 = 0.0;  //!< the held command [m in displacement, N in force/free mode]
   };
 
-  //! Gradients of the 8 output channels (displacement, velocity, acceleration,
-  //! force, pressure, spool, drive, flow) by the states (columns 0..num_states()-1;
-  //! the rest of the capacity is 0) and, in the last column kMaxStates, by u.
-  using OutputGradients = std::array<std::array<double, kMaxStates + 1>, 8>;
+  //! Gradients of the 9 output channels (displacement, velocity, acceleration,
+  //! force, pressure, spool, drive, flow, specimen force) by the states (columns
+  //! 0..num_states()-1; the rest of the capacity is 0) and, in the last column kMaxStates, by u.
+  using OutputGradients = std::array<std::array<double, kMaxStates + 1>, 9>;
 
   void rhs(const double* y, const Input& in, double* ydot) const noexcept;
   //! J = df/dy; if B is given, also B = df/du.

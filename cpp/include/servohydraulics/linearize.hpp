@@ -12,10 +12,10 @@ namespace servohydraulics {
 //! The linearised plant over its dyn.num_states() active states (the base states,
 //! then those of the switched-on elements: Dynamics::layout, Dynamics::state_info).
 struct LinearModel {
-  static constexpr int kOutputs = 8;
+  static constexpr int kOutputs = 9;
   Eigen::MatrixXd A;  //!< n x n
   Eigen::VectorXd B;  //!< n
-  //! Rows: displacement, velocity, acceleration, force, pressure, spool, drive, flow.
+  //! Rows: displacement, velocity, acceleration, force, pressure, spool, drive, flow, specimen force.
   Eigen::MatrixXd C;  //!< kOutputs x n
   Eigen::VectorXd D;  //!< kOutputs
   //! States that take part in this mode/effect set (the others have zero dynamics).
