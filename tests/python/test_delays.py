@@ -90,7 +90,7 @@ def test_eft_loop_sees_the_plant_turned_by_the_delay(samples):
     r.command_delay = samples * dt
     H = _plant_transfer(sh.run_eft(r, ground_acceleration=ag, dt=dt), "force", w, 4.0)
     expected = np.exp(-1j * w * samples * dt)
-    assert abs(H / H0 - expected) < 2e-4, (H / H0, expected)
+    assert abs(H / H0 - expected) < 1e-5, (H / H0, expected)
 
 
 @pytest.mark.parametrize("samples", [1.0, 1.5])
@@ -106,7 +106,7 @@ def test_rpsd_loop_sees_the_plant_turned_by_the_delay(samples):
     r.command_delay = samples * dt
     H = _plant_transfer(sh.run_rpsd(r, **kw), "displacement", w, 4.0)
     expected = np.exp(-1j * w * samples * dt)
-    assert abs(H / H0 - expected) < 2e-4, (H / H0, expected)
+    assert abs(H / H0 - expected) < 1e-5, (H / H0, expected)
 
 
 @pytest.mark.parametrize("order", range(1, _core.MAX_PADE_ORDER + 1))

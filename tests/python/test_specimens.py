@@ -214,7 +214,7 @@ def test_mr_damper_matches_an_independent_transcription_of_spencer_1997(volts):
     F_core = np.array([dyn.specimen_force(state(ti, si)) for ti, si in zip(sol.t, sol.y.T)])
     _, F_ref = _spencer_force(T, 1.5, f, volts)
     peak = np.max(np.abs(F_ref))
-    assert np.max(np.abs(F_core - F_ref)) < 1e-5 * peak
+    assert np.max(np.abs(F_core - F_ref)) < 1e-8 * peak
 
 
 def test_mr_damper_bingham_limit_is_coulomb_plus_viscous():
@@ -241,7 +241,7 @@ def test_mr_damper_bingham_limit_is_coulomb_plus_viscous():
     bingham = Fc * np.sign(v) + c0 * v
     err = np.abs(F - bingham)[far]
     assert far.sum() > 1500
-    assert np.max(err) < 1e-3 * (Fc + c0 * np.max(np.abs(v)))
+    assert np.max(err) < 2e-4 * (Fc + c0 * np.max(np.abs(v)))
 
 
 def test_mr_damper_at_rest_holds_the_accumulator_force():
