@@ -97,6 +97,8 @@ Dynamics::Dynamics(const Rig& rig, ControlMode mode) : rig_(rig), mode_(mode) {
     }
   }
   layout_.num_states = n;
+  ku_ = n;
+  ng_ = n + 1;
 }
 
 const StateInfo& Dynamics::state_info(int i) const noexcept {
@@ -179,26 +181,36 @@ double Dynamics::pressure_factor_dp(double s, double p) const noexcept {
   return -sgn(s) / rig_.p_s * ssqrt_slope(1.0 - sgn(s) * p / rig_.p_s);
 }
 
-// Gradients carry one extra column, index kU, for the derivative by the command u.
-constexpr int kU = kMaxStates;
-constexpr int kNG = kMaxStates + 1;
+// Gradients have the active states' columns 0..n-1 and one more, index ku_ = n, for the
+// derivative by the command u (n = num_states(): the width stays the paper plant's 7 when no
+// element is appended).  Arrays are sized for the capacity and zeroed up to ng_ = n + 1.
+constexpr int kCap = kMaxStates + 1;
 
 struct Dynamics::Algebra {
-  double a = 0, da[kNG] = {};          // acceleration and its gradient
-  double F = 0, dF[kNG] = {};          // load-cell force
-  double drive = 0, ddrive[kNG] = {};  // valve drive after saturation
-  double s = 0, ds[kNG] = {};          // metering opening after saturation
-  double Q = 0, dQ[kNG] = {};          // valve flow
-  double pdot = 0, dpdot[kNG] = {};
-  double xvdd = 0, dxvdd[kNG] = {};
-  double zdot = 0, dzdot[kNG] = {};    // LuGre bristle rate
-  double Fsp = 0, dFsp[kNG] = {};      // specimen force (Bouc-Wen + MR damper)
-  double bw_zdot = 0, dbw_zdot[kNG] = {};  // Bouc-Wen rate
-  double mr_ydot = 0, dmr_ydot[kNG] = {};  // MR damper y' and z'
-  double mr_zdot = 0, dmr_zdot[kNG] = {};
-  double vdrive = 0, dvdrive[kNG] = {};    // the drive as the valve sees it (after the Pade loop delay)
-  double qdot = 0, dqdot[kNG] = {};        // the last Pade state's rate
+  double a = 0, da[kCap];          // acceleration and its gradient
+  double F = 0, dF[kCap];          // load-cell force
+  double drive = 0, ddrive[kCap];  // valve drive after saturation
+  double s = 0, ds[kCap];          // metering opening after saturation
+  double Q = 0, dQ[kCap];          // valve flow
+  double pdot = 0, dpdot[kCap];
+  double xvdd = 0, dxvdd[kCap];
+  double zdot = 0, dzdot[kCap];    // LuGre bristle rate
+  double Fsp = 0, dFsp[kCap];      // specimen force (Bouc-Wen + MR damper)
+  double bw_zdot = 0, dbw_zdot[kCap];  // Bouc-Wen rate
+  double mr_ydot = 0, dmr_ydot[kCap];  // MR damper y' and z'
+  double mr_zdot = 0, dmr_zdot[kCap];
+  double vdrive = 0, dvdrive[kCap];    // the drive as the valve sees it (after the Pade loop delay)
+  double qdot = 0, dqdot[kCap];        // the last Pade state's rate
   bool drive_sat = false, spool_sat = false;
+  // Zeroes the first W entries of the gradients of the paper plant (and of the specimen force,
+  // read by outputs()); the appended elements zero theirs when on.
+  template <int W>
+  void zero() noexcept {
+    for (int j = 0; j < W; ++j) {
+      da[j] = dF[j] = ddrive[j] = ds[j] = dQ[j] = 0.0;
+      dpdot[j] = dxvdd[j] = dzdot[j] = dFsp[j] = 0.0;
+    }
+  }
 };
 
 struct Dynamics::Friction {
@@ -229,7 +241,8 @@ Dynamics::Friction Dynamics::friction(double v, double z) const noexcept {
 double Dynamics::specimen_force(const double* y) const noexcept {
   if (layout_.bw_z < 0 && layout_.mr_y < 0) return 0.0;
   Algebra g;
-  specimen(y, g);
+  g.zero<kCap>();
+  specimen<kCap>(y, g);
   return g.Fsp;
 }
 
@@ -240,11 +253,13 @@ double Dynamics::structure_force(double x, double v, double z) const noexcept {
 // Specimen elements in parallel with the structure: their force and state rates.
 // Bouc-Wen (Wen 1976): F = bw_k z.  MR damper (Spencer et al. 1997):
 // y' = (alpha z + c0 x' + k0 (x - y)) / (c0 + c1), z' = BW(x' - y', z), F = c1 y' + k1 (x - x0).
+template <int W>
 void Dynamics::specimen(const double* y, Algebra& g) const noexcept {
   const Rig& r = rig_;
   const double x = y[kX], v = y[kV];
   if (layout_.bw_z >= 0) {
     const int iz = layout_.bw_z;
+    std::fill(g.dbw_zdot, g.dbw_zdot + W, 0.0);
     const Hysteretic h = hysteretic_rate(v, y[iz], r.bw_A, r.bw_beta, r.bw_gamma, r.bw_n);
     g.bw_zdot = h.f;
     g.dbw_zdot[kV] = h.df_dw;
@@ -255,6 +270,7 @@ void Dynamics::specimen(const double* y, Algebra& g) const noexcept {
   if (layout_.mr_y >= 0) {
     const int iy = layout_.mr_y, iz = iy + 1;
     const double cs = mr_c0_ + mr_c1_;
+    std::fill(g.dmr_ydot, g.dmr_ydot + W, 0.0);
     g.mr_ydot = (mr_alpha_ * y[iz] + mr_c0_ * v + r.mr_k0 * (x - y[iy])) / cs;
     g.dmr_ydot[kX] = r.mr_k0 / cs;
     g.dmr_ydot[kV] = mr_c0_ / cs;
@@ -262,21 +278,22 @@ void Dynamics::specimen(const double* y, Algebra& g) const noexcept {
     g.dmr_ydot[iz] = mr_alpha_ / cs;
     const Hysteretic h = hysteretic_rate(v - g.mr_ydot, y[iz], r.mr_A, r.mr_gamma, r.mr_beta, r.mr_n);
     g.mr_zdot = h.f;
-    for (int j = 0; j < kNG; ++j) g.dmr_zdot[j] = -h.df_dw * g.dmr_ydot[j];
+    for (int j = 0; j < W; ++j) g.dmr_zdot[j] = -h.df_dw * g.dmr_ydot[j];
     g.dmr_zdot[kV] += h.df_dw;
     g.dmr_zdot[iz] += h.df_dz;
     g.Fsp += mr_c1_ * g.mr_ydot + r.mr_k1 * (x - r.mr_x0);
-    for (int j = 0; j < kNG; ++j) g.dFsp[j] += mr_c1_ * g.dmr_ydot[j];
+    for (int j = 0; j < W; ++j) g.dFsp[j] += mr_c1_ * g.dmr_ydot[j];
     g.dFsp[kX] += r.mr_k1;
   }
 }
 
 // The Pade loop delay on the valve drive w: q' = (A' q + e_N w) / tau, w_delayed = C' q + d w.
+template <int W>
 void Dynamics::loop_delay(const double* y, Algebra& g) const noexcept {
   const Pade& P = pade_;
   const int i0 = layout_.pade, N = P.order;
   g.vdrive = P.d * g.drive;
-  for (int j = 0; j < kNG; ++j) g.dvdrive[j] = P.d * g.ddrive[j];
+  for (int j = 0; j < W; ++j) g.dvdrive[j] = P.d * g.ddrive[j];
   double last = g.drive;
   for (int k = 0; k < N; ++k) {
     g.vdrive += P.c[k] * y[i0 + k];
@@ -284,11 +301,13 @@ void Dynamics::loop_delay(const double* y, Algebra& g) const noexcept {
     last -= P.a[k] * y[i0 + k];
   }
   g.qdot = last / P.tau;
-  for (int j = 0; j < kNG; ++j) g.dqdot[j] = g.ddrive[j] / P.tau;
+  for (int j = 0; j < W; ++j) g.dqdot[j] = g.ddrive[j] / P.tau;
   for (int k = 0; k < N; ++k) g.dqdot[i0 + k] -= P.a[k] / P.tau;
 }
 
+template <int W>
 void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noexcept {
+  g.zero<W>();
   const Rig& r = rig_;
   const bool actuator = mode_ != ControlMode::Free;
   const double x = y[kX], v = y[kV], p = y[kP];
@@ -310,86 +329,96 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
     g.da[kX] = -spring_stiffness(x) / M_;
     g.da[kV] = -(dFf_dv + r.c) / M_;
   } else {
-    specimen(y, g);
+    specimen<W>(y, g);
     g.a = (applied - Ff - r.c * v - spring_force(x) - g.Fsp) / M_;
-    for (int j = 0; j < kNG; ++j) g.da[j] = -g.dFsp[j] / M_;
+    for (int j = 0; j < W; ++j) g.da[j] = -g.dFsp[j] / M_;
     g.da[kX] = -(spring_stiffness(x) + g.dFsp[kX]) / M_;
     g.da[kV] = -(dFf_dv + r.c + g.dFsp[kV]) / M_;
   }
   g.da[kZ] = -dFf_dz / M_;
   g.da[kP] = actuator ? r.A / M_ : 0.0;
-  g.da[kU] = actuator ? 0.0 : 1.0 / M_;
+  g.da[ku_] = actuator ? 0.0 : 1.0 / M_;
   if (!actuator) {
-    g.dF[kU] = 1.0;
+    g.dF[ku_] = 1.0;
     g.F = in.u;
     return;
   }
   // Load cell between piston and structure: F = pA - m_p a.
   g.F = p * r.A - mp_ * g.a;
-  for (int j = 0; j < kNG; ++j) g.dF[j] = -mp_ * g.da[j];
+  for (int j = 0; j < W; ++j) g.dF[j] = -mp_ * g.da[j];
   g.dF[kP] += r.A;
 
   // Servo controller, Eq (1).
   double raw;
-  double draw[kNG] = {};
+  double draw[kCap];
+  std::fill(draw, draw + W, 0.0);
   if (mode_ == ControlMode::Displacement) {
     raw = CF_ * (r.G_p * (in.u - x) + r.G_d * (in.u_rate - v));
     draw[kX] = -CF_ * r.G_p;
     draw[kV] = -CF_ * r.G_d;
-    draw[kU] = CF_ * r.G_p;
+    draw[ku_] = CF_ * r.G_p;
   } else {
     raw = CF_ * r.G_p * (in.u - g.F);
-    for (int j = 0; j < kNG; ++j) draw[j] = -CF_ * r.G_p * g.dF[j];
-    draw[kU] += CF_ * r.G_p;
+    for (int j = 0; j < W; ++j) draw[j] = -CF_ * r.G_p * g.dF[j];
+    draw[ku_] += CF_ * r.G_p;
   }
   g.drive_sat = r.effects.drive_saturation && std::fabs(raw) >= r.v_max;
   g.drive = g.drive_sat ? std::copysign(r.v_max, raw) : raw;
-  for (int j = 0; j < kNG; ++j) g.ddrive[j] = g.drive_sat ? 0.0 : draw[j];
+  for (int j = 0; j < W; ++j) g.ddrive[j] = g.drive_sat ? 0.0 : draw[j];
   // The drive the valve sees: delayed by the Pade loop delay when it is on.
   double vdrive = g.drive;
   const double* dvdrive = g.ddrive;
   if (layout_.pade >= 0) {
-    loop_delay(y, g);
+    loop_delay<W>(y, g);
     vdrive = g.vdrive;
     dvdrive = g.dvdrive;
   }
 
   // Servovalve: Eq (2) as x_v'' = w_v^2 (K_s v - x_v) - 2 zeta_v w_v x_v', or Eq (6).
   double xv;
-  double dxv[kNG] = {};
+  double dxv[kCap];
+  std::fill(dxv, dxv + W, 0.0);
   if (r.effects.servovalve_dynamics) {
     xv = y[kXv];
     dxv[kXv] = 1.0;
     const double w2 = wv_ * wv_;
     g.xvdd = w2 * (r.K_s * vdrive - y[kXv]) - 2.0 * r.zeta_v * wv_ * y[kXvDot];
-    for (int j = 0; j < kNG; ++j) g.dxvdd[j] = w2 * r.K_s * dvdrive[j];
+    for (int j = 0; j < W; ++j) g.dxvdd[j] = w2 * r.K_s * dvdrive[j];
     g.dxvdd[kXv] -= w2;
     g.dxvdd[kXvDot] -= 2.0 * r.zeta_v * wv_;
   } else {
     xv = r.K_s * vdrive;
-    for (int j = 0; j < kNG; ++j) dxv[j] = r.K_s * dvdrive[j];
+    for (int j = 0; j < W; ++j) dxv[j] = r.K_s * dvdrive[j];
   }
   g.spool_sat = r.effects.spool_saturation && std::fabs(xv) >= r.x_v_max;
   g.s = g.spool_sat ? std::copysign(r.x_v_max, xv) : xv;
-  for (int j = 0; j < kNG; ++j) g.ds[j] = g.spool_sat ? 0.0 : dxv[j];
+  for (int j = 0; j < W; ++j) g.ds[j] = g.spool_sat ? 0.0 : dxv[j];
 
   // Valve flow, Eq (3) (Eq 7 with the effects off).
   const double gs = flow_gain(g.s), R = pressure_factor(g.s, p);
   g.Q = r.K_v * gs * R;
   const double dQds = r.K_v * flow_gain_slope(g.s) * R;
-  for (int j = 0; j < kNG; ++j) g.dQ[j] = dQds * g.ds[j];
+  for (int j = 0; j < W; ++j) g.dQ[j] = dQds * g.ds[j];
   g.dQ[kP] += r.K_v * gs * pressure_factor_dp(g.s, p);
 
   // Actuator continuity, Eq (4): K_a p' = Q - C_l p - A x'.
   g.pdot = (g.Q - r.C_l * p - r.A * v) / r.K_a;
-  for (int j = 0; j < kNG; ++j) g.dpdot[j] = g.dQ[j] / r.K_a;
+  for (int j = 0; j < W; ++j) g.dpdot[j] = g.dQ[j] / r.K_a;
   g.dpdot[kP] -= r.C_l / r.K_a;
   g.dpdot[kV] -= r.A / r.K_a;
 }
 
+// Dispatch on the gradient width: the paper plant's (unrolled loops) or the capacity.
+void Dynamics::evaluate_any(const double* y, const Input& in, Algebra& g) const noexcept {
+  if (ng_ == kNumStates + 1)
+    evaluate<kNumStates + 1>(y, in, g);
+  else
+    evaluate<kCap>(y, in, g);
+}
+
 void Dynamics::rhs(const double* y, const Input& in, double* ydot) const noexcept {
   Algebra g;
-  evaluate(y, in, g);
+  evaluate_any(y, in, g);
   ydot[kX] = y[kV];
   ydot[kV] = g.a;
   const bool actuator = mode_ != ControlMode::Free;
@@ -413,23 +442,23 @@ void Dynamics::rhs(const double* y, const Input& in, double* ydot) const noexcep
 
 void Dynamics::jacobian(const double* y, const Input& in, Jacobian& J, State* B) const noexcept {
   Algebra g;
-  evaluate(y, in, g);
+  evaluate_any(y, in, g);
   const int n = layout_.num_states;
   for (auto& row : J) row.fill(0.0);
   if (B) B->fill(0.0);
   J[kX][kV] = 1.0;
   for (int j = 0; j < n; ++j) J[kV][j] = g.da[j];
-  if (B) (*B)[kV] = g.da[kU];
+  if (B) (*B)[kV] = g.da[ku_];
   if (lugre_)
     for (int j = 0; j < n; ++j) J[kZ][j] = g.dzdot[j];
   jacobian_appended(g, J, B);
   if (mode_ == ControlMode::Free) return;
   for (int j = 0; j < n; ++j) J[kP][j] = g.dpdot[j];
-  if (B) (*B)[kP] = g.dpdot[kU];
+  if (B) (*B)[kP] = g.dpdot[ku_];
   if (rig_.effects.servovalve_dynamics) {
     J[kXv][kXvDot] = 1.0;
     for (int j = 0; j < n; ++j) J[kXvDot][j] = g.dxvdd[j];
-    if (B) (*B)[kXvDot] = g.dxvdd[kU];
+    if (B) (*B)[kXvDot] = g.dxvdd[ku_];
   }
 }
 
@@ -439,7 +468,7 @@ void Dynamics::jacobian_appended(const Algebra& g, Jacobian& J, State* B) const 
   const int n = L.num_states;
   auto row = [&](int i, const double* grad) {
     for (int j = 0; j < n; ++j) J[i][j] = grad[j];
-    if (B) (*B)[i] = grad[kU];
+    if (B) (*B)[i] = grad[ku_];
   };
   if (L.bw_z >= 0) row(L.bw_z, g.dbw_zdot);
   if (L.mr_y >= 0) {
@@ -455,20 +484,22 @@ void Dynamics::jacobian_appended(const Algebra& g, Jacobian& J, State* B) const 
 
 void Dynamics::outputs(const double* y, const Input& in, Output& out, OutputGradients* grad) const noexcept {
   Algebra g;
-  evaluate(y, in, g);
+  evaluate_any(y, in, g);
   if (grad) {
     const bool act = mode_ != ControlMode::Free;
-    for (int j = 0; j < kNG; ++j) {
-      auto& G = *grad;
-      G[0][j] = j == kX ? 1.0 : 0.0;
-      G[1][j] = j == kV ? 1.0 : 0.0;
-      G[2][j] = g.da[j];
-      G[3][j] = g.dF[j];
-      G[4][j] = act && j == kP ? 1.0 : 0.0;
-      G[5][j] = act ? g.ds[j] : 0.0;
-      G[6][j] = act ? g.ddrive[j] : 0.0;
-      G[7][j] = act ? g.dQ[j] : 0.0;
-      G[8][j] = g.dFsp[j];
+    auto& G = *grad;
+    for (auto& row : G) row.fill(0.0);
+    for (int j = 0; j < ng_; ++j) {
+      const int c = j == ku_ ? kMaxStates : j;  // the public column of u is kMaxStates
+      G[0][c] = j == kX ? 1.0 : 0.0;
+      G[1][c] = j == kV ? 1.0 : 0.0;
+      G[2][c] = g.da[j];
+      G[3][c] = g.dF[j];
+      G[4][c] = act && j == kP ? 1.0 : 0.0;
+      G[5][c] = act ? g.ds[j] : 0.0;
+      G[6][c] = act ? g.ddrive[j] : 0.0;
+      G[7][c] = act ? g.dQ[j] : 0.0;
+      G[8][c] = g.dFsp[j];
     }
   }
   out.displacement = y[kX];

@@ -100,8 +100,14 @@ class Dynamics {
  private:
   struct Algebra;  // intermediate quantities of one evaluation
   struct Friction;  // friction force, bristle rate and their gradients
+  // W: the gradient width the loops run over, a constant so that they unroll (the paper
+  // plant's kNumStates + 1, or the capacity with appended states).
+  template <int W>
   void evaluate(const double* y, const Input& in, Algebra& a) const noexcept;
+  void evaluate_any(const double* y, const Input& in, Algebra& a) const noexcept;
+  template <int W>
   void specimen(const double* y, Algebra& a) const noexcept;
+  template <int W>
   void loop_delay(const double* y, Algebra& a) const noexcept;
   void jacobian_appended(const Algebra& g, Jacobian& J, State* B) const noexcept;
   Friction friction(double v, double z) const noexcept;
@@ -115,6 +121,8 @@ class Dynamics {
   double CF_;       // conversion factor of the mode [V/m or V/N]
   double wv_;       // valve natural frequency [rad/s]
   StateLayout layout_;
+  int ku_ = kNumStates;      // gradient column of the command u (= num_states())
+  int ng_ = kNumStates + 1;  // gradient width
   double mr_alpha_ = 0.0, mr_c0_ = 0.0, mr_c1_ = 0.0;  // MR damper coefficients at the run's voltage
   Pade pade_;
 };
