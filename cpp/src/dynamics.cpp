@@ -183,7 +183,7 @@ double Dynamics::pressure_factor_dp(double s, double p) const noexcept {
 
 // Gradients have the active states' columns 0..n-1 and one more, index ku_ = n, for the
 // derivative by the command u (n = num_states(): the width stays the paper plant's 7 when no
-// element is appended).  Arrays are sized for the capacity and zeroed up to ng_ = n + 1.
+// element is appended).  Arrays are sized for the capacity; evaluate<W> runs over W = n + 1.
 constexpr int kCap = kMaxStates + 1;
 
 struct Dynamics::Algebra {
@@ -408,12 +408,22 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
   g.dpdot[kV] -= r.A / r.K_a;
 }
 
-// Dispatch on the gradient width: the paper plant's (unrolled loops) or the capacity.
+// Dispatch on the gradient width num_states() + 1, a compile-time constant in each case.
 void Dynamics::evaluate_any(const double* y, const Input& in, Algebra& g) const noexcept {
-  if (ng_ == kNumStates + 1)
-    evaluate<kNumStates + 1>(y, in, g);
-  else
-    evaluate<kCap>(y, in, g);
+  static_assert(kCap == 17, "one case per width from kNumStates + 1 to kMaxStates + 1");
+  switch (ng_) {
+    case 7: return evaluate<7>(y, in, g);
+    case 8: return evaluate<8>(y, in, g);
+    case 9: return evaluate<9>(y, in, g);
+    case 10: return evaluate<10>(y, in, g);
+    case 11: return evaluate<11>(y, in, g);
+    case 12: return evaluate<12>(y, in, g);
+    case 13: return evaluate<13>(y, in, g);
+    case 14: return evaluate<14>(y, in, g);
+    case 15: return evaluate<15>(y, in, g);
+    case 16: return evaluate<16>(y, in, g);
+    default: return evaluate<kCap>(y, in, g);
+  }
 }
 
 void Dynamics::rhs(const double* y, const Input& in, double* ydot) const noexcept {
