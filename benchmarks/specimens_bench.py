@@ -132,10 +132,10 @@ def mr_table() -> str:
 
 
 def _replace(text: str, name: str, table: str) -> str:
-    pat = re.compile(rf"(<!-- specimens_bench:{name} -->\n).*?(\n<!-- /specimens_bench -->)", re.S)
+    pat = re.compile(rf"(<!-- specimens_bench:{name} -->\n)(.*?)(<!-- /specimens_bench -->)", re.S)
     if not pat.search(text):
         raise ValueError(f"marker <!-- specimens_bench:{name} --> not found")
-    return pat.sub(lambda m: m.group(1) + table + m.group(2), text)
+    return pat.sub(lambda m: m.group(1) + table + "\n" + m.group(3), text, count=1)
 
 
 def main() -> None:

@@ -133,6 +133,11 @@ def test_bouc_wen_small_amplitude_stiffness():
     wn = np.sort(np.abs(np.imag(sys.poles())))[-1]
     expected = math.sqrt((r.k + r.bw_k * r.bw_A) / r.m)
     assert abs(wn - expected) < 1e-9 * expected
+    # the specimen_force output of the linearisation (z' = A v at rest: z is A x plus a constant, so
+    # the DC gain is undefined): at w it carries bw_k A / (k + bw_k A - m w^2) of the applied force
+    w = 3.0
+    H = complex(np.squeeze(sh.linearize(r, mode="free", outputs=("specimen_force",))(1j * w)))
+    assert H == pytest.approx(r.bw_k * r.bw_A / (r.k + r.bw_k * r.bw_A - r.m * w ** 2), rel=1e-9)
     X = 1e-5
     t = np.arange(1, 1025) * DT
     plant, ys = _run_states(_bouc_wen_rig(bw_A=0.8, bw_k=500e3), X * np.sin(2 * np.pi * t))
