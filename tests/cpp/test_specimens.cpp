@@ -96,8 +96,8 @@ void check_command_delay_closed_form() {
         const double exact = t > ts ? F / r.k * (1.0 - std::cos(w * (t - ts))) : 0.0;
         worst = std::max(worst, std::fabs(out.displacement - exact));
       }
-      // 3e-8 of the amplitude 2F/k (CVODE at rtol 1e-10, restarting or not); holding the command a fraction f of a sample
-      // off would be off by ~v f dt ~ 1e-5 m.
+      // 3e-8 of the amplitude 2F/k (CVODE at rtol 1e-10, restarting or not); holding the command
+      // a fraction f of a sample off would be off by ~v f dt ~ 1e-5 m.
       const double tol = 3e-8 * F / r.k * 2.0;
       worst_all = std::max(worst_all, worst / (2.0 * F / r.k));
       if (!CHECK(worst < tol))
