@@ -7,6 +7,7 @@
 #include <string>
 
 #include "servohydraulics/parameters.hpp"
+#include "servohydraulics/state.hpp"
 
 namespace servohydraulics {
 
@@ -101,6 +102,7 @@ const char* bound_text(Bound b) noexcept {
     case Bound::Positive: return "finite and > 0";
     case Bound::NonNegative: return "finite and >= 0";
     case Bound::AtLeastOne: return "finite and >= 1";
+    case Bound::PadeOrder: return "an integer in 1..6";
   }
   return "";
 }
@@ -110,6 +112,7 @@ bool within(Bound b, double v) noexcept {
     case Bound::Positive: return finite_positive(v);
     case Bound::NonNegative: return finite_nonneg(v);
     case Bound::AtLeastOne: return std::isfinite(v) && v >= 1.0;
+    case Bound::PadeOrder: return std::isfinite(v) && v >= 1.0 && v <= kMaxPadeOrder && v == std::floor(v);
   }
   return false;
 }

@@ -1,8 +1,9 @@
 """Rig parameters: the paper's presets and TOML rig files.
 
 A rig file is TOML with one table per subsystem and keys named after the
-symbols of Zhao et al. (2003), Table I, in SI units.  Unknown keys are an
-error.  ``PARAMETERS`` (keys, units, sources) and ``EFFECTS`` come from the
+symbols of Zhao et al. (2003), Table I, in SI units; the specimens
+(Bouc-Wen, MR damper) are in ``[specimen]`` and the delays inside the loop in
+``[delays]`` (docs/specimens.md).  Unknown keys are an error.  ``PARAMETERS`` (keys, units, sources) and ``EFFECTS`` come from the
 core's one parameter table (``_core.RIG_PARAMETERS``, ``_core.EFFECTS``); the
 README's key table is generated from it (``python -m servohydraulics.rig``).
 ``Rig`` has ``==``, ``repr``, ``copy.copy`` and pickle from the binding.

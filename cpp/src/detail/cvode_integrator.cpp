@@ -28,18 +28,20 @@ std::string flag_name(int flag) {
 }  // namespace
 
 CvodeIntegrator::CvodeIntegrator(const Dynamics& dyn, double dt, const SolverOptions& opt, const State& y_prime)
-    : restart_(opt.restart), dyn_(&dyn) {
-  y_.reset(SH_PTR(N_VNew_Serial, kNumStates, ctx_));
-  atol_.reset(SH_PTR(N_VNew_Serial, kNumStates, ctx_));
-  for (int i = 0; i < kNumStates; ++i) NV_Ith_S(atol_.get(), i) = opt.rtol * opt.atol_scale[i];
-  for (int i = 0; i < kNumStates; ++i) NV_Ith_S(y_.get(), i) = 0.0;
+    : restart_(opt.restart), dyn_(&dyn), n_(dyn.num_states()) {
+  // The vectors and the matrix have the active length (the base states and the switched-on elements').
+  y_.reset(SH_PTR(N_VNew_Serial, n_, ctx_));
+  atol_.reset(SH_PTR(N_VNew_Serial, n_, ctx_));
+  for (int i = 0; i < n_; ++i)
+    NV_Ith_S(atol_.get(), i) = opt.rtol * (i < kNumStates ? opt.atol_scale[i] : dyn.state_scale(i));
+  for (int i = 0; i < n_; ++i) NV_Ith_S(y_.get(), i) = 0.0;
   mem_.reset(SH_PTR(CVodeCreate, CV_BDF, ctx_));
   void* cv = mem_.get();
   SH_FLAG(CVodeInit, cv, &CvodeIntegrator::rhs, 0.0, y_.get());
   SH_FLAG(CVodeSetUserData, cv, this);
   SH_FLAG(CVodeSetErrHandlerFn, cv, silent_error_handler, nullptr);
   SH_FLAG(CVodeSVtolerances, cv, opt.rtol, atol_.get());
-  J_.reset(SH_PTR(SUNDenseMatrix, kNumStates, kNumStates, ctx_));
+  J_.reset(SH_PTR(SUNDenseMatrix, n_, n_, ctx_));
   LS_.reset(SH_PTR(SUNLinSol_Dense, y_.get(), J_.get(), ctx_));
   SH_FLAG(CVodeSetLinearSolver, cv, LS_.get(), J_.get());
   SH_FLAG(CVodeSetJacFn, cv, &CvodeIntegrator::jac);
@@ -62,7 +64,7 @@ CvodeIntegrator::CvodeIntegrator(const Dynamics& dyn, double dt, const SolverOpt
 // (CVodeReInit keeps that memory).
 void CvodeIntegrator::prime(const State& y_prime, double dt) {
   in_ = {};
-  for (int i = 0; i < kNumStates; ++i) NV_Ith_S(y_.get(), i) = y_prime[i];
+  for (int i = 0; i < n_; ++i) NV_Ith_S(y_.get(), i) = y_prime[i];
   SH_FLAG(CVodeReInit, mem_.get(), 0.0, y_.get());
   SH_FLAG(CVodeSetStopTime, mem_.get(), dt);
   sunrealtype tret = 0.0;
@@ -88,8 +90,8 @@ int CvodeIntegrator::jac(sunrealtype, N_Vector yv, N_Vector, SUNMatrix Jm, void*
   auto* self = static_cast<CvodeIntegrator*>(user);
   Jacobian Jl;
   self->dyn_->jacobian(N_VGetArrayPointer(yv), self->in_, Jl);
-  for (int i = 0; i < kNumStates; ++i)
-    for (int j = 0; j < kNumStates; ++j) SM_ELEMENT_D(Jm, i, j) = Jl[i][j];
+  for (int i = 0; i < self->n_; ++i)
+    for (int j = 0; j < self->n_; ++j) SM_ELEMENT_D(Jm, i, j) = Jl[i][j];
   return 0;
 }
 
@@ -97,7 +99,7 @@ void CvodeIntegrator::reset(const State& y, double t) noexcept {
   steps_done_ = rhs_done_ = restarts_ = 0;
   in_ = {};
   // CVodeReInit also zeroes the counters of the current run, so that the totals restart.
-  for (int i = 0; i < kNumStates; ++i) NV_Ith_S(y_.get(), i) = y[i];
+  for (int i = 0; i < n_; ++i) NV_Ith_S(y_.get(), i) = y[i];
   CVodeReInit(mem_.get(), t, y_.get());
   need_reinit_ = false;
 }
@@ -122,7 +124,7 @@ Status CvodeIntegrator::advance(const Dynamics& dyn, const Dynamics::Input& in, 
   Status st;
   if (need_reinit_) {
     accumulate_counters();
-    for (int i = 0; i < kNumStates; ++i) NV_Ith_S(y_.get(), i) = y[i];
+    for (int i = 0; i < n_; ++i) NV_Ith_S(y_.get(), i) = y[i];
     CVodeReInit(cv, t, y_.get());
     need_reinit_ = false;
     st.restarted = true;
@@ -139,7 +141,7 @@ Status CvodeIntegrator::advance(const Dynamics& dyn, const Dynamics::Input& in, 
   CVodeGetNumRhsEvals(cv, &nf1);
   st.internal_steps = static_cast<int>(ns1 - ns0);
   st.rhs_evals = static_cast<int>(nf1 - nf0);
-  for (int i = 0; i < kNumStates; ++i) y[i] = NV_Ith_S(y_.get(), i);
+  for (int i = 0; i < n_; ++i) y[i] = NV_Ith_S(y_.get(), i);
   t = tret;
   if (flag < 0) {
     st.code = flag == CV_TOO_MUCH_WORK ? Status::TooMuchWork : Status::SolverFailure;
