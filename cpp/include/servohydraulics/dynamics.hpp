@@ -50,6 +50,8 @@ class Dynamics {
   OperatingPoint operating_point(double x0) const noexcept;
 
   const Rig& rig() const noexcept { return rig_; }
+  //! Length of the state vector of this rig (integrators loop over it).
+  int num_states() const noexcept { return kNumStates; }
   ControlMode mode() const noexcept { return mode_; }
   double moving_mass() const noexcept { return M_; }
 

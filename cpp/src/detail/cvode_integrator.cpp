@@ -1,39 +1,28 @@
 #include "detail/cvode_integrator.hpp"
 
-#include <string>
-
-#include "servohydraulics/error.hpp"
+#include "detail/sundials_check.hpp"
 
 namespace servohydraulics::detail {
 
 namespace {
-int check_flag(int flag, const char* call) {
-  if (flag < 0) throw Error(std::string("SUNDIALS setup call ") + call + " failed with flag " + std::to_string(flag));
-  return flag;
-}
-template <class P>
-P check_ptr(P p, const char* call) {
-  if (p == nullptr) throw Error(std::string("SUNDIALS setup call ") + call + " returned NULL");
-  return p;
-}
 // CVODE prints its errors by default; the hot path must stay silent.  The
 // status carries the flag instead.
 void silent_error_handler(int, const char*, const char*, char*, void*) {}
 }  // namespace
 
 CvodeIntegrator::CvodeIntegrator(const Dynamics& dyn, double dt, const SolverOptions& opt, const State& y_prime)
-    : restart_(opt.restart), dyn_(&dyn) {
-  y_.reset(check_ptr(N_VNew_Serial(kNumStates, ctx_), "N_VNew_Serial"));
-  atol_.reset(check_ptr(N_VNew_Serial(kNumStates, ctx_), "N_VNew_Serial"));
-  for (int i = 0; i < kNumStates; ++i) NV_Ith_S(atol_.get(), i) = opt.rtol * opt.atol_scale[i];
-  for (int i = 0; i < kNumStates; ++i) NV_Ith_S(y_.get(), i) = 0.0;
+    : n_(dyn.num_states()), restart_(opt.restart), dyn_(&dyn) {
+  y_.reset(check_ptr(N_VNew_Serial(n_, ctx_), "N_VNew_Serial"));
+  atol_.reset(check_ptr(N_VNew_Serial(n_, ctx_), "N_VNew_Serial"));
+  absolute_tolerances(dyn, opt, N_VGetArrayPointer(atol_.get()));
+  for (int i = 0; i < n_; ++i) NV_Ith_S(y_.get(), i) = 0.0;
   mem_.reset(check_ptr(CVodeCreate(CV_BDF, ctx_), "CVodeCreate"));
   void* cv = mem_.get();
   check_flag(CVodeInit(cv, &CvodeIntegrator::rhs, 0.0, y_.get()), "CVodeInit");
   check_flag(CVodeSetUserData(cv, this), "CVodeSetUserData");
   check_flag(CVodeSetErrHandlerFn(cv, silent_error_handler, nullptr), "CVodeSetErrHandlerFn");
   check_flag(CVodeSVtolerances(cv, opt.rtol, atol_.get()), "CVodeSVtolerances");
-  J_.reset(check_ptr(SUNDenseMatrix(kNumStates, kNumStates, ctx_), "SUNDenseMatrix"));
+  J_.reset(check_ptr(SUNDenseMatrix(n_, n_, ctx_), "SUNDenseMatrix"));
   LS_.reset(check_ptr(SUNLinSol_Dense(y_.get(), J_.get(), ctx_), "SUNLinSol_Dense"));
   check_flag(CVodeSetLinearSolver(cv, LS_.get(), J_.get()), "CVodeSetLinearSolver");
   check_flag(CVodeSetJacFn(cv, &CvodeIntegrator::jac), "CVodeSetJacFn");
@@ -56,7 +45,7 @@ CvodeIntegrator::CvodeIntegrator(const Dynamics& dyn, double dt, const SolverOpt
 // (CVodeReInit keeps that memory).
 void CvodeIntegrator::prime(const State& y_prime, double dt) {
   in_ = {};
-  for (int i = 0; i < kNumStates; ++i) NV_Ith_S(y_.get(), i) = y_prime[i];
+  for (int i = 0; i < n_; ++i) NV_Ith_S(y_.get(), i) = y_prime[i];
   check_flag(CVodeReInit(mem_.get(), 0.0, y_.get()), "CVodeReInit");
   check_flag(CVodeSetStopTime(mem_.get(), dt), "CVodeSetStopTime");
   sunrealtype tret = 0.0;
@@ -73,8 +62,8 @@ int CvodeIntegrator::jac(sunrealtype, N_Vector yv, N_Vector, SUNMatrix Jm, void*
   auto* self = static_cast<CvodeIntegrator*>(user);
   Jacobian Jl;
   self->dyn_->jacobian(N_VGetArrayPointer(yv), self->in_, Jl);
-  for (int i = 0; i < kNumStates; ++i)
-    for (int j = 0; j < kNumStates; ++j) SM_ELEMENT_D(Jm, i, j) = Jl[i][j];
+  for (int i = 0; i < self->n_; ++i)
+    for (int j = 0; j < self->n_; ++j) SM_ELEMENT_D(Jm, i, j) = Jl[i][j];
   return 0;
 }
 
@@ -82,7 +71,7 @@ void CvodeIntegrator::reset(const State& y, double t) noexcept {
   steps_done_ = rhs_done_ = restarts_ = 0;
   in_ = {};
   // CVodeReInit also zeroes the counters of the current run, so that the totals restart.
-  for (int i = 0; i < kNumStates; ++i) NV_Ith_S(y_.get(), i) = y[i];
+  for (int i = 0; i < n_; ++i) NV_Ith_S(y_.get(), i) = y[i];
   CVodeReInit(mem_.get(), t, y_.get());
   need_reinit_ = false;
 }
@@ -107,7 +96,7 @@ Status CvodeIntegrator::advance(const Dynamics& dyn, const Dynamics::Input& in, 
   Status st;
   if (need_reinit_) {
     accumulate_counters();
-    for (int i = 0; i < kNumStates; ++i) NV_Ith_S(y_.get(), i) = y[i];
+    for (int i = 0; i < n_; ++i) NV_Ith_S(y_.get(), i) = y[i];
     CVodeReInit(cv, t, y_.get());
     need_reinit_ = false;
     st.restarted = true;
@@ -124,7 +113,7 @@ Status CvodeIntegrator::advance(const Dynamics& dyn, const Dynamics::Input& in, 
   CVodeGetNumRhsEvals(cv, &nf1);
   st.internal_steps = static_cast<int>(ns1 - ns0);
   st.rhs_evals = static_cast<int>(nf1 - nf0);
-  for (int i = 0; i < kNumStates; ++i) y[i] = NV_Ith_S(y_.get(), i);
+  for (int i = 0; i < n_; ++i) y[i] = NV_Ith_S(y_.get(), i);
   t = tret;
   if (flag < 0) {
     st.code = flag == CV_TOO_MUCH_WORK ? Status::TooMuchWork : Status::SolverFailure;

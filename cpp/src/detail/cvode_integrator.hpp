@@ -59,6 +59,7 @@ class CvodeIntegrator {
   void prime(const State& y_prime, double dt);
   void accumulate_counters() noexcept;
 
+  int n_;  // dyn.num_states()
   // Declared in creation order: destroyed in reverse, the context last.
   sundials::Context ctx_;
   std::unique_ptr<std::remove_pointer_t<N_Vector>, NVectorDeleter> y_;
