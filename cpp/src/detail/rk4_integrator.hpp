@@ -19,7 +19,8 @@ class Rk4Integrator {
   //! stages with k5 = f(y_next) (the next substep's k1; one extra evaluation per sample) give the
   //! 3rd-order companion b^ = (1/6, 1/3, 1/3, 0, 1/6), so e = h (k4 - k5) / 6 per substep, summed in
   //! absolute value over the sample and measured in the weighted RMS norm of (rk4_flag_rtol, atol).
-  //! Above 1: redone with twice the substeps up to rk4_max_refinements times, then Status::inaccurate.
+  //! Above 1: Status::inaccurate, and the sample is redone with twice the substeps up to
+  //! rk4_max_refinements times (the flag stays: a local estimate does not bound the error carried on).
   Status advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t, double t_next) noexcept;
 
   int substeps() const noexcept { return substeps_; }
