@@ -9,6 +9,11 @@
 namespace servohydraulics {
 
 void SolverOptions::validate() const {
+  const int m = static_cast<int>(method), r = static_cast<int>(restart);
+  require(m >= static_cast<int>(Method::Dopri5) && m <= static_cast<int>(Method::ArkodeDirk), "method", m,
+          "is not a SolverOptions::Method (0 dopri5, 1 cvode, 2 rk4, 3 arkode_erk, 4 arkode_dirk)");
+  require(r >= static_cast<int>(Restart::OnInputChange) && r <= static_cast<int>(Restart::Never), "restart", r,
+          "is not a SolverOptions::Restart (0 on_input_change, 1 never)");
   require(std::isfinite(rtol) && rtol > 0.0 && rtol < 1.0, "rtol", rtol, "must be in (0, 1)");
   require(std::isfinite(atol_fraction) && atol_fraction > 0.0 && atol_fraction <= 1.0, "atol_fraction",
           atol_fraction, "must be in (0, 1] (a fraction of each state's scale)");
