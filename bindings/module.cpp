@@ -11,6 +11,7 @@ void expose_record(py::module_& m);
 void expose_linearize(py::module_& m);
 void expose_compensators(py::module_& m);
 void expose_loops(py::module_& m);
+void expose_rths(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "C++ core of servohydraulics (SUNDIALS CVODE, Eigen)";
@@ -22,4 +23,5 @@ PYBIND11_MODULE(_core, m) {
   expose_linearize(m);
   expose_compensators(m);
   expose_loops(m);
+  expose_rths(m);
 }

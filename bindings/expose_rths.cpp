@@ -1,0 +1,228 @@
+// The RTHS benchmark's blocks (servohydraulics/rths/*.hpp): no logic here.
+#include <cstdint>
+#include <vector>
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "servohydraulics/rths/loop.hpp"
+
+namespace py = pybind11;
+using namespace servohydraulics;
+using namespace servohydraulics::rths;
+
+namespace {
+using Arr = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+std::vector<double> to_vector(const Arr& a, const char* name) {
+  if (a.ndim() != 1) throw Error(std::string("invalid ") + name + ": expected a 1-D array");
+  return std::vector<double>(a.data(), a.data() + a.shape(0));
+}
+
+py::dict run_loop(RthsLoop& loop, const LinearSubstructure& num, const GroundMotion& ag, std::size_t n,
+                  bool timing) {
+  const auto nd = static_cast<py::ssize_t>(num.model().size());
+  const auto N = static_cast<py::ssize_t>(n);
+  Arr measured(N), displacement(N), force(N), command(N), fin(N), numerical({N, nd}), steps(timing ? N : 0);
+  RthsRecord rec{measured.mutable_data(), displacement.mutable_data(), force.mutable_data(), command.mutable_data(),
+                 fin.mutable_data(), numerical.mutable_data(), timing ? steps.mutable_data() : nullptr};
+  RthsSummary s;
+  {
+    py::gil_scoped_release release;
+    loop.reset();
+    s = loop.run(ag, n, rec);
+  }
+  const auto rows = static_cast<py::ssize_t>(s.rows);
+  py::dict out;
+  out["measured"] = measured[py::slice(0, rows, 1)];
+  out["displacement"] = displacement[py::slice(0, rows, 1)];
+  out["actuator_force"] = force[py::slice(0, rows, 1)];
+  out["command"] = command[py::slice(0, rows, 1)];
+  out["feedback_force"] = fin[py::slice(0, rows, 1)];
+  out["numerical"] = numerical[py::slice(0, rows, 1)];
+  if (timing) out["step_seconds"] = steps[py::slice(0, rows, 1)];
+  out["rows"] = s.rows;
+  out["ok"] = s.ok;
+  out["failure_time"] = s.failure_time;
+  out["peak_actuator_force"] = s.peak_actuator_force;
+  out["peak_displacement"] = s.peak_displacement;
+  out["peak_velocity"] = s.peak_velocity;
+  return out;
+}
+
+template <class T>
+void pi_and_converters(py::class_<T>& c) {
+  c.def_readwrite("dt", &T::dt).def_readwrite("pi", &T::pi).def_readwrite("converters", &T::converters)
+      .def("validate", &T::validate);
+}
+}  // namespace
+
+void expose_rths(py::module_& m) {
+  py::module_ r = m.def_submodule("rths", "RTHS benchmark blocks (Silva et al. 2020)");
+
+  // --- converters -------------------------------------------------------------------------------------
+  py::class_<Saturation>(r, "Saturation").def(py::init<>())
+      .def(py::init([](double lo, double hi) { return Saturation{lo, hi}; }), py::arg("lower"), py::arg("upper"))
+      .def_readwrite("lower", &Saturation::lower).def_readwrite("upper", &Saturation::upper)
+      .def("__call__", &Saturation::operator());
+  py::class_<Quantizer>(r, "Quantizer").def(py::init<>())
+      .def(py::init([](double q) { return Quantizer{q}; }), py::arg("step"))
+      .def_readwrite("step", &Quantizer::step).def("__call__", &Quantizer::operator());
+  py::class_<Converter> conv(r, "Converter");
+  py::enum_<Converter::Kind>(conv, "Kind")
+      .value("AnalogToDigital", Converter::Kind::AnalogToDigital)
+      .value("DigitalToAnalog", Converter::Kind::DigitalToAnalog);
+  conv.def(py::init<>()).def_readwrite("kind", &Converter::kind).def_readwrite("saturation", &Converter::saturation)
+      .def_readwrite("quantizer", &Converter::quantizer).def_readwrite("enabled", &Converter::enabled)
+      .def("validate", &Converter::validate).def("__call__", &Converter::operator());
+  r.def("benchmark_converter", &benchmark_converter, py::arg("kind"));
+  r.def("ideal_converter", &ideal_converter);
+  py::class_<GaussianSequence>(r, "GaussianSequence")
+      .def(py::init<std::uint64_t>(), py::arg("seed") = 0)
+      .def("reset", &GaussianSequence::reset, py::arg("seed"))
+      .def("next", &GaussianSequence::next);
+  py::class_<SensorNoise>(r, "SensorNoise").def(py::init<>())
+      .def(py::init([](double s, double g) { return SensorNoise{s, g}; }), py::arg("sigma"), py::arg("gain") = 1.0)
+      .def_readwrite("sigma", &SensorNoise::sigma).def_readwrite("gain", &SensorNoise::gain)
+      .def_static("band_limited_sigma", &SensorNoise::band_limited_sigma, py::arg("noise_power"),
+                  py::arg("sample_time"));
+  py::class_<ControllerConverters>(r, "ControllerConverters").def(py::init<>())
+      .def_readwrite("ad", &ControllerConverters::ad).def_readwrite("da", &ControllerConverters::da);
+
+  // --- plants -------------------------------------------------------------------------------------------
+  py::class_<SpecimenModel>(r, "SpecimenModel").def(py::init<>())
+      .def_readwrite("m", &SpecimenModel::m).def_readwrite("c", &SpecimenModel::c).def_readwrite("k", &SpecimenModel::k);
+  py::class_<BenchmarkPlantParameters>(r, "BenchmarkPlantParameters").def(py::init<>())
+      .def_readwrite("a1_beta0", &BenchmarkPlantParameters::a1_beta0)
+      .def_readwrite("a2", &BenchmarkPlantParameters::a2).def_readwrite("a3", &BenchmarkPlantParameters::a3)
+      .def_readwrite("beta1", &BenchmarkPlantParameters::beta1)
+      .def_readwrite("beta2", &BenchmarkPlantParameters::beta2)
+      .def_readwrite("m_e", &BenchmarkPlantParameters::m_e).def_readwrite("k_e", &BenchmarkPlantParameters::k_e)
+      .def_readwrite("zeta_e", &BenchmarkPlantParameters::zeta_e)
+      .def_readwrite("gain", &BenchmarkPlantParameters::gain)
+      .def("validate", &BenchmarkPlantParameters::validate)
+      .def_property_readonly("c_e", &BenchmarkPlantParameters::c_e)
+      .def("specimen", &BenchmarkPlantParameters::specimen)
+      .def("denominator", &BenchmarkPlantParameters::denominator)
+      .def("numerator", &BenchmarkPlantParameters::numerator);
+  py::class_<BenchmarkPlantUncertainty>(r, "BenchmarkPlantUncertainty").def(py::init<>())
+      .def_readwrite("k_e", &BenchmarkPlantUncertainty::k_e)
+      .def_readwrite("beta1", &BenchmarkPlantUncertainty::beta1)
+      .def_readwrite("beta2", &BenchmarkPlantUncertainty::beta2)
+      .def_readwrite("a3", &BenchmarkPlantUncertainty::a3)
+      .def("draw", &BenchmarkPlantUncertainty::draw, py::arg("nominal"), py::arg("seed"));
+  py::class_<ExperimentalSubstructure>(r, "ExperimentalSubstructure")
+      .def("reset", &ExperimentalSubstructure::reset)
+      .def("step", &ExperimentalSubstructure::step, py::arg("command"))
+      .def_property_readonly("displacement", &ExperimentalSubstructure::displacement)
+      .def_property_readonly("velocity", &ExperimentalSubstructure::velocity)
+      .def_property_readonly("actuator_force", &ExperimentalSubstructure::actuator_force)
+      .def_property_readonly("dt", &ExperimentalSubstructure::dt)
+      .def("specimen", &ExperimentalSubstructure::specimen);
+  py::class_<BenchmarkPlant, ExperimentalSubstructure>(r, "BenchmarkPlant")
+      .def(py::init<const BenchmarkPlantParameters&, double>(), py::arg("parameters"), py::arg("dt"))
+      .def_property_readonly("parameters", &BenchmarkPlant::parameters)
+      .def_property_readonly("state", &BenchmarkPlant::state);
+  py::class_<ServoHydraulicSubstructure, ExperimentalSubstructure>(r, "ServoHydraulicSubstructure")
+      .def(py::init<const Rig&, double, const SolverOptions&>(), py::arg("rig"), py::arg("dt"),
+           py::arg("options") = SolverOptions{});
+
+  // --- numerical substructure -----------------------------------------------------------------------
+  py::enum_<SubstructureScheme>(r, "SubstructureScheme")
+      .value("RungeKutta4", SubstructureScheme::RungeKutta4)
+      .value("CentralDifference", SubstructureScheme::CentralDifference)
+      .value("ExplicitNewmark", SubstructureScheme::ExplicitNewmark);
+  py::class_<LinearSubstructureModel>(r, "LinearSubstructureModel").def(py::init<>())
+      .def(py::init([](Eigen::MatrixXd M, Eigen::MatrixXd C, Eigen::MatrixXd K, Eigen::VectorXd g,
+                       Eigen::VectorXd gam) { return LinearSubstructureModel{M, C, K, g, gam}; }),
+           py::arg("M"), py::arg("C"), py::arg("K"), py::arg("ground"), py::arg("interface"))
+      .def_readwrite("M", &LinearSubstructureModel::M).def_readwrite("C", &LinearSubstructureModel::C)
+      .def_readwrite("K", &LinearSubstructureModel::K).def_readwrite("ground", &LinearSubstructureModel::ground)
+      .def_readwrite("interface", &LinearSubstructureModel::interface)
+      .def("validate", &LinearSubstructureModel::validate);
+  py::class_<LinearSubstructure>(r, "LinearSubstructure")
+      .def(py::init<const LinearSubstructureModel&, double, SubstructureScheme>(), py::arg("model"), py::arg("h"),
+           py::arg("scheme") = SubstructureScheme::RungeKutta4)
+      .def("reset", &LinearSubstructure::reset)
+      .def("step", &LinearSubstructure::step, py::arg("ag0"), py::arg("ag_mid"), py::arg("ag1"), py::arg("f_in"))
+      .def_property_readonly("displacement", &LinearSubstructure::displacement)
+      .def_property_readonly("velocity", &LinearSubstructure::velocity)
+      .def("acceleration", &LinearSubstructure::acceleration, py::arg("dof"), py::arg("ag"), py::arg("f_in"));
+  py::class_<GroundMotion>(r, "GroundMotion")
+      .def(py::init([](const Arr& t, const Arr& a, double s) {
+             return GroundMotion(to_vector(t, "time"), to_vector(a, "acceleration"), s);
+           }),
+           py::arg("time"), py::arg("acceleration"), py::arg("scale") = 1.0)
+      .def("__call__", &GroundMotion::operator(), py::arg("t"))
+      .def_property_readonly("end_time", &GroundMotion::end_time)
+      .def_property_readonly("scale", &GroundMotion::scale);
+
+  // --- controllers --------------------------------------------------------------------------------------
+  py::class_<PiGains>(r, "PiGains").def(py::init<>())
+      .def(py::init([](double kp, double ki) { return PiGains{kp, ki}; }), py::arg("Kp"), py::arg("Ki"))
+      .def_readwrite("Kp", &PiGains::Kp).def_readwrite("Ki", &PiGains::Ki);
+  py::class_<TrackingInput>(r, "TrackingInput").def(py::init<>())
+      .def(py::init([](double d, double dv, double da, double xm, double fm) { return TrackingInput{d, dv, da, xm, fm}; }),
+           py::arg("desired"), py::arg("desired_velocity") = 0.0, py::arg("desired_acceleration") = 0.0,
+           py::arg("measured") = 0.0, py::arg("measured_force") = 0.0);
+  py::class_<TrackingController>(r, "TrackingController")
+      .def("reset", &TrackingController::reset)
+      .def("command", &TrackingController::command, py::arg("input"));
+  py::class_<SampleControllerConfig> sc(r, "SampleControllerConfig");
+  sc.def(py::init<>()).def_readwrite("lead_b1", &SampleControllerConfig::lead_b1)
+      .def_readwrite("lead_b0", &SampleControllerConfig::lead_b0)
+      .def_readwrite("lead_a0", &SampleControllerConfig::lead_a0);
+  pi_and_converters(sc);
+  py::class_<PolynomialConfig> pc(r, "PolynomialConfig");
+  pc.def(py::init<>()).def_readwrite("tau", &PolynomialConfig::tau).def_readwrite("order", &PolynomialConfig::order)
+      .def_readwrite("stride", &PolynomialConfig::stride).def_readwrite("static_gain", &PolynomialConfig::static_gain);
+  pi_and_converters(pc);
+  py::class_<AtsConfig> ac(r, "AtsConfig");
+  ac.def(py::init<>()).def_readwrite("initial", &AtsConfig::initial).def_readwrite("lower", &AtsConfig::lower)
+      .def_readwrite("upper", &AtsConfig::upper).def_readwrite("window", &AtsConfig::window)
+      .def_readwrite("filter_hz", &AtsConfig::filter_hz).def_readwrite("update_every", &AtsConfig::update_every)
+      .def_readwrite("min_amplitude", &AtsConfig::min_amplitude);
+  pi_and_converters(ac);
+  py::class_<ModelBasedConfig> mc(r, "ModelBasedConfig");
+  mc.def(py::init<>()).def_readwrite("coefficients", &ModelBasedConfig::coefficients)
+      .def_static("from_plant", &ModelBasedConfig::from_plant, py::arg("plant"), py::arg("order") = 2);
+  pi_and_converters(mc);
+  py::class_<SampleController, TrackingController>(r, "SampleController")
+      .def(py::init<const SampleControllerConfig&>(), py::arg("config") = SampleControllerConfig{})
+      .def_property_readonly("lead_coefficients", [](const SampleController& c) {
+        return py::make_tuple(c.lead().n0(), c.lead().n1(), c.lead().d1());
+      })
+      .def_property_readonly("pi_coefficients", [](const SampleController& c) {
+        return py::make_tuple(c.pi().n0(), c.pi().n1(), c.pi().d1());
+      });
+  py::class_<PolynomialExtrapolation, TrackingController>(r, "PolynomialExtrapolation")
+      .def(py::init<const PolynomialConfig&>(), py::arg("config"))
+      .def_property_readonly("weights", &PolynomialExtrapolation::weights);
+  py::class_<AdaptiveTimeSeries, TrackingController>(r, "AdaptiveTimeSeries")
+      .def(py::init<const AtsConfig&>(), py::arg("config"))
+      .def_property_readonly("coefficients", &AdaptiveTimeSeries::coefficients);
+  py::class_<ModelBasedCompensator, TrackingController>(r, "ModelBasedCompensator")
+      .def(py::init<const ModelBasedConfig&>(), py::arg("config"));
+  r.def("plant_delay", &plant_delay, py::arg("plant"));
+
+  // --- loop -----------------------------------------------------------------------------------------------
+  py::class_<RthsLoopConfig>(r, "RthsLoopConfig").def(py::init<>())
+      .def_readwrite("dt", &RthsLoopConfig::dt)
+      .def_readwrite("displacement_noise", &RthsLoopConfig::displacement_noise)
+      .def_readwrite("force_noise", &RthsLoopConfig::force_noise)
+      .def_readwrite("independent_noise", &RthsLoopConfig::independent_noise)
+      .def_readwrite("seed", &RthsLoopConfig::seed)
+      .def("validate", &RthsLoopConfig::validate);
+  py::class_<RthsLoop>(r, "RthsLoop")
+      .def(py::init<ExperimentalSubstructure&, LinearSubstructure&, TrackingController&, const RthsLoopConfig&>(),
+           py::arg("experimental"), py::arg("numerical"), py::arg("controller"), py::arg("config") = RthsLoopConfig{},
+           py::keep_alive<1, 2>(), py::keep_alive<1, 3>(), py::keep_alive<1, 4>())
+      .def("run",
+           [](RthsLoop& loop, const LinearSubstructure& num, const GroundMotion& ag, std::size_t n, bool timing) {
+             return run_loop(loop, num, ag, n, timing);
+           },
+           py::arg("numerical"), py::arg("ground_motion"), py::arg("n"), py::arg("timing") = false,
+           "Reset, then run n samples; numerical: the loop's numerical substructure (for the row width).");
+}
