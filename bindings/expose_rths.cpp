@@ -102,6 +102,7 @@ void expose_rths(py::module_& m) {
       .def_readwrite("m_e", &BenchmarkPlantParameters::m_e).def_readwrite("k_e", &BenchmarkPlantParameters::k_e)
       .def_readwrite("zeta_e", &BenchmarkPlantParameters::zeta_e)
       .def_readwrite("gain", &BenchmarkPlantParameters::gain)
+      .def_readwrite("csi_derivative_block", &BenchmarkPlantParameters::csi_derivative_block)
       .def("validate", &BenchmarkPlantParameters::validate)
       .def_property_readonly("c_e", &BenchmarkPlantParameters::c_e)
       .def("specimen", &BenchmarkPlantParameters::specimen)

@@ -52,10 +52,17 @@ BenchmarkPlant::BenchmarkPlant(const BenchmarkPlantParameters& parameters, doubl
   c_e_ = par_.c_e();
 }
 
-void BenchmarkPlant::rhs(const std::array<double, 5>& p, double u, std::array<double, 5>& dp) const noexcept {
+// x' seen by the CSI: the state, or the Derivative block's difference quotient
+// from the last major step (since = time since it; 0 = the major step itself).
+double BenchmarkPlant::csi_rate(const std::array<double, 5>& p, double since) const noexcept {
+  if (!par_.csi_derivative_block) return p[4];
+  return since > 0.0 ? (p[3] - x_major_) / since : d_major_;
+}
+
+void BenchmarkPlant::rhs(const std::array<double, 5>& p, double u, double rate, std::array<double, 5>& dp) const noexcept {
   dp[0] = p[1];
   dp[1] = -par_.beta1 * p[1] - par_.beta2 * p[0] + par_.a1_beta0 * (par_.gain * u - p[3]);
-  dp[2] = -par_.a3 * p[2] + p[0] - par_.a2 * p[4];
+  dp[2] = -par_.a3 * p[2] + p[0] - par_.a2 * rate;
   dp[3] = p[4];
   dp[4] = (p[2] - c_e_ * p[4] - par_.k_e * p[3]) / par_.m_e;
 }
@@ -63,13 +70,17 @@ void BenchmarkPlant::rhs(const std::array<double, 5>& p, double u, std::array<do
 bool BenchmarkPlant::step(double command) noexcept {
   std::array<double, 5> k1, k2, k3, k4, t;
   const double h = dt_;
-  rhs(p_, command, k1);
+  x_major_ = p_[3];
+  d_major_ = first_ ? 0.0 : (p_[3] - x_prev_) / h;
+  first_ = false;
+  x_prev_ = p_[3];
+  rhs(p_, command, csi_rate(p_, 0.0), k1);
   for (int i = 0; i < 5; ++i) t[i] = p_[i] + 0.5 * h * k1[i];
-  rhs(t, command, k2);
+  rhs(t, command, csi_rate(t, 0.5 * h), k2);
   for (int i = 0; i < 5; ++i) t[i] = p_[i] + 0.5 * h * k2[i];
-  rhs(t, command, k3);
+  rhs(t, command, csi_rate(t, 0.5 * h), k3);
   for (int i = 0; i < 5; ++i) t[i] = p_[i] + h * k3[i];
-  rhs(t, command, k4);
+  rhs(t, command, csi_rate(t, h), k4);
   bool finite = true;
   for (int i = 0; i < 5; ++i) {
     p_[i] += (h / 6.0) * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);

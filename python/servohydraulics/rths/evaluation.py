@@ -22,10 +22,23 @@ def matlab_round(x: float) -> float:
     return math.copysign(math.floor(abs(x) + 0.5), x)
 
 
-def _corr(a: np.ndarray, b: np.ndarray) -> float:
-    a = a - a.mean()
-    b = b - b.mean()
-    return float(np.dot(a, b) / math.sqrt(np.dot(a, a) * np.dot(b, b)))
+def _lagged_corr(x: np.ndarray, y: np.ndarray, max_lag: int) -> np.ndarray:
+    """Pearson correlation of x[L:] and y[:N-L] for L = 0 .. max_lag-1 (MATLAB
+    ``corr`` of the overlapping segments, each with its own mean removed), by
+    running sums after removing the global means (for conditioning)."""
+    x = x - x.mean()
+    y = y - y.mean()
+    N = x.size
+    cx, cy = np.concatenate([[0.0], np.cumsum(x)]), np.concatenate([[0.0], np.cumsum(y)])
+    cxx, cyy = np.concatenate([[0.0], np.cumsum(x * x)]), np.concatenate([[0.0], np.cumsum(y * y)])
+    r = np.empty(max_lag)
+    for L in range(max_lag):
+        n = N - L
+        sa, sb = cx[N] - cx[L], cy[n]
+        saa, sbb = cxx[N] - cxx[L], cyy[n]
+        sab = float(np.dot(x[L:], y[:n]))
+        r[L] = (sab - sa * sb / n) / math.sqrt((saa - sa * sa / n) * (sbb - sb * sb / n))
+    return r
 
 
 def evaluate(measured: np.ndarray, numerical: np.ndarray, reference: np.ndarray, dt: float,
@@ -44,8 +57,7 @@ def evaluate(measured: np.ndarray, numerical: np.ndarray, reference: np.ndarray,
     if num.ndim != 2 or num.shape[0] != xm.size or ref.shape != num.shape:
         raise ValueError(f"invalid shapes: measured {xm.shape}, numerical {num.shape}, reference {ref.shape}")
     n1 = num[:, 0]
-    r = [_corr(xm[j:], n1[:xm.size - j]) for j in range(max_lag)]
-    lag = int(np.argmax(r))  # first maximum, as MATLAB's max
+    lag = int(np.argmax(_lagged_corr(xm, n1, max_lag)))  # first maximum, as MATLAB's max
     J = [matlab_round(10000.0 * lag * dt) / 10.0]
 
     def pct(x: float) -> float:

@@ -39,6 +39,10 @@ struct BenchmarkPlantParameters {
   double k_e = 1190e3;          //!< specimen stiffness [N/m]
   double zeta_e = 0.0097;       //!< specimen damping ratio: c_e = 2 zeta_e sqrt(k_e m_e)
   double gain = 1.0261;         //!< gain on the command only (F1 L106)
+  //! CSI as the code's Simulink Derivative block on a2 x (major step: backward
+  //! difference, 0 at the first step; RK4 stages: difference from the last major
+  //! step) instead of the exact a2 x' of the paper's Eq 21.
+  bool csi_derivative_block = false;
   void validate() const;
   double c_e() const noexcept;  //!< [N s/m]
   SpecimenModel specimen() const noexcept { return {m_e, c_e(), k_e}; }
@@ -76,7 +80,11 @@ class ExperimentalSubstructure {
 class BenchmarkPlant final : public ExperimentalSubstructure {
  public:
   BenchmarkPlant(const BenchmarkPlantParameters& parameters, double dt);
-  void reset() noexcept override { p_.fill(0.0); }
+  void reset() noexcept override {
+    p_.fill(0.0);
+    x_prev_ = 0.0;
+    first_ = true;
+  }
   bool step(double command) noexcept override;
   double displacement() const noexcept override { return p_[3]; }
   double velocity() const noexcept override { return p_[4]; }
@@ -87,9 +95,11 @@ class BenchmarkPlant final : public ExperimentalSubstructure {
   const std::array<double, 5>& state() const noexcept { return p_; }  //!< [q, q', f, x, x']
 
  private:
-  void rhs(const std::array<double, 5>& p, double u, std::array<double, 5>& dp) const noexcept;
+  void rhs(const std::array<double, 5>& p, double u, double csi_rate, std::array<double, 5>& dp) const noexcept;
+  double csi_rate(const std::array<double, 5>& p, double since) const noexcept;
   BenchmarkPlantParameters par_;
-  double dt_, c_e_;
+  double dt_, c_e_, x_prev_ = 0.0, x_major_ = 0.0, d_major_ = 0.0;
+  bool first_ = true;
   std::array<double, 5> p_{};
 };
 
