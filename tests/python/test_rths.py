@@ -25,14 +25,20 @@ def data():
 
 
 def test_published_case1_row(data):
+    """BENCHMARK.md 10: the official noise realisation cannot be reproduced, so the
+    row is compared with the mean over noise seeds; the peak criteria (J3, J5)
+    depend on single samples and are compared with the seed-to-seed spread."""
     case, rec = rths.load_case(data, 1), rths.load_record(data, "elcentro")
-    J = np.array([rths.run_trial(case, rec, "sample", seed=s).J for s in range(3)]).mean(axis=0)
+    ref = rths.case_reference(case, rec)
+    Js = np.array([rths.run_trial(case, rec, "sample", seed=s, reference=ref).J for s in range(16)])
+    J, sd = Js.mean(axis=0), Js.std(axis=0, ddof=1)
     assert J[0] == pytest.approx(PUBLISHED_CASE1[0], abs=0.1)  # J1 to 0.1 ms
-    for i in (1, 2, 3, 5, 6, 7, 8):  # J2-J4, J6-J9 to 0.5 percentage points
-        assert J[i] == pytest.approx(PUBLISHED_CASE1[i], abs=0.5), f"J{i + 1}"
-    # J5 (peak error, floor 1) comes out 18.4-18.6 over seeds against the published
-    # 19.0: a known 0.5-0.6 pp gap (docs/rths-benchmark.md), checked at 0.8.
-    assert J[4] == pytest.approx(PUBLISHED_CASE1[4], abs=0.8)
+    for i in (1, 3, 5, 6, 7, 8):  # J2, J4, J6-J9: noise-insensitive (seed sd < 0.03), to 0.5 pp
+        assert sd[i] < 0.05 and J[i] == pytest.approx(PUBLISHED_CASE1[i], abs=0.5), f"J{i + 1}"
+    for i in (2, 4):  # J3, J5: single-sample peaks (seed sd ~0.19 pp)
+        assert 0.1 < sd[i] < 0.4, f"J{i + 1} sd {sd[i]}"
+        assert abs(J[i] - PUBLISHED_CASE1[i]) <= max(0.5, 3.0 * sd[i]), f"J{i + 1} {J[i]} +- {sd[i]}"
+    # J5's seed mean is 18.48 against the published 19.0 (docs/rths-benchmark.md, "The J5 gap").
 
 
 def test_embedded_structure_matches_official_files(data):
