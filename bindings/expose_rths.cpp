@@ -7,6 +7,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "busy.hpp"
 #include "servohydraulics/rths/loop.hpp"
 
 namespace py = pybind11;
@@ -23,6 +24,8 @@ std::vector<double> to_vector(const Arr& a, const char* name) {
 
 py::dict run_loop(RthsLoop& loop, const LinearSubstructure& num, const GroundMotion& ag, std::size_t n,
                   bool timing) {
+  if (&num != &loop.numerical())
+    throw Error("invalid numerical: expected the loop's own numerical substructure (the one it was built with)");
   const auto nd = static_cast<py::ssize_t>(num.model().size());
   const auto N = static_cast<py::ssize_t>(n);
   Arr measured(N), displacement(N), force(N), command(N), fin(N), numerical({N, nd}), steps(timing ? N : 0);
@@ -30,6 +33,8 @@ py::dict run_loop(RthsLoop& loop, const LinearSubstructure& num, const GroundMot
                  fin.mutable_data(), numerical.mutable_data(), timing ? steps.mutable_data() : nullptr};
   RthsSummary s;
   {
+    bindings::BusyGuard busy({&loop, &loop.experimental(), &loop.numerical(), &loop.controller(), &ag},
+                             "RthsLoop.run");
     py::gil_scoped_release release;
     loop.reset();
     s = loop.run(ag, n, rec);
@@ -78,7 +83,7 @@ void expose_rths(py::module_& m) {
       .def_readwrite("quantizer", &Converter::quantizer).def_readwrite("enabled", &Converter::enabled)
       .def("validate", &Converter::validate).def("__call__", &Converter::operator());
   r.def("benchmark_converter", &benchmark_converter, py::arg("kind"));
-  r.def("ideal_converter", &ideal_converter);
+  r.def("ideal_converter", &ideal_converter, py::arg("kind") = Converter::Kind::AnalogToDigital);
   py::class_<GaussianSequence>(r, "GaussianSequence")
       .def(py::init<std::uint64_t>(), py::arg("seed") = 0)
       .def("reset", &GaussianSequence::reset, py::arg("seed"))
@@ -115,8 +120,11 @@ void expose_rths(py::module_& m) {
       .def_readwrite("a3", &BenchmarkPlantUncertainty::a3)
       .def("draw", &BenchmarkPlantUncertainty::draw, py::arg("nominal"), py::arg("seed"));
   py::class_<ExperimentalSubstructure>(r, "ExperimentalSubstructure")
-      .def("reset", &ExperimentalSubstructure::reset)
-      .def("step", &ExperimentalSubstructure::step, py::arg("command"))
+      .def("reset", [](ExperimentalSubstructure& e) { bindings::require_idle(&e, "ExperimentalSubstructure.reset"); e.reset(); })
+      .def("step", [](ExperimentalSubstructure& e, double u) {
+        bindings::require_idle(&e, "ExperimentalSubstructure.step");
+        return e.step(u);
+      }, py::arg("command"))
       .def_property_readonly("displacement", &ExperimentalSubstructure::displacement)
       .def_property_readonly("velocity", &ExperimentalSubstructure::velocity)
       .def_property_readonly("actuator_force", &ExperimentalSubstructure::actuator_force)
@@ -146,8 +154,11 @@ void expose_rths(py::module_& m) {
   py::class_<LinearSubstructure>(r, "LinearSubstructure")
       .def(py::init<const LinearSubstructureModel&, double, SubstructureScheme>(), py::arg("model"), py::arg("h"),
            py::arg("scheme") = SubstructureScheme::RungeKutta4)
-      .def("reset", &LinearSubstructure::reset)
-      .def("step", &LinearSubstructure::step, py::arg("ag0"), py::arg("ag_mid"), py::arg("ag1"), py::arg("f_in"))
+      .def("reset", [](LinearSubstructure& s) { bindings::require_idle(&s, "LinearSubstructure.reset"); s.reset(); })
+      .def("step", [](LinearSubstructure& s, double a0, double am, double a1, double f) {
+        bindings::require_idle(&s, "LinearSubstructure.step");
+        s.step(a0, am, a1, f);
+      }, py::arg("ag0"), py::arg("ag_mid"), py::arg("ag1"), py::arg("f_in"))
       .def_property_readonly("displacement", &LinearSubstructure::displacement)
       .def_property_readonly("velocity", &LinearSubstructure::velocity)
       .def("acceleration", &LinearSubstructure::acceleration, py::arg("dof"), py::arg("ag"), py::arg("f_in"));
@@ -169,8 +180,11 @@ void expose_rths(py::module_& m) {
            py::arg("desired"), py::arg("desired_velocity") = 0.0, py::arg("desired_acceleration") = 0.0,
            py::arg("measured") = 0.0, py::arg("measured_force") = 0.0);
   py::class_<TrackingController>(r, "TrackingController")
-      .def("reset", &TrackingController::reset)
-      .def("command", &TrackingController::command, py::arg("input"));
+      .def("reset", [](TrackingController& c) { bindings::require_idle(&c, "TrackingController.reset"); c.reset(); })
+      .def("command", [](TrackingController& c, const TrackingInput& in) {
+        bindings::require_idle(&c, "TrackingController.command");
+        return c.command(in);
+      }, py::arg("input"));
   py::class_<SampleControllerConfig> sc(r, "SampleControllerConfig");
   sc.def(py::init<>()).def_readwrite("lead_b1", &SampleControllerConfig::lead_b1)
       .def_readwrite("lead_b0", &SampleControllerConfig::lead_b0)

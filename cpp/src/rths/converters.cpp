@@ -1,6 +1,7 @@
 #include "servohydraulics/rths/converters.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "servohydraulics/error.hpp"
 
@@ -32,9 +33,11 @@ Converter benchmark_converter(Converter::Kind kind) {
   return c;
 }
 
-Converter ideal_converter() {
+Converter ideal_converter(Converter::Kind kind) {
   Converter c;
+  c.kind = kind;
   c.enabled = false;
+  c.saturation = {-std::numeric_limits<double>::max(), std::numeric_limits<double>::max()};  // never acts
   return c;
 }
 

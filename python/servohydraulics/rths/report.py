@@ -12,6 +12,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from ..atomic import FileSet
 from .benchmark import CONTROLLERS, FORCE_LIMIT, run_case
 from .data import EQ_INTENSITY, embedded_case, load_case, load_record, synthetic_record
 from .evaluation import J_NAMES
@@ -119,7 +120,7 @@ def j_table(results: dict[str, Any]) -> str:
     return head + "\n".join(rows) + "\n"
 
 
-def _plots(run: dict[str, Any], out: Path) -> list[str]:
+def _plots(run: dict[str, Any], out: Path, files_out: "FileSet") -> list[str]:
     from matplotlib.figure import Figure
     files = []
     trials = run["trials"]
@@ -138,7 +139,7 @@ def _plots(run: dict[str, Any], out: Path) -> list[str]:
             ax.legend(loc="upper right", fontsize=7)
     fig.axes[-1].set_xlabel("time [s]")
     fig.tight_layout()
-    fig.savefig(out / "tracking.png", dpi=110)
+    fig.savefig(files_out.path(out / "tracking.png"), dpi=110)
     files.append("tracking.png")
     fig = Figure(figsize=(9, 3.5))
     ax = fig.add_subplot(1, 1, 1)
@@ -154,21 +155,25 @@ def _plots(run: dict[str, Any], out: Path) -> list[str]:
     ax.set_ylabel("[%]")
     ax.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(out / "criteria.png", dpi=110)
+    fig.savefig(files_out.path(out / "criteria.png"), dpi=110)
     files.append("criteria.png")
     return files
 
 
 def write_outputs(run: dict[str, Any], out: str | Path) -> Path:
-    """results.json, report.md, tracking.png and criteria.png in ``out`` (written
-    to temporary names, then renamed: no half-written file)."""
+    """results.json, report.md, tracking.png and criteria.png in ``out``, renamed
+    into place together once all are written (atomic.FileSet: no half-written file)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    with FileSet() as files:
+        _write_all(run, out, files)
+    return out
+
+
+def _write_all(run: dict[str, Any], out: Path, files: FileSet) -> None:
     res = run["results"]
-    tmp = out / "results.json.tmp"
-    tmp.write_text(json.dumps(res, indent=2, allow_nan=True))
-    os.replace(tmp, out / "results.json")
-    plots = _plots(run, out)
+    files.write_text(out / "results.json", json.dumps(res, indent=2, allow_nan=True))
+    _plots(run, out, files)
     meta = res["meta"]
     lines = ["# RTHS benchmark (Silva et al. 2020)", ""]
     if meta.get("synthetic"):
@@ -184,7 +189,4 @@ def write_outputs(run: dict[str, Any], out: str | Path) -> Path:
     if "perturbed_stable" in meta:
         lines += [f"Perturbed trials that ran to the end (stable), per case: {meta['perturbed_stable']}."]
     lines += ["", "![tracking](tracking.png)", "", "![criteria](criteria.png)", ""]
-    tmp = out / "report.md.tmp"
-    tmp.write_text("\n".join(lines))
-    os.replace(tmp, out / "report.md")
-    return out
+    files.write_text(out / "report.md", "\n".join(lines))

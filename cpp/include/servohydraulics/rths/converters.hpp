@@ -47,8 +47,8 @@ struct Converter {
 //! The benchmark's converters (F1_input_file.m L186-189): 18 bit over +-3.8 in
 //! the code's units (metres: q = 2^-18, the saturation never acts in practice).
 Converter benchmark_converter(Converter::Kind kind);
-//! An ideal converter (enabled = false).
-Converter ideal_converter();
+//! An ideal converter (enabled = false; the saturation at +-DBL_MAX and no quantizer if it is enabled).
+Converter ideal_converter(Converter::Kind kind = Converter::Kind::AnalogToDigital);
 
 //! Standard normal draws, one per sample, from a seeded 64-bit Mersenne twister
 //! (Marsaglia polar method: the same sequence on every platform for one seed).

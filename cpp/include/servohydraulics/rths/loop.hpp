@@ -65,6 +65,9 @@ class RthsLoop {
   RthsSummary run(const GroundMotion& ag, std::size_t n, const RthsRecord& record) noexcept;
 
   const RthsLoopConfig& config() const noexcept { return cfg_; }
+  const ExperimentalSubstructure& experimental() const noexcept { return exp_; }
+  const LinearSubstructure& numerical() const noexcept { return num_; }
+  const TrackingController& controller() const noexcept { return ctrl_; }
 
  private:
   ExperimentalSubstructure& exp_;
