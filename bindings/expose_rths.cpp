@@ -1,5 +1,8 @@
 // The RTHS benchmark's blocks (servohydraulics/rths/*.hpp): no logic here.
+#include <cmath>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <pybind11/eigen.h>
@@ -22,11 +25,85 @@ std::vector<double> to_vector(const Arr& a, const char* name) {
   return std::vector<double>(a.data(), a.data() + a.shape(0));
 }
 
-py::dict run_loop(RthsLoop& loop, const LinearSubstructure& num, const GroundMotion& ag, std::size_t n,
+// A Python object as the loop's numerical substructure (e.g. rths.OpenSeesSubstructure).
+// Its protocol: attributes h, size, interface_dof; methods reset(), step(ag0, ag_mid,
+// ag1, f_in), displacements() -> size floats, interface_velocity(),
+// interface_acceleration(ag, f_in).  The loop runs without the GIL: each call
+// takes it.  A Python exception marks the substructure failed (healthy() false,
+// the loop stops); run() then raises it with its message.
+class PythonSubstructure final : public NumericalSubstructure {
+ public:
+  explicit PythonSubstructure(py::object obj) : obj_(std::move(obj)) {
+    h_ = obj_.attr("h").cast<double>();
+    n_ = obj_.attr("size").cast<Eigen::Index>();
+    dof_ = obj_.attr("interface_dof").cast<Eigen::Index>();
+    if (!(std::isfinite(h_) && h_ > 0.0)) throw Error("invalid numerical.h = " + std::to_string(h_) + ": finite and > 0");
+    if (n_ < 1) throw Error("invalid numerical.size = " + std::to_string(n_) + ": >= 1");
+    if (dof_ < 0 || dof_ >= n_)
+      throw Error("invalid numerical.interface_dof = " + std::to_string(dof_) + ": one of its DOFs (0 .. size-1)");
+    x_.setZero(n_);
+  }
+  void reset() noexcept override {
+    failed_ = false;
+    error_.clear();
+    call([&] {
+      obj_.attr("reset")();
+      pull();
+    });
+  }
+  void step(double ag0, double ag_mid, double ag1, double f_in) noexcept override {
+    call([&] {
+      obj_.attr("step")(ag0, ag_mid, ag1, f_in);
+      pull();
+    });
+  }
+  Eigen::Index dof_count() const noexcept override { return n_; }
+  double dof_displacement(Eigen::Index i) const noexcept override { return x_(i); }
+  Eigen::Index interface_dof() const noexcept override { return dof_; }
+  double interface_velocity() const noexcept override { return v_; }
+  double interface_acceleration(double ag, double f_in) const noexcept override {
+    double a = std::nan("");
+    call([&] { a = obj_.attr("interface_acceleration")(ag, f_in).cast<double>(); });
+    return a;
+  }
+  double sample_time() const noexcept override { return h_; }
+  bool healthy() const noexcept override { return !failed_ && x_.allFinite() && std::isfinite(v_); }
+  const std::string& error() const noexcept { return error_; }
+  const py::object& object() const noexcept { return obj_; }
+
+ private:
+  void pull() {
+    const auto d = obj_.attr("displacements")().cast<std::vector<double>>();
+    if (static_cast<Eigen::Index>(d.size()) != n_)
+      throw Error("invalid numerical.displacements(): " + std::to_string(d.size()) + " values, expected size = " +
+                  std::to_string(n_));
+    for (Eigen::Index i = 0; i < n_; ++i) x_(i) = d[static_cast<std::size_t>(i)];
+    v_ = obj_.attr("interface_velocity")().cast<double>();
+  }
+  template <class F>
+  void call(F&& f) const noexcept {
+    if (failed_) return;
+    py::gil_scoped_acquire gil;
+    try {
+      f();
+    } catch (const std::exception& e) {
+      failed_ = true;
+      error_ = e.what();
+    }
+  }
+  py::object obj_;
+  double h_ = 0.0, v_ = 0.0;
+  Eigen::Index n_ = 0, dof_ = 0;
+  Eigen::VectorXd x_;
+  mutable bool failed_ = false;
+  mutable std::string error_;
+};
+
+py::dict run_loop(RthsLoop& loop, const NumericalSubstructure& num, const GroundMotion& ag, std::size_t n,
                   bool timing) {
   if (&num != &loop.numerical())
     throw Error("invalid numerical: expected the loop's own numerical substructure (the one it was built with)");
-  const auto nd = static_cast<py::ssize_t>(num.model().size());
+  const auto nd = static_cast<py::ssize_t>(num.dof_count());
   const auto N = static_cast<py::ssize_t>(n);
   Arr measured(N), displacement(N), force(N), command(N), fin(N), numerical({N, nd}), steps(timing ? N : 0);
   RthsRecord rec{measured.mutable_data(), displacement.mutable_data(), force.mutable_data(), command.mutable_data(),
@@ -39,6 +116,9 @@ py::dict run_loop(RthsLoop& loop, const LinearSubstructure& num, const GroundMot
     loop.reset();
     s = loop.run(ag, n, rec);
   }
+  if (const auto* p = dynamic_cast<const PythonSubstructure*>(&num); p && !p->error().empty())
+    throw std::runtime_error("numerical substructure failed at t = " + std::to_string(s.failure_time) +
+                             " s: " + p->error());
   const auto rows = static_cast<py::ssize_t>(s.rows);
   py::dict out;
   out["measured"] = measured[py::slice(0, rows, 1)];
@@ -151,7 +231,17 @@ void expose_rths(py::module_& m) {
       .def_readwrite("K", &LinearSubstructureModel::K).def_readwrite("ground", &LinearSubstructureModel::ground)
       .def_readwrite("interface", &LinearSubstructureModel::interface)
       .def("validate", &LinearSubstructureModel::validate);
-  py::class_<LinearSubstructure>(r, "LinearSubstructure")
+  py::class_<NumericalSubstructure>(r, "NumericalSubstructure")
+      .def_property_readonly("dof_count", &NumericalSubstructure::dof_count)
+      .def_property_readonly("interface_dof", &NumericalSubstructure::interface_dof)
+      .def_property_readonly("sample_time", &NumericalSubstructure::sample_time)
+      .def_property_readonly("healthy", &NumericalSubstructure::healthy);
+  py::class_<PythonSubstructure, NumericalSubstructure>(r, "PythonSubstructure",
+                                                        "a Python object as the RTHS loop's numerical substructure")
+      .def(py::init<py::object>(), py::arg("substructure"))
+      .def_property_readonly("error", &PythonSubstructure::error)
+      .def_property_readonly("substructure", &PythonSubstructure::object);
+  py::class_<LinearSubstructure, NumericalSubstructure>(r, "LinearSubstructure")
       .def(py::init<const LinearSubstructureModel&, double, SubstructureScheme>(), py::arg("model"), py::arg("h"),
            py::arg("scheme") = SubstructureScheme::RungeKutta4)
       .def("reset", [](LinearSubstructure& s) { bindings::require_idle(&s, "LinearSubstructure.reset"); s.reset(); })
@@ -231,11 +321,11 @@ void expose_rths(py::module_& m) {
       .def_readwrite("seed", &RthsLoopConfig::seed)
       .def("validate", &RthsLoopConfig::validate);
   py::class_<RthsLoop>(r, "RthsLoop")
-      .def(py::init<ExperimentalSubstructure&, LinearSubstructure&, TrackingController&, const RthsLoopConfig&>(),
+      .def(py::init<ExperimentalSubstructure&, NumericalSubstructure&, TrackingController&, const RthsLoopConfig&>(),
            py::arg("experimental"), py::arg("numerical"), py::arg("controller"), py::arg("config") = RthsLoopConfig{},
            py::keep_alive<1, 2>(), py::keep_alive<1, 3>(), py::keep_alive<1, 4>())
       .def("run",
-           [](RthsLoop& loop, const LinearSubstructure& num, const GroundMotion& ag, std::size_t n, bool timing) {
+           [](RthsLoop& loop, const NumericalSubstructure& num, const GroundMotion& ag, std::size_t n, bool timing) {
              return run_loop(loop, num, ag, n, timing);
            },
            py::arg("numerical"), py::arg("ground_motion"), py::arg("n"), py::arg("timing") = false,

@@ -26,6 +26,10 @@ LinearSubstructure::LinearSubstructure(const LinearSubstructureModel& model, dou
   model_.validate();
   require(std::isfinite(h) && h > 0.0, "h", h, "finite and > 0");
   const Eigen::Index n = model_.size();
+  dof_ = n;
+  for (Eigen::Index i = n - 1; i >= 0; --i)
+    if (model_.interface(i) != 0.0) dof_ = i;
+  require(dof_ < n, "interface", 0.0, "a nonzero entry (the DOF the specimen force acts on)");
   const Eigen::PartialPivLU<Eigen::MatrixXd> lu(model_.M);
   MiK_ = lu.solve(model_.K);
   MiC_ = lu.solve(model_.C);

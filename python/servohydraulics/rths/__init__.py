@@ -17,6 +17,7 @@ from .benchmark import (CONTROLLERS, FORCE_LIMIT, Trial, case_psi, case_referenc
 from .data import (CASES, DT, EQ_INTENSITY, FS, RECORDS, BenchmarkCase, Record, embedded_case, load_case,
                    load_record, modal_damping, reference_stiffness, synthetic_record)
 from .evaluation import J_NAMES, critical_delay, evaluate, matlab_round, psi, reference_response
+from .opensees import OpenSeesSubstructure, spring_model
 
 core = _core.rths
 
@@ -24,4 +25,4 @@ __all__ = ["CONTROLLERS", "FORCE_LIMIT", "Trial", "case_psi", "case_reference", 
            "partition", "perturbed_plant", "run_case", "run_trial", "trial_seed", "CASES", "DT", "EQ_INTENSITY",
            "FS", "RECORDS", "BenchmarkCase", "Record", "embedded_case", "load_case", "load_record",
            "modal_damping", "reference_stiffness", "synthetic_record", "J_NAMES", "critical_delay", "evaluate",
-           "matlab_round", "psi", "reference_response", "core"]
+           "matlab_round", "psi", "reference_response", "core", "OpenSeesSubstructure", "spring_model"]

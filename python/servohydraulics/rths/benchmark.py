@@ -127,7 +127,7 @@ def _ground_motion(record: Record, scale: float) -> "R.GroundMotion":
 
 def run_trial(case: BenchmarkCase, record: Record, controller: str = "sample", plant=None, seed: int = 0,
               scale: float = EQ_INTENSITY, scheme: str = "RungeKutta4", reference: np.ndarray | None = None,
-              keep_signals: bool = False, timing: bool = False, experimental=None) -> Trial:
+              keep_signals: bool = False, timing: bool = False, experimental=None, numerical=None) -> Trial:
     """One vRTHS run on the 4096 Hz grid of the record, then J1-J9.
 
     Args:
@@ -138,10 +138,13 @@ def run_trial(case: BenchmarkCase, record: Record, controller: str = "sample", p
         reference: the reference displacements (N x 3), if already computed.
         experimental: another ExperimentalSubstructure (e.g. ServoHydraulicSubstructure);
             None: the benchmark plant.
+        numerical: another numerical substructure: a core NumericalSubstructure (e.g. a
+            LinearSubstructure of other matrices) or a Python object with its protocol (e.g.
+            ``rths.OpenSeesSubstructure``); None: the case partitioned at the first floor.
     """
     plant = plant if plant is not None else nominal_plant()
     exp = experimental if experimental is not None else R.BenchmarkPlant(plant, DT)
-    num = R.LinearSubstructure(partition(case, exp.specimen()), DT, getattr(R.SubstructureScheme, scheme))
+    num = _numerical(numerical, case, exp, scheme)
     ctrl = make_controller(controller)
     cfg = R.RthsLoopConfig()
     cfg.seed = int(seed) & (2**64 - 1)
@@ -165,6 +168,14 @@ def run_trial(case: BenchmarkCase, record: Record, controller: str = "sample", p
         trial.signals["reference"] = reference
         trial.signals["time"] = np.arange(out["rows"]) * DT
     return trial
+
+
+def _numerical(numerical, case: BenchmarkCase, exp, scheme: str):
+    if numerical is None:
+        return R.LinearSubstructure(partition(case, exp.specimen()), DT, getattr(R.SubstructureScheme, scheme))
+    if isinstance(numerical, R.NumericalSubstructure):
+        return numerical
+    return R.PythonSubstructure(numerical)
 
 
 _REFERENCE_CACHE: dict[tuple, np.ndarray] = {}

@@ -56,9 +56,8 @@ struct RthsSummary {
 
 class RthsLoop {
  public:
-  //! References are kept: the three parts must outlive the loop.  The numerical
-  //! substructure's interface DOF is the first one whose interface entry is nonzero.
-  RthsLoop(ExperimentalSubstructure& experimental, LinearSubstructure& numerical, TrackingController& controller,
+  //! References are kept: the three parts must outlive the loop.
+  RthsLoop(ExperimentalSubstructure& experimental, NumericalSubstructure& numerical, TrackingController& controller,
            const RthsLoopConfig& config = {});
   void reset() noexcept;
   //! n samples t_k = k dt, k = 0..n-1, ground acceleration from ag (already scaled).
@@ -66,15 +65,14 @@ class RthsLoop {
 
   const RthsLoopConfig& config() const noexcept { return cfg_; }
   const ExperimentalSubstructure& experimental() const noexcept { return exp_; }
-  const LinearSubstructure& numerical() const noexcept { return num_; }
+  const NumericalSubstructure& numerical() const noexcept { return num_; }
   const TrackingController& controller() const noexcept { return ctrl_; }
 
  private:
   ExperimentalSubstructure& exp_;
-  LinearSubstructure& num_;
+  NumericalSubstructure& num_;
   TrackingController& ctrl_;
   RthsLoopConfig cfg_;
-  Eigen::Index dof_ = 0;
   GaussianSequence wx_, wf_;
   BackwardDifference dx_, dv_;
   UnitDelay delay_;

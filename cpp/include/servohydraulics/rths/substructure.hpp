@@ -22,6 +22,27 @@ namespace servohydraulics::rths {
 
 enum class SubstructureScheme { RungeKutta4, CentralDifference, ExplicitNewmark };
 
+//! A numerical substructure as the RTHS loop sees it (loop.hpp): stepped once
+//! per controller sample, its DOF displacements read back, one interface DOF.
+//! LinearSubstructure is the C++ one; the Python bindings let a Python object
+//! (e.g. the OpenSeesPy adapter) be one.  All calls are noexcept: a failure is
+//! reported by healthy() == false (the loop then stops).
+class NumericalSubstructure {
+ public:
+  virtual ~NumericalSubstructure() = default;
+  virtual void reset() noexcept = 0;  //!< at rest at t = 0
+  //! One sample: ground acceleration at t_k, t_k + h/2, t_k + h [m/s^2]; f_in held [N].
+  virtual void step(double ag0, double ag_mid, double ag1, double f_in) noexcept = 0;
+  virtual Eigen::Index dof_count() const noexcept = 0;                 //!< DOFs read back
+  virtual double dof_displacement(Eigen::Index i) const noexcept = 0;  //!< x_i(t_k) [m]
+  virtual Eigen::Index interface_dof() const noexcept = 0;            //!< the DOF the specimen force acts on
+  virtual double interface_velocity() const noexcept = 0;             //!< [m/s]
+  //! Relative acceleration of the interface DOF at t_k with a_g and f_in at t_k [m/s^2].
+  virtual double interface_acceleration(double ag, double f_in) const noexcept = 0;
+  virtual double sample_time() const noexcept = 0;  //!< h [s]
+  virtual bool healthy() const noexcept = 0;        //!< finite state, no failure
+};
+
 //! M, C, K [kg, N s/m, N/m], ground-load vector g [kg] and interface vector gamma [-].
 struct LinearSubstructureModel {
   Eigen::MatrixXd M, C, K;
@@ -31,15 +52,26 @@ struct LinearSubstructureModel {
   Eigen::Index size() const noexcept { return M.rows(); }
 };
 
-class LinearSubstructure {
+class LinearSubstructure final : public NumericalSubstructure {
  public:
+  //! The interface DOF is the first one whose interface entry is nonzero (Error if none).
   LinearSubstructure(const LinearSubstructureModel& model, double h,
                      SubstructureScheme scheme = SubstructureScheme::RungeKutta4);
 
-  void reset() noexcept;  //!< at rest at t = 0
+  void reset() noexcept override;  //!< at rest at t = 0
   //! Advance one sample from t_k to t_k + h: ground acceleration [m/s^2] at t_k,
   //! t_k + h/2 and t_k + h; interface force f_in [N] held over the sample.
-  void step(double ag0, double ag_mid, double ag1, double f_in) noexcept;
+  void step(double ag0, double ag_mid, double ag1, double f_in) noexcept override;
+
+  Eigen::Index dof_count() const noexcept override { return model_.size(); }
+  double dof_displacement(Eigen::Index i) const noexcept override { return x_(i); }
+  Eigen::Index interface_dof() const noexcept override { return dof_; }
+  double interface_velocity() const noexcept override { return v_(dof_); }
+  double interface_acceleration(double ag, double f_in) const noexcept override {
+    return acceleration(dof_, ag, f_in);
+  }
+  double sample_time() const noexcept override { return h_; }
+  bool healthy() const noexcept override { return x_.allFinite() && v_.allFinite(); }
 
   const Eigen::VectorXd& displacement() const noexcept { return x_; }  //!< x(t_k) [m]
   //! x'(t_k) [m/s]: the state (RK4, Newmark) or the backward difference (central difference).
@@ -57,6 +89,7 @@ class LinearSubstructure {
   LinearSubstructureModel model_;
   SubstructureScheme scheme_;
   double h_;
+  Eigen::Index dof_ = 0;
   Eigen::MatrixXd MiK_, MiC_;       // M^-1 K, M^-1 C
   Eigen::VectorXd Mig_, Migam_;     // M^-1 g, M^-1 gamma
   Eigen::MatrixXd S_inv_;           // central difference: (M/h^2 + C/2h)^-1 ; Newmark: (M + h/2 C)^-1
