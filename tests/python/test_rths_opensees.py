@@ -93,18 +93,19 @@ def test_bad_input_names_the_field():
 
 
 def _shear_building():
-    """A 3-storey shear building (storey stiffnesses 6, 5, 4 MN/m, 1000 kg floors, Rayleigh 5 %
-    at modes 1 and 3) as a benchmark case, and its numerical part (M, K) without the specimen."""
-    ks = [6e6, 5e6, 4e6]
-    Kr = np.array([[ks[0] + ks[1], -ks[1], 0.0], [-ks[1], ks[1] + ks[2], -ks[2]], [0.0, -ks[2], ks[2]]])
-    Mr = 1000.0 * np.eye(3)
-    w = np.sqrt(np.sort(np.linalg.eigvals(np.linalg.solve(Mr, Kr)).real))
-    a, b = np.linalg.solve([[1 / (2 * w[0]), w[0] / 2], [1 / (2 * w[2]), w[2] / 2]], [0.05, 0.05])
-    case = rths.BenchmarkCase(0, Mr, a * Mr + b * Kr, Kr, source="test shear building")
+    """rths.shear_building (6, 5, 4 MN/m storeys, 1000 kg floors, 5 % Rayleigh) and its numerical
+    part (M, K) without the specimen, with its Rayleigh coefficients (a, b)."""
+    case = rths.shear_building()
+    Kr, Cr, Mr = case.K, case.C, case.M
+    a, b = np.linalg.lstsq(np.c_[Mr.ravel(), Kr.ravel()], Cr.ravel(), rcond=None)[0]
+    np.testing.assert_allclose(a * Mr + b * Kr, Cr, rtol=1e-12, atol=1e-9)
     sp = rths.nominal_plant().specimen()
     M, K = Mr.copy(), Kr.copy()
     M[0, 0] -= sp.m
     K[0, 0] -= sp.k
+    w = np.sqrt(np.linalg.eigvals(np.linalg.solve(Mr, Kr)).real)
+    zeta = a / (2 * w) + b * w / 2
+    assert zeta.min() > 0.03 and max(zeta[np.argmin(w)], zeta[np.argmax(w)]) == pytest.approx(0.05)
     return case, M, K, a, b
 
 
@@ -133,3 +134,21 @@ def test_yielding_storey_that_never_yields_is_the_linear_model_and_one_that_yiel
     assert soft.ok and np.max(np.abs(x1)) < 10 * peak
     assert abs(np.mean(x1[tail])) > 0.02 * peak  # 0.05 peak here
     assert abs(np.mean(x_lin[tail])) < 1e-3 * peak  # 4e-6 peak here
+
+
+def test_example_06_runs(monkeypatch, capsys):
+    """examples/06_rths_opensees.py (the docs' nonlinear example) on its synthetic ground motion."""
+    import runpy
+    import sys
+    from pathlib import Path
+    path = Path(__file__).resolve().parents[2] / "examples" / "06_rths_opensees.py"
+    monkeypatch.setattr(sys, "argv", [str(path)])
+    runpy.run_path(str(path), run_name="__main__")
+    rows = {}
+    for line in capsys.readouterr().out.splitlines():
+        name, _, rest = line.partition(": ")
+        if name in ("linear", "yielding"):
+            rows[name] = dict(kv.split("=") for kv in rest.split())
+    assert rows["linear"]["ok"] == rows["yielding"]["ok"] == "True"
+    assert abs(float(rows["linear"]["residual_drift_mm"])) < 0.005
+    assert abs(float(rows["yielding"]["residual_drift_mm"])) > 0.05

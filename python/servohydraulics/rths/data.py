@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["BenchmarkCase", "Record", "RECORDS", "CASES", "load_case", "load_record", "embedded_case",
+           "shear_building",
            "synthetic_record", "reference_stiffness", "modal_damping", "FS", "DT", "EQ_INTENSITY"]
 
 FS = 4096                 #: the benchmark's sample rate [Hz]
@@ -170,6 +171,26 @@ def embedded_case(number: int) -> BenchmarkCase:
     M = m * np.eye(3)
     K = reference_stiffness()
     return BenchmarkCase(number, M, modal_damping(M, K, [zeta] * 3), K, source="embedded (published parameters)")
+
+
+def shear_building(storey_stiffness=(6e6, 5e6, 4e6), floor_mass: float = 1000.0,
+                   zeta: float = 0.05) -> BenchmarkCase:
+    """A shear building (NOT one of the benchmark's cases) as a BenchmarkCase: storey
+    stiffnesses [N/m] from the ground up, equal floor masses [kg], Rayleigh damping C = a M + b K
+    with ``zeta`` at the first and last modes.  Its stiffness splits into positive storey springs,
+    so a storey can be made to yield (rths.spring_model)."""
+    ks = np.asarray(storey_stiffness, dtype=float)
+    n = ks.size
+    if n < 1 or not np.all(np.isfinite(ks)) or np.any(ks <= 0):
+        raise ValueError(f"invalid storey_stiffness = {ks.tolist()}: finite and > 0 [N/m]")
+    if not (math.isfinite(floor_mass) and floor_mass > 0 and math.isfinite(zeta) and zeta >= 0):
+        raise ValueError(f"invalid floor_mass, zeta = {floor_mass!r}, {zeta!r}: > 0 [kg], >= 0")
+    K = np.diag(ks + np.append(ks[1:], 0.0)) - np.diag(ks[1:], 1) - np.diag(ks[1:], -1)
+    M = floor_mass * np.eye(n)
+    w = np.sqrt(np.sort(np.linalg.eigvals(np.linalg.solve(M, K)).real))
+    a, b = (zeta * w[0], 0.0) if n == 1 else np.linalg.solve([[1 / (2 * w[0]), w[0] / 2],
+                                                                [1 / (2 * w[-1]), w[-1] / 2]], [zeta, zeta])
+    return BenchmarkCase(0, M, a * M + b * K, K, source=f"shear building {ks.tolist()} N/m (Rayleigh {a:.6g}, {b:.6g})")
 
 
 def synthetic_record(duration: float = 20.0, dt: float = 0.01, pga: float = 3.0, seed: int = 1) -> Record:
