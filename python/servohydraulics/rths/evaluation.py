@@ -36,7 +36,7 @@ def _lagged_corr(x: np.ndarray, y: np.ndarray, max_lag: int) -> np.ndarray:
         n = N - L
         sa, sb = cx[N] - cx[L], cy[n]
         saa, sbb = cxx[N] - cxx[L], cyy[n]
-        sab = float(np.dot(x[L:], y[:n]))
+        sab = float(np.einsum("i,i->", x[L:], y[:n]))  # not np.dot: a threaded BLAS call is 40x slower here
         r[L] = (sab - sa * sb / n) / math.sqrt((saa - sa * sa / n) * (sbb - sb * sb / n))
     return r
 
