@@ -8,10 +8,11 @@ def _run(args) -> int:
     from ..rths.data import RECORDS
     from ..rths.report import run_benchmark, write_outputs
     if args.data is None:
+        motion = "the benchmark's chirp" if args.record == "chirp" else "a synthetic ground motion"
         print("rths-benchmark: no --data: running the EMBEDDED DEFAULT (published structure parameters, "
-              "synthetic ground motion): NOT the benchmark's records or results")
-    elif args.record not in RECORDS:
-        raise ValueError(f"invalid --record = {args.record!r}: expected one of {sorted(RECORDS)}")
+              f"{motion}): NOT the benchmark's records or results")
+    if args.record not in RECORDS and args.record != "chirp":
+        raise ValueError(f"invalid --record = {args.record!r}: expected one of {sorted(RECORDS) + ['chirp']}")
     run = run_benchmark(args.data, args.record, args.cases, args.controller, args.perturbed, args.seed,
                         workers=args.workers, progress=not args.quiet)
     out = write_outputs(run, args.out)
@@ -26,7 +27,8 @@ def register(sub) -> None:
     p.add_argument("--data", default=None,
                    help="folder with the official files ('RTHS code RT V23/' layout or a flat folder of "
                         "Case_N.mat and the records); omitted: the embedded default with a synthetic ground motion")
-    p.add_argument("--record", default="elcentro", help="elcentro | kobe | morganhill (default: elcentro)")
+    p.add_argument("--record", default="elcentro", help="elcentro | kobe | morganhill | chirp (default: elcentro; chirp: the benchmark's 0.1-40 Hz "
+                        "verification sweep, generated)")
     p.add_argument("--cases", default="1,2,3,4", help="comma-separated cases (default: 1,2,3,4)")
     p.add_argument("--controller", default="sample", choices=["sample", "polynomial", "ats", "model"],
                    help="tracking controller (default: the benchmark's sample controller)")

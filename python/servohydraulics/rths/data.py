@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["BenchmarkCase", "Record", "RECORDS", "CASES", "load_case", "load_record", "embedded_case",
-           "shear_building",
+           "shear_building", "chirp_record",
            "synthetic_record", "reference_stiffness", "modal_damping", "FS", "DT", "EQ_INTENSITY"]
 
 FS = 4096                 #: the benchmark's sample rate [Hz]
@@ -102,10 +102,13 @@ def load_case(root: str | Path, number: int) -> BenchmarkCase:
                      "'Building cases/Case_N.mat' nor 'Case_N.mat' nor building_cases.json)")
 
 
-def load_record(root: str | Path, name: str) -> Record:
-    """An official record (``*AccelNoScaling.mat`` or its CSV copy), unscaled."""
+def load_record(root: str | Path | None, name: str) -> Record:
+    """An official record (``*AccelNoScaling.mat`` or its CSV copy), unscaled; ``"chirp"``:
+    the benchmark's verification chirp (``chirp_record``, generated, no file needed)."""
+    if name == "chirp":
+        return chirp_record()
     if name not in RECORDS:
-        raise ValueError(f"invalid record = {name!r}: expected one of {sorted(RECORDS)}")
+        raise ValueError(f"invalid record = {name!r}: expected one of {sorted(RECORDS) + ['chirp']}")
     root = Path(root)
     fname, var, csv_name = RECORDS[name]
     p = _first_file(root, [fname])
@@ -171,6 +174,22 @@ def embedded_case(number: int) -> BenchmarkCase:
     M = m * np.eye(3)
     K = reference_stiffness()
     return BenchmarkCase(number, M, modal_damping(M, K, [zeta] * 3), K, source="embedded (published parameters)")
+
+
+def chirp_record(f1: float = 0.1, f2: float = 40.0, T: float = 90.0) -> Record:
+    """The benchmark's chirp (E_sw = 4; BENCHMARK.md 6): unit amplitude (scaled by eq_intensity
+    like the records), sin(2 pi (f1 t + (f2 - f1) t^2 / (2 T))), t = 0 .. T, no zero padding.
+    Sampled every h/2 = 2^-13 s, so that the loop's linear interpolation at the RK4 stage times
+    t_k, t_k + h/2, t_k + h returns the exact sine.  The paper publishes no chirp results."""
+    for name, v in (("f1", f1), ("f2", f2), ("T", T)):
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+            raise ValueError(f"invalid {name} = {v!r}: finite and >= 0")
+    if not T > 0:
+        raise ValueError(f"invalid T = {T!r}: > 0 [s]")
+    t = np.arange(int(math.floor(T * 2 * FS)) + 1) * (DT / 2)
+    a = np.sin(2 * np.pi * (f1 * t + (f2 - f1) * t * t / (2 * T)))
+    return Record("chirp", t, a, source=f"generated: linear chirp {f1:g}-{f2:g} Hz over {T:g} s (BENCHMARK.md 6)",
+                  notes=["the benchmark's verification chirp: no published results"])
 
 
 def shear_building(storey_stiffness=(6e6, 5e6, 4e6), floor_mass: float = 1000.0,
