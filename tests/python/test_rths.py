@@ -169,3 +169,18 @@ def test_chirp_is_the_specified_sweep_and_runs(tmp_path):
     res = json.loads((tmp_path / "results.json").read_text())
     assert res["meta"]["record"] == "chirp" and all(math.isfinite(j) for j in res["cases"]["1"]["nominal"]["J"])
     assert "chirp" in (tmp_path / "report.md").read_text()
+
+
+def test_cli_csi_derivative_block_option(data, tmp_path):
+    """--csi derivative-block: the official code's Derivative block on the CSI (BENCHMARK.md 2.1);
+    it moves the noise-insensitive J4 of case 1 by +0.05 pp (docs, "The J5 gap")."""
+    outs = {}
+    for csi in ("exact", "derivative-block"):
+        out = tmp_path / csi
+        assert main(["rths-benchmark", "--data", str(data), "--cases", "1", "--csi", csi, "--perturbed", "1",
+                     "--workers", "1", "--quiet", "--out", str(out)]) == 0
+        outs[csi] = json.loads((out / "results.json").read_text())
+        assert outs[csi]["meta"]["csi"] == csi
+    J0, J1 = outs["exact"]["cases"]["1"]["nominal"]["J"], outs["derivative-block"]["cases"]["1"]["nominal"]["J"]
+    assert J1[3] - J0[3] == pytest.approx(0.05, abs=0.02)
+    assert outs["exact"]["cases"]["1"]["perturbed"]["J_mean"] != outs["derivative-block"]["cases"]["1"]["perturbed"]["J_mean"]

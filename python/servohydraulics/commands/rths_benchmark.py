@@ -14,7 +14,7 @@ def _run(args) -> int:
     if args.record not in RECORDS and args.record != "chirp":
         raise ValueError(f"invalid --record = {args.record!r}: expected one of {sorted(RECORDS) + ['chirp']}")
     run = run_benchmark(args.data, args.record, args.cases, args.controller, args.perturbed, args.seed,
-                        workers=args.workers, progress=not args.quiet)
+                        workers=args.workers, progress=not args.quiet, csi=args.csi)
     out = write_outputs(run, args.out)
     from ..rths.report import j_table
     print(j_table(run["results"]))
@@ -35,6 +35,9 @@ def register(sub) -> None:
     p.add_argument("--perturbed", type=int, default=0, help="perturbed plants per case (default: 0)")
     p.add_argument("--seed", type=int, default=0, help="seed of the noise and of the perturbations (default: 0)")
     p.add_argument("--workers", type=int, default=None, help="processes for the perturbed runs (default: all cores)")
+    p.add_argument("--csi", default="exact", choices=["exact", "derivative-block"],
+                   help="control-structure interaction: exact a2 dx/dt (default, the spec's) or the official code's "
+                        "Simulink Derivative block")
     p.add_argument("--out", required=True, help="output folder (results.json, report.md, plots)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_run)

@@ -25,9 +25,13 @@ STROKE_LIMIT = 7e-3   #: paper limit (not checked by the code) [m]
 VELOCITY_LIMIT = 0.3  #: paper limit (not checked by the code) [m/s]
 
 
-def nominal_plant() -> "R.BenchmarkPlantParameters":
-    """The code values of F1_input_file.m (the C++ defaults)."""
-    return R.BenchmarkPlantParameters()
+def nominal_plant(csi_derivative_block: bool = False) -> "R.BenchmarkPlantParameters":
+    """The code values of F1_input_file.m (the C++ defaults).  ``csi_derivative_block``: the CSI
+    term as the code's Simulink Derivative block instead of the exact a2 x' (BENCHMARK.md 2.1:
+    optional; docs/rths-benchmark.md, "The J5 gap")."""
+    p = R.BenchmarkPlantParameters()
+    p.csi_derivative_block = bool(csi_derivative_block)
+    return p
 
 
 def trial_seed(seed: int, *parts: Any) -> int:
@@ -36,10 +40,10 @@ def trial_seed(seed: int, *parts: Any) -> int:
     return int.from_bytes(h[:8], "little")
 
 
-def perturbed_plant(seed: int, case: int, trial: int) -> "R.BenchmarkPlantParameters":
+def perturbed_plant(seed: int, case: int, trial: int, csi_derivative_block: bool = False) -> "R.BenchmarkPlantParameters":
     """Trial ``trial`` >= 1 of the perturbed plants of one case: ke, beta1, beta2,
     a3 drawn from the official distributions (F1 L67, L119-121), untruncated."""
-    return R.BenchmarkPlantUncertainty().draw(nominal_plant(), trial_seed(seed, "plant", case, trial))
+    return R.BenchmarkPlantUncertainty().draw(nominal_plant(csi_derivative_block), trial_seed(seed, "plant", case, trial))
 
 
 def partition(case: BenchmarkCase, specimen) -> "R.LinearSubstructureModel":
@@ -204,9 +208,9 @@ def case_psi(case: BenchmarkCase) -> float:
 
 
 def _perturbed_job(rig, trial: int, case: BenchmarkCase, record: Record, controller: str, seed: int,
-                   scale: float) -> dict[str, Any]:
+                   scale: float, csi_derivative_block: bool = False) -> dict[str, Any]:
     """One perturbed trial in a sweep worker (the rig argument of sh.sweep is unused)."""
-    plant = perturbed_plant(seed, case.number, trial)
+    plant = perturbed_plant(seed, case.number, trial, csi_derivative_block)
     t = run_trial(case, record, controller, plant=plant, seed=seed, scale=scale,
                   reference=case_reference(case, record, scale))
     out = {f"J{i + 1}": t.J[i] for i in range(9)}
@@ -218,13 +222,15 @@ def _perturbed_job(rig, trial: int, case: BenchmarkCase, record: Record, control
 
 def run_case(case: BenchmarkCase, record: Record, controller: str = "sample", perturbed: int = 0, seed: int = 0,
              scale: float = EQ_INTENSITY, executor=None, max_workers: int | None = None,
-             progress: bool = True, keep_signals: bool = False) -> dict[str, Any]:
+             progress: bool = True, keep_signals: bool = False,
+             csi_derivative_block: bool = False) -> dict[str, Any]:
     """The nominal trial and ``perturbed`` perturbed trials (through ``sh.sweep``) of one case.
 
     Returns ``{"nominal": {...}, "perturbed": {...} (if any), "trial": Trial, "table": DataFrame | None}``.
     """
     ref = case_reference(case, record, scale)
-    nom = run_trial(case, record, controller, seed=seed, scale=scale, reference=ref, keep_signals=keep_signals)
+    nom = run_trial(case, record, controller, plant=nominal_plant(csi_derivative_block), seed=seed, scale=scale,
+                    reference=ref, keep_signals=keep_signals)
     res: dict[str, Any] = {"nominal": {"J": nom.J, "max_force_N": nom.max_force_N,
                                        "max_displacement_m": nom.max_displacement_m,
                                        "max_velocity_m_per_s": nom.max_velocity_m_per_s,
@@ -234,9 +240,10 @@ def run_case(case: BenchmarkCase, record: Record, controller: str = "sample", pe
     if perturbed > 0:
         from ..sweep import sweep
         df = sweep(grid={"trial": list(range(1, perturbed + 1))}, run=_perturbed_job,
-                   fixed={"case": case, "record": record, "controller": controller, "seed": seed, "scale": scale},
+                   fixed={"case": case, "record": record, "controller": controller, "seed": seed, "scale": scale,
+                          "csi_derivative_block": bool(csi_derivative_block)},
                    executor=executor, max_workers=max_workers, progress=progress)
-        df = df.drop(columns=["case", "record"])
+        df = df.drop(columns=["case", "record", "csi_derivative_block"])
         if "error" in df.columns and df["error"].notna().any():
             raise RuntimeError(f"perturbed trial failed: {df['error'].dropna().iloc[0]}")
         Js = df[[f"J{i + 1}" for i in range(9)]].to_numpy(dtype=float)

@@ -38,15 +38,19 @@ def parse_cases(text: str | Sequence[int]) -> list[int]:
 
 def run_benchmark(data: str | Path | None = None, record: str = "elcentro", cases: str | Sequence[int] = "1,2,3,4",
                   controller: str = "sample", perturbed: int = 0, seed: int = 0, scale: float = EQ_INTENSITY,
-                  workers: int | None = None, progress: bool = True) -> dict[str, Any]:
+                  workers: int | None = None, progress: bool = True, csi: str = "exact") -> dict[str, Any]:
     """Runs the benchmark: per case the nominal trial (signals kept) and
     ``perturbed`` perturbed trials (through ``sh.sweep`` on one process pool).
 
+    ``csi``: ``"exact"`` (a2 x', the spec's default) or ``"derivative-block"`` (the code's
+    Simulink Derivative block, BENCHMARK.md 2.1).
     Without ``data``: the embedded default (published parameters, synthetic
     ground motion), labelled as not the benchmark's.
     Returns ``{"results": <results.json content>, "trials": {case: Trial}, "tables": {case: DataFrame}}``.
     """
     case_list = parse_cases(cases)
+    if csi not in ("exact", "derivative-block"):
+        raise ValueError(f"invalid csi = {csi!r}: expected 'exact' or 'derivative-block'")
     if controller not in CONTROLLERS:
         raise ValueError(f"invalid controller = {controller!r}: expected one of {sorted(CONTROLLERS)}")
     if isinstance(perturbed, bool) or int(perturbed) != perturbed or perturbed < 0:
@@ -61,7 +65,7 @@ def run_benchmark(data: str | Path | None = None, record: str = "elcentro", case
     meta = {"record": rec.name, "record_source": rec.source, "synthetic": rec.synthetic,
             "controller": controller, "controller_description": CONTROLLERS[controller][1],
             "eq_intensity": scale, "seed": seed, "perturbed_runs": int(perturbed), "fs_Hz": 4096,
-            "J_names": list(J_NAMES), "force_limit_N": FORCE_LIMIT}
+            "J_names": list(J_NAMES), "force_limit_N": FORCE_LIMIT, "csi": csi}
     if rec.synthetic:
         meta["label"] = SYNTHETIC_LABEL
     elif data is None:
@@ -77,7 +81,8 @@ def run_benchmark(data: str | Path | None = None, record: str = "elcentro", case
         for n in case_list:
             case = load(n)
             out = run_case(case, rec, controller, perturbed=int(perturbed), seed=seed, scale=scale,
-                           executor=executor, progress=False, keep_signals=True)
+                           executor=executor, progress=False, keep_signals=True,
+                           csi_derivative_block=csi == "derivative-block")
             nom = out["nominal"]
             entry: dict[str, Any] = {"nominal": {"J": nom["J"], "max_force_N": nom["max_force_N"],
                                                  "max_displacement_m": nom["max_displacement_m"],
@@ -184,6 +189,7 @@ def _write_all(run: dict[str, Any], out: Path, files: FileSet) -> None:
     lines += [f"- record: {meta['record']} × {meta['eq_intensity']} ({meta['record_source']})",
               f"- controller: {meta['controller']}: {meta['controller_description']}",
               f"- noise seed / perturbation seed: {meta['seed']}; perturbed runs per case: {meta['perturbed_runs']}",
+              f"- CSI: {meta['csi']} ({'a2 dx/dt' if meta['csi'] == 'exact' else 'the code Derivative block'})",
               "- J in the official code's order (F4_evaluation.m): J1 [ms], J2-J9 [%]; PSI = log10(tau_cr / ms)", ""]
     lines += [j_table(res), ""]
     flagged = [n for n, e in res["cases"].items() if e["nominal"]["max_force_N"] >= FORCE_LIMIT]
