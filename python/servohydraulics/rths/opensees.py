@@ -41,7 +41,7 @@ def _opensees():
     try:
         import openseespy.opensees as ops
     except ImportError as e:  # pragma: no cover - openseespy is a dependency of the venv
-        raise ImportError("OpenSeesSubstructure needs the PyPI package openseespy") from e
+        raise ImportError("OpenSeesSubstructure needs the PyPI package openseespy (pip install servohydraulics[opensees])") from e
     return ops
 
 
