@@ -165,6 +165,16 @@ void substructure_step() {
                 static_cast<int>(cs.scheme), worst / xs);
     CHECK(worst <= cs.tol * xs);
   }
+  // No interface DOF: a setup error naming the field.
+  LinearSubstructureModel none = model;
+  none.interface.setZero();
+  bool named = false;
+  try {
+    LinearSubstructure bad(none, kH);
+  } catch (const Error& e) {
+    named = std::string(e.what()).find("interface") != std::string::npos;
+  }
+  CHECK(named);
   // One RK4 step against its own closed form: x1 = h^2/2 a0 (1 - h^2 wn^2/12) ... checked via the Taylor series.
   LinearSubstructure s(model, kH);
   s.step(ag, ag, ag, f);
