@@ -41,6 +41,8 @@ LinearSubstructure::LinearSubstructure(const LinearSubstructureModel& model, dou
     P2_ = model_.M / (h * h) - model_.C / (2.0 * h);
   } else if (scheme_ == SubstructureScheme::ExplicitNewmark) {
     S_inv_ = (model_.M + 0.5 * h * model_.C).inverse();
+  } else if (scheme_ == SubstructureScheme::AverageAcceleration) {
+    S_inv_ = (model_.M + 0.5 * h * model_.C + 0.25 * h * h * model_.K).inverse();
   }
   for (Eigen::VectorXd* v : {&x_, &v_, &a_, &x_prev_, &t1_, &t2_, &t3_, &k1x_, &k1v_, &k2x_, &k2v_, &k3x_, &k3v_,
                              &k4x_, &k4v_})
@@ -109,6 +111,19 @@ void LinearSubstructure::step(double ag0, double ag_mid, double ag1, double f_in
       t1_.noalias() -= model_.C * t3_;
       t2_.noalias() = S_inv_ * t1_;
       v_ = t3_ + 0.5 * h * t2_;
+      break;
+    }
+    case SubstructureScheme::AverageAcceleration: {
+      // (M + h/2 C + h^2/4 K) a_{k+1} = p_{k+1} - C (v_k + h/2 a_k) - K (x_k + h v_k + h^2/4 a_k)
+      t3_ = v_ + 0.5 * h * a_;             // velocity predictor
+      x_ += h * v_ + 0.25 * h * h * a_;  // displacement predictor
+      t1_ = -ag1 * model_.ground - f_in * model_.interface;
+      t1_.noalias() -= model_.C * t3_;
+      t1_.noalias() -= model_.K * x_;
+      t2_.noalias() = S_inv_ * t1_;  // a_{k+1}
+      x_ += 0.25 * h * h * t2_;
+      v_ = t3_ + 0.5 * h * t2_;
+      a_ = t2_;
       break;
     }
   }

@@ -20,7 +20,9 @@
 
 namespace servohydraulics::rths {
 
-enum class SubstructureScheme { RungeKutta4, CentralDifference, ExplicitNewmark };
+//! AverageAcceleration: implicit Newmark (gamma = 1/2, beta = 1/4), unconditionally stable,
+//! the acceleration carried from step to step (0 at rest), loads at t_k + h.
+enum class SubstructureScheme { RungeKutta4, CentralDifference, ExplicitNewmark, AverageAcceleration };
 
 //! A numerical substructure as the RTHS loop sees it (loop.hpp): stepped once
 //! per controller sample, its DOF displacements read back, one interface DOF.
@@ -92,7 +94,7 @@ class LinearSubstructure final : public NumericalSubstructure {
   Eigen::Index dof_ = 0;
   Eigen::MatrixXd MiK_, MiC_;       // M^-1 K, M^-1 C
   Eigen::VectorXd Mig_, Migam_;     // M^-1 g, M^-1 gamma
-  Eigen::MatrixXd S_inv_;           // central difference: (M/h^2 + C/2h)^-1 ; Newmark: (M + h/2 C)^-1
+  Eigen::MatrixXd S_inv_;  // central difference: (M/h^2 + C/2h)^-1; Newmark: (M + h/2 C)^-1; average: (M + h/2 C + h^2/4 K)^-1
   Eigen::MatrixXd P1_, P2_;         // central difference: K - 2M/h^2, M/h^2 - C/2h
   Eigen::VectorXd x_, v_, a_, x_prev_;
   mutable Eigen::VectorXd t1_, t2_, t3_;
