@@ -138,7 +138,7 @@ def run_trial(case: BenchmarkCase, record: Record, controller: str = "sample", p
         plant: BenchmarkPlantParameters of the control plant (None: nominal).
         seed: of the sensor noise (one sequence shared by both channels).
         scheme: the numerical substructure's integrator (``RungeKutta4`` as the
-            benchmark, ``CentralDifference``, ``ExplicitNewmark``).
+            benchmark, ``CentralDifference``, ``ExplicitNewmark``, ``AverageAcceleration``).
         reference: the reference displacements (N x 3), if already computed.
         experimental: another ExperimentalSubstructure (e.g. ServoHydraulicSubstructure);
             None: the benchmark plant.
