@@ -46,6 +46,45 @@ const double* optional_input(const std::optional<Arr>& a, std::size_t n, const c
 }
 }  // namespace
 
+// The optional sensor and converter blocks of the loops (loop_converters.hpp).
+void expose_loop_converters(py::module_& m) {
+  py::class_<SensorChannel>(m, "SensorChannel", "noise, A/D converter and unit delay of one measured channel")
+      .def(py::init<>())
+      .def_readwrite("noise", &SensorChannel::noise)
+      .def_readwrite("converter", &SensorChannel::converter)
+      .def_readwrite("unit_delay", &SensorChannel::unit_delay)
+      .def_property_readonly("active", &SensorChannel::active);
+  py::class_<LoopConverters>(m, "LoopConverters", "the optional sensor and converter blocks of a loop (off by default)")
+      .def(py::init<>())
+      .def_readwrite("displacement", &LoopConverters::displacement)
+      .def_readwrite("velocity", &LoopConverters::velocity)
+      .def_readwrite("force", &LoopConverters::force)
+      .def_readwrite("command", &LoopConverters::command)
+      .def_readwrite("command_unit_delay", &LoopConverters::command_unit_delay)
+      .def_readwrite("seed", &LoopConverters::seed)
+      .def_property_readonly("active", &LoopConverters::active)
+      .def("validate", &LoopConverters::validate);
+  py::class_<LoopIo>(m, "LoopIo", "the blocks' state: measure(truth) -> measured Output, actuate(command)")
+      .def(py::init<const LoopConverters&>(), py::arg("config") = LoopConverters{})
+      .def("reset", [](LoopIo& io) { bindings::require_idle(&io, "LoopIo.reset"); io.reset(); })
+      .def("measure", [](LoopIo& io, double x, double v, double f) {
+        bindings::require_idle(&io, "LoopIo.measure");
+        Output truth, y;
+        truth.displacement = x;
+        truth.velocity = v;
+        truth.force = f;
+        io.measure(truth, y);
+        return py::make_tuple(y.displacement, y.velocity, y.force);
+      }, py::arg("displacement"), py::arg("velocity"), py::arg("force"),
+      "One sample: the true (displacement, velocity, force) -> the measured ones")
+      .def("actuate", [](LoopIo& io, double u) {
+        bindings::require_idle(&io, "LoopIo.actuate");
+        return io.actuate(u);
+      }, py::arg("command"))
+      .def_property_readonly("active", &LoopIo::active)
+      .def_property_readonly("config", &LoopIo::config);
+}
+
 void expose_loops(py::module_& m) {
   // --- integration schemes of Eq (15) ---------------------------------------------------------------
   py::class_<ModelSDOF> model(m, "ModelSDOF", "Modelled SDOF system of Eq (15): m_m [kg], c_m [N s/m]");
@@ -112,9 +151,11 @@ void expose_loops(py::module_& m) {
       .def_property_readonly("config", &EftController::config)
       .def_property_readonly("mass", &EftController::mass)
       .def_property_readonly("compensator", &EftController::compensator, py::return_value_policy::reference_internal);
+  expose_loop_converters(m);
   py::class_<EffectiveForceTest>(m, "EffectiveForceTest", "Effective force testing loop (force control, Fig 1a)")
-      .def(py::init<const Rig&, const EftConfig&, const std::optional<Rig>&>(), py::arg("rig"), py::arg("config"),
-           py::arg("model") = py::none())
+      .def(py::init<const Rig&, const EftConfig&, const std::optional<Rig>&, const LoopConverters&>(),
+           py::arg("rig"), py::arg("config"), py::arg("model") = py::none(), py::arg("converters") = LoopConverters{})
+      .def_property_readonly("converters", [](const EffectiveForceTest& t) { return t.converters().config(); })
       .def("reset",
            [](EffectiveForceTest& t) {
              bindings::require_idle(&t, "EffectiveForceTest.reset");
@@ -212,7 +253,9 @@ void expose_loops(py::module_& m) {
       .def_property_readonly("subtract_damping", &RpsdController::subtract_damping);
   py::class_<RealTimePseudoDynamicTest>(m, "RealTimePseudoDynamicTest",
                                         "Real-time pseudodynamic testing loop (displacement control, Figs 1b, 7)")
-      .def(py::init<const Rig&, const RpsdConfig&>(), py::arg("rig"), py::arg("config"))
+      .def(py::init<const Rig&, const RpsdConfig&, const LoopConverters&>(), py::arg("rig"), py::arg("config"),
+           py::arg("converters") = LoopConverters{})
+      .def_property_readonly("converters", [](const RealTimePseudoDynamicTest& t) { return t.converters().config(); })
       .def("reset",
            [](RealTimePseudoDynamicTest& t) {
              bindings::require_idle(&t, "RealTimePseudoDynamicTest.reset");

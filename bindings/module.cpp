@@ -12,6 +12,7 @@ void expose_record(py::module_& m);
 void expose_linearize(py::module_& m);
 void expose_compensators(py::module_& m);
 void expose_loops(py::module_& m);
+void expose_rths(py::module_& m);
 void expose_fmu(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
@@ -26,5 +27,6 @@ PYBIND11_MODULE(_core, m) {
   expose_linearize(m);
   expose_compensators(m);
   expose_loops(m);
+  expose_rths(m);
   expose_fmu(m);
 }

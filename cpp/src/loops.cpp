@@ -20,9 +20,10 @@ EftConfig with_mass(const EftConfig& config, const Rig& rig) {
 }
 }  // namespace
 
-EffectiveForceTest::EffectiveForceTest(const Rig& rig, const EftConfig& config, const std::optional<Rig>& model)
+EffectiveForceTest::EffectiveForceTest(const Rig& rig, const EftConfig& config, const std::optional<Rig>& model,
+                                       const LoopConverters& converters)
     : ClosedLoop(Plant(rig, ControlMode::Force, config.dt, config.plant_options),
-                 EftController(with_mass(config, rig), model.value_or(rig))) {}
+                 EftController(with_mass(config, rig), model.value_or(rig)), converters) {}
 
 Rig RealTimePseudoDynamicTest::physical_rig(const Rig& rig, const RpsdConfig& cfg) {
   cfg.validate();
@@ -32,9 +33,10 @@ Rig RealTimePseudoDynamicTest::physical_rig(const Rig& rig, const RpsdConfig& cf
   return r;
 }
 
-RealTimePseudoDynamicTest::RealTimePseudoDynamicTest(const Rig& rig, const RpsdConfig& config)
+RealTimePseudoDynamicTest::RealTimePseudoDynamicTest(const Rig& rig, const RpsdConfig& config,
+                                                     const LoopConverters& converters)
     : ClosedLoop(Plant(physical_rig(rig, config), ControlMode::Displacement, config.dt, config.plant_options),
-                 RpsdController(config, physical_rig(rig, config))) {}
+                 RpsdController(config, physical_rig(rig, config)), converters) {}
 
 // -------------------------------------------------------------------- runners
 

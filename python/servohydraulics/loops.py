@@ -99,6 +99,63 @@ def _choice(name: str, v: str, table: dict):
     return table[v]
 
 
+def sensor_channel(sigma: float = 0.0, quantum: float = 0.0, range: tuple[float, float] | None = None,
+                   unit_delay: bool = False, gain: float = 1.0) -> _core.SensorChannel:
+    """One measured channel of ``loop_converters``: y_k = AD(gain x_k + sigma w_k), w_k ~ N(0, 1)
+    drawn once per sample, AD = saturation to ``range`` then quantizer of step ``quantum``
+    (round half away from zero); ``unit_delay``: the controller sees y_{k-1}."""
+    ch = _core.SensorChannel()
+    ch.noise = _core.rths.SensorNoise(_nonneg("sigma", sigma), gain)
+    ch.converter = _converter("AnalogToDigital", quantum, range)
+    ch.unit_delay = bool(unit_delay)
+    return ch
+
+
+def _converter(kind: str, quantum: float, range: tuple[float, float] | None) -> "_core.rths.Converter":
+    c = _core.rths.Converter()
+    c.kind = getattr(_core.rths.Converter.Kind, kind)
+    c.enabled = quantum != 0.0 or range is not None
+    c.quantizer = _core.rths.Quantizer(_nonneg("quantum", quantum))
+    big = np.finfo(float).max  # no range: a saturation that never acts
+    lo, hi = (-big, big) if range is None else (float(range[0]), float(range[1]))
+    if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo):
+        raise ValueError(f"invalid range = {range!r}: expected (lower, upper), finite, upper > lower")
+    c.saturation = _core.rths.Saturation(lo, hi)
+    return c
+
+
+def loop_converters(displacement: _core.SensorChannel | None = None, velocity: _core.SensorChannel | None = None,
+                    force: _core.SensorChannel | None = None, command_quantum: float = 0.0,
+                    command_range: tuple[float, float] | None = None, command_unit_delay: bool = False,
+                    seed: int = 0) -> _core.LoopConverters:
+    """The sensor and converter blocks of an EFT or RPsD loop (all off by default).
+
+    Args:
+        displacement, velocity, force: ``sensor_channel(...)`` of the measured channels
+            the controller reads (None: ideal).
+        command_quantum, command_range: the D/A on the command (quantizer then saturation).
+        command_unit_delay: the plant receives the command of the previous sample.
+        seed: of the noise generators (one per channel).
+    """
+    c = _core.LoopConverters()
+    for name, ch in (("displacement", displacement), ("velocity", velocity), ("force", force)):
+        if ch is not None:
+            setattr(c, name, ch)
+    c.command = _converter("DigitalToAnalog", command_quantum, command_range)
+    c.command_unit_delay = bool(command_unit_delay)
+    c.seed = _integer("seed", seed) & (2**64 - 1)
+    c.validate()
+    return c
+
+
+def _converters(c: _core.LoopConverters | None) -> _core.LoopConverters:
+    if c is None:
+        return _core.LoopConverters()
+    if not isinstance(c, _core.LoopConverters):
+        raise ValueError(f"invalid converters = {c!r}: expected loop_converters(...) or None")
+    return c
+
+
 def eft_config(dt: float | None = None, compensation: str = "linear", lead_T: float | None = None,
                alpha: float | None = None, mass: float | None = None, compute_delay: int = 0,
                solver_options: _core.SolverOptions | None = None) -> _core.EftConfig:
@@ -117,7 +174,8 @@ def run_eft(rig: Rig, ground_acceleration: ArrayLike | None = None, effective_fo
             dt: float | None = None, compensation: str = "linear", lead_T: float | None = None,
             alpha: float | None = None, mass: float | None = None, compute_delay: int = 0,
             model: Rig | None = None, solver_options: _core.SolverOptions | None = None,
-            raise_on_failure: bool = True, options: _core.SolverOptions | None = None) -> Response:
+            raise_on_failure: bool = True, options: _core.SolverOptions | None = None,
+            converters: _core.LoopConverters | None = None) -> Response:
     """Effective force testing (force control) of ``rig``.
 
     Args:
@@ -134,6 +192,8 @@ def run_eft(rig: Rig, ground_acceleration: ArrayLike | None = None, effective_fo
         solver_options: the plant's ODE integrator (``solver_options(...)``); ``options=`` is
             its deprecated alias.
         raise_on_failure: raise SimulationError (with the partial Response) if the loop fails.
+        converters: sensor noise, A/D and D/A converters and unit delays between the plant
+            and the controller (``loop_converters(...)``); None: ideal (all off).
 
     Returns:
         A Response of kind ``"eft"``: the plant's channels, ``flags`` and the
@@ -147,7 +207,7 @@ def run_eft(rig: Rig, ground_acceleration: ArrayLike | None = None, effective_fo
     m = rig.m if cfg.mass is None else cfg.mass
     ag = (_array("ground_acceleration", ground_acceleration) if effective_force is None
           else -_array("effective_force", effective_force) / m)
-    test = _core.EffectiveForceTest(rig, cfg, model)
+    test = _core.EffectiveForceTest(rig, cfg, model, _converters(converters))
     d, s = test.run(ag)
     return finish(Response(d, kind="eft", mode="force", dt=cfg.dt, rig=rig, work=s), raise_on_failure)
 
@@ -189,8 +249,12 @@ def run_rpsd(rig: Rig, ground_acceleration: ArrayLike | None = None, external_fo
              force_measurement: str = "load_cell", subtract_mass: float | None = None,
              subtract_damping: float | None = None, compute_delay: int = 0,
              solver_options: _core.SolverOptions | None = None, raise_on_failure: bool = True,
-             solver: str | None = None, options: _core.SolverOptions | None = None) -> Response:
+             solver: str | None = None, options: _core.SolverOptions | None = None,
+             converters: _core.LoopConverters | None = None) -> Response:
     """Real-time pseudodynamic testing (displacement control) of ``rig``.
+
+    ``converters`` (``loop_converters(...)``; None: ideal) puts sensor noise, A/D and D/A
+    converters and unit delays between the plant and the controller.
 
     The solver integrates m_m a + c_m v + f = -m_m a_g + P_ext (Eq 15) online.
     Keywords left at None take the core's ``RpsdConfig`` defaults (the paper's values).
@@ -237,7 +301,7 @@ def run_rpsd(rig: Rig, ground_acceleration: ArrayLike | None = None, external_fo
     cfg = rpsd_config(dt, m_m, c_m, k_m, scheme, restoring_force, amplitude_T, delay_T, alpha,
                       physical_mass_fraction, force_measurement, subtract_mass, subtract_damping, compute_delay,
                       opts or _solver_options())
-    test = _core.RealTimePseudoDynamicTest(rig, cfg)
+    test = _core.RealTimePseudoDynamicTest(rig, cfg, _converters(converters))
     d, s = test.run(ag, pe, fe)
     phys = _core.RealTimePseudoDynamicTest.physical_rig(rig, cfg)
     return finish(Response(d, kind="rpsd", mode="displacement", dt=cfg.dt, rig=phys, work=s), raise_on_failure)

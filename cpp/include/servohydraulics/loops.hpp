@@ -6,7 +6,11 @@
 //
 // Row convention (as record.hpp): step() fills row k with the sensors at t_k,
 // then the controller computes from them the command it holds over
-// [t_k, t_k + dt], then the plant advances to t_{k+1}.  A laboratory runs the
+// [t_k, t_k + dt], then the plant advances to t_{k+1}.  Optional sensor and
+// converter blocks (loop_converters.hpp; all off by default) sit between the
+// plant and the controller: the controller then sees the measured channels and
+// the plant receives the converted command; the row keeps the plant's true
+// sensors and the controller's own channels (its command before the D/A).  A laboratory runs the
 // same controller on its own rig, with its I/O in place of the Plant
 // (examples/02_rpsd_controller.cpp).
 #pragma once
@@ -16,6 +20,7 @@
 #include <utility>
 
 #include "servohydraulics/controllers.hpp"
+#include "servohydraulics/loop_converters.hpp"
 #include "servohydraulics/plant.hpp"
 #include "servohydraulics/record.hpp"
 
@@ -26,31 +31,41 @@ namespace servohydraulics {
 template <class Controller>
 class ClosedLoop {
  public:
-  ClosedLoop(Plant plant, Controller controller) : plant_(std::move(plant)), controller_(std::move(controller)) {
+  ClosedLoop(Plant plant, Controller controller, const LoopConverters& converters = {})
+      : plant_(std::move(plant)), controller_(std::move(controller)), io_(converters) {
     reset();
   }
 
-  void reset() noexcept {  //!< plant and controller at rest at t = 0
+  void reset() noexcept {  //!< plant, controller and converter blocks at rest at t = 0
     plant_.reset(0.0, 0.0);
     plant_.observe(last_);
     controller_.reset();
+    io_.reset();
   }
   //! Row k: the sensors at t_k and what the controller computed from them (Row
   //! is EftOutput or RpsdOutput); inputs are the controller's exogenous inputs.
   template <class Row, class... Inputs>
   Status step(Row& row, Inputs... inputs) noexcept {
-    const double u = controller_.command(last_, inputs..., &row);
+    if (!io_.active()) {
+      const double u = controller_.command(last_, inputs..., &row);
+      return plant_.step(u, last_);
+    }
+    io_.measure(last_, measured_);
+    const double u = io_.actuate(controller_.command(measured_, inputs..., &row));
+    row.plant = last_;
     return plant_.step(u, last_);
   }
 
   const Plant& plant() const noexcept { return plant_; }
   const Controller& controller() const noexcept { return controller_; }
   const Output& sensors() const noexcept { return last_; }  //!< the plant's output at the current time
+  const LoopIo& converters() const noexcept { return io_; }
 
  protected:
   Plant plant_;
   Controller controller_;
-  Output last_;
+  LoopIo io_;
+  Output last_, measured_;
 };
 
 // ---------------------------------------------------------------------------
@@ -62,7 +77,9 @@ class EffectiveForceTest : public ClosedLoop<EftController> {
   //! rig: the plant; model: the controller's model of the rig for the compensator
   //! (none = the same rig, i.e. perfect knowledge).  config.mass none = rig.m
   //! (the plant's, whatever the model).
-  EffectiveForceTest(const Rig& rig, const EftConfig& config, const std::optional<Rig>& model = std::nullopt);
+  //! converters: the optional sensor and converter blocks (loop_converters.hpp; off by default).
+  EffectiveForceTest(const Rig& rig, const EftConfig& config, const std::optional<Rig>& model = std::nullopt,
+                     const LoopConverters& converters = {});
 
   Status step(double ground_acceleration, EftOutput& out) noexcept {
     return ClosedLoop::step(out, ground_acceleration);
@@ -79,7 +96,8 @@ class EffectiveForceTest : public ClosedLoop<EftController> {
 class RealTimePseudoDynamicTest : public ClosedLoop<RpsdController> {
  public:
   //! rig: the physical test (its m is replaced by physical_mass_fraction * m_m).
-  RealTimePseudoDynamicTest(const Rig& rig, const RpsdConfig& config);
+  //! converters: the optional sensor and converter blocks (loop_converters.hpp; off by default).
+  RealTimePseudoDynamicTest(const Rig& rig, const RpsdConfig& config, const LoopConverters& converters = {});
 
   //! ground_acceleration [m/s^2], external_force into the solver [N], restoring_force_error added to f [N].
   Status step(double ground_acceleration, double external_force, double restoring_force_error,

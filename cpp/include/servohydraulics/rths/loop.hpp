@@ -1,0 +1,81 @@
+// The virtual real-time hybrid simulation loop of the RTHS benchmark (Silva et
+// al. 2020, Fig 7; BENCHMARK.md Sec 5.4), with any experimental substructure,
+// numerical substructure scheme and tracking controller.  Per sample k:
+//   1. x_k = true specimen displacement; y1_k = numerical x_1(t_k)
+//   2. w_k ~ N(0,1) (one draw, shared by both channels unless independent_noise)
+//      x_m = x_k + sigma_x w_k
+//   3. f_e = k_e x_k + c_e D(x)_k + m_e D(D(x))_k (backward differences, 0 at k = 0),
+//      f_m = f_e + sigma_f w_k
+//   4. f_in = f_m delayed one sample (0 at k = 0)
+//   5. u_k = controller.command({y1, y1', y1'', x_m, f_m})
+//   6. log row k
+//   7. experimental substructure: one sample with u_k held; numerical substructure:
+//      one sample with a_g at t_k, t_k + h/2, t_k + h and f_in held.
+// Construction validates (throws Error); run() is noexcept and allocation-free
+// (the caller provides the row buffers).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "servohydraulics/rths/benchmark_plant.hpp"
+#include "servohydraulics/rths/converters.hpp"
+#include "servohydraulics/rths/substructure.hpp"
+#include "servohydraulics/rths/tracking.hpp"
+
+namespace servohydraulics::rths {
+
+struct RthsLoopConfig {
+  double dt = 1.0 / 4096.0;               //!< [s]; must equal the substructures' sample times
+  SensorNoise displacement_noise{1.6e-5};  //!< sigma = sqrt(6.25e-14 * 4096) m (F1 L169)
+  SensorNoise force_noise{2.1797614548385793};  //!< sigma = sqrt(1.16e-3 * 4096) N (F1 L177)
+  bool independent_noise = false;         //!< false: one w_k for both channels, as the official code
+  std::uint64_t seed = 0;                 //!< of the noise generator(s)
+  void validate() const;
+};
+
+//! Row buffers of a run (each n long; numerical is n x dofs, row-major).  Any may be nullptr.
+struct RthsRecord {
+  double* measured = nullptr;        //!< X_m [m]
+  double* displacement = nullptr;    //!< true specimen displacement X_int [m]
+  double* actuator_force = nullptr;  //!< Force_act [N]
+  double* command = nullptr;         //!< y_gc [m]
+  double* feedback_force = nullptr;  //!< f_in into the numerical substructure [N]
+  double* numerical = nullptr;       //!< numerical substructure displacements [m]
+  double* step_seconds = nullptr;    //!< wall time of each sample's computation [s]
+};
+
+struct RthsSummary {
+  std::size_t rows = 0;      //!< rows written
+  bool ok = true;            //!< false: the experimental substructure failed or the state is not finite
+  double failure_time = -1.0;
+  double peak_actuator_force = 0.0;  //!< max |f| [N]
+  double peak_displacement = 0.0;    //!< max |X_int| [m]
+  double peak_velocity = 0.0;        //!< max |x'| [m/s]
+};
+
+class RthsLoop {
+ public:
+  //! References are kept: the three parts must outlive the loop.
+  RthsLoop(ExperimentalSubstructure& experimental, NumericalSubstructure& numerical, TrackingController& controller,
+           const RthsLoopConfig& config = {});
+  void reset() noexcept;
+  //! n samples t_k = k dt, k = 0..n-1, ground acceleration from ag (already scaled).
+  RthsSummary run(const GroundMotion& ag, std::size_t n, const RthsRecord& record) noexcept;
+
+  const RthsLoopConfig& config() const noexcept { return cfg_; }
+  const ExperimentalSubstructure& experimental() const noexcept { return exp_; }
+  const NumericalSubstructure& numerical() const noexcept { return num_; }
+  const TrackingController& controller() const noexcept { return ctrl_; }
+
+ private:
+  ExperimentalSubstructure& exp_;
+  NumericalSubstructure& num_;
+  TrackingController& ctrl_;
+  RthsLoopConfig cfg_;
+  GaussianSequence wx_, wf_;
+  BackwardDifference dx_, dv_;
+  UnitDelay delay_;
+};
+
+}  // namespace servohydraulics::rths

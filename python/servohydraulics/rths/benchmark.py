@@ -1,0 +1,255 @@
+"""Running the RTHS benchmark (Silva et al. 2020): partitioning, one trial in
+the C++ loop, J1-J9, and the perturbed trials through ``sh.sweep``."""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from .. import _core
+from .data import DT, EQ_INTENSITY, BenchmarkCase, Record
+from .evaluation import evaluate, psi, reference_response
+
+R = _core.rths
+
+__all__ = ["CONTROLLERS", "make_controller", "nominal_plant", "perturbed_plant", "partition", "Trial",
+           "run_trial", "run_case", "trial_seed", "FORCE_LIMIT"]
+
+FORCE_LIMIT = 8900.0  #: the benchmark's actuator capacity check on max|f| [N] (F4_evaluation.m L60-62)
+STROKE_LIMIT = 7e-3   #: paper limit (not checked by the code) [m]
+VELOCITY_LIMIT = 0.3  #: paper limit (not checked by the code) [m/s]
+
+
+def nominal_plant(csi_derivative_block: bool = False) -> "R.BenchmarkPlantParameters":
+    """The code values of F1_input_file.m (the C++ defaults).  ``csi_derivative_block``: the CSI
+    term as the code's Simulink Derivative block instead of the exact a2 x' (BENCHMARK.md 2.1:
+    optional; docs/rths-benchmark.md, "The J5 gap")."""
+    p = R.BenchmarkPlantParameters()
+    p.csi_derivative_block = bool(csi_derivative_block)
+    return p
+
+
+def trial_seed(seed: int, *parts: Any) -> int:
+    """A 64-bit seed derived from the user's seed and a trial's identity (stable across runs)."""
+    h = hashlib.sha256(repr((int(seed),) + parts).encode()).digest()
+    return int.from_bytes(h[:8], "little")
+
+
+def perturbed_plant(seed: int, case: int, trial: int, csi_derivative_block: bool = False) -> "R.BenchmarkPlantParameters":
+    """Trial ``trial`` >= 1 of the perturbed plants of one case: ke, beta1, beta2,
+    a3 drawn from the official distributions (F1 L67, L119-121), untruncated."""
+    return R.BenchmarkPlantUncertainty().draw(nominal_plant(csi_derivative_block), trial_seed(seed, "plant", case, trial))
+
+
+def partition(case: BenchmarkCase, specimen) -> "R.LinearSubstructureModel":
+    """Mn = Mr - Me, Cn = Cr - Ce, Kn = Kr - Ke at the first floor; the ground load
+    is the whole Mr iota; the interface is the first floor (BENCHMARK.md 5.1)."""
+    n = case.n
+    Mn, Cn, Kn = case.M.copy(), case.C.copy(), case.K.copy()
+    Mn[0, 0] -= specimen.m
+    Cn[0, 0] -= specimen.c
+    Kn[0, 0] -= specimen.k
+    gamma = np.zeros(n)
+    gamma[0] = 1.0
+    return R.LinearSubstructureModel(Mn, Cn, Kn, case.M @ np.ones(n), gamma)
+
+
+# ----------------------------------------------------------------------------- controllers
+
+def _sample(plant, dt):
+    return R.SampleController(R.SampleControllerConfig())
+
+
+def _polynomial(plant, dt):
+    c = R.PolynomialConfig()
+    c.dt = dt
+    c.tau = R.plant_delay(plant)
+    c.order = 2
+    c.stride = 16
+    c.static_gain = plant.numerator() / plant.denominator()[5]
+    return R.PolynomialExtrapolation(c)
+
+
+def _ats(plant, dt):
+    c = R.AtsConfig()
+    c.dt = dt
+    mb = R.ModelBasedConfig.from_plant(plant, 2).coefficients
+    c.initial = [mb[0], mb[1], mb[2]]
+    return R.AdaptiveTimeSeries(c)
+
+
+def _model(plant, dt):
+    c = R.ModelBasedConfig.from_plant(plant, 3)
+    c.dt = dt
+    return R.ModelBasedCompensator(c)
+
+
+#: name -> (factory(nominal plant parameters, dt), citation)
+CONTROLLERS: dict[str, tuple[Callable, str]] = {
+    "sample": (_sample, "PI + phase lead (Silva et al. 2020, Sec 5.2-5.3)"),
+    "polynomial": (_polynomial, "polynomial extrapolation (Horiuchi et al. 1999) + PI"),
+    "ats": (_ats, "adaptive time series (Chae, Kazemibidokhti, Ricles 2013) + PI"),
+    "model": (_model, "model-based feedforward (Phillips and Spencer 2013) + PI feedback"),
+}
+
+
+def make_controller(name: str, dt: float = DT):
+    """A tracking controller by name, designed on the NOMINAL plant (the
+    designer does not know the perturbed plant)."""
+    if name not in CONTROLLERS:
+        raise ValueError(f"invalid controller = {name!r}: expected one of {sorted(CONTROLLERS)}")
+    return CONTROLLERS[name][0](nominal_plant(), dt)
+
+
+# ----------------------------------------------------------------------------- one trial
+
+@dataclass
+class Trial:
+    """One benchmark trial: J1-J9 and the limits (plus the signals if kept)."""
+    J: list[float]
+    max_force_N: float
+    max_displacement_m: float
+    max_velocity_m_per_s: float
+    ok: bool
+    failure_time: float
+    wall_time: float
+    signals: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def capacity_exceeded(self) -> bool:
+        return self.max_force_N >= FORCE_LIMIT
+
+
+def _ground_motion(record: Record, scale: float) -> "R.GroundMotion":
+    return R.GroundMotion(record.time, record.acceleration, scale)
+
+
+def run_trial(case: BenchmarkCase, record: Record, controller: str = "sample", plant=None, seed: int = 0,
+              scale: float = EQ_INTENSITY, scheme: str = "RungeKutta4", reference: np.ndarray | None = None,
+              keep_signals: bool = False, timing: bool = False, experimental=None, numerical=None) -> Trial:
+    """One vRTHS run on the 4096 Hz grid of the record, then J1-J9.
+
+    Args:
+        plant: BenchmarkPlantParameters of the control plant (None: nominal).
+        seed: of the sensor noise (one sequence shared by both channels).
+        scheme: the numerical substructure's integrator (``RungeKutta4`` as the
+            benchmark, ``CentralDifference``, ``ExplicitNewmark``, ``AverageAcceleration``).
+        reference: the reference displacements (N x 3), if already computed.
+        experimental: another ExperimentalSubstructure (e.g. ServoHydraulicSubstructure);
+            None: the benchmark plant.
+        numerical: another numerical substructure: a core NumericalSubstructure (e.g. a
+            LinearSubstructure of other matrices) or a Python object with its protocol (e.g.
+            ``rths.OpenSeesSubstructure``); None: the case partitioned at the first floor.
+    """
+    plant = plant if plant is not None else nominal_plant()
+    exp = experimental if experimental is not None else R.BenchmarkPlant(plant, DT)
+    num = _numerical(numerical, case, exp, scheme)
+    ctrl = make_controller(controller)
+    cfg = R.RthsLoopConfig()
+    cfg.seed = int(seed) & (2**64 - 1)
+    loop = R.RthsLoop(exp, num, ctrl, cfg)
+    gm = _ground_motion(record, scale)
+    n = record.samples()
+    t0 = time.perf_counter()
+    out = loop.run(num, gm, n, timing)
+    wall = time.perf_counter() - t0
+    if reference is None:
+        reference = case_reference(case, record, scale)
+    if out["ok"]:
+        J = evaluate(out["measured"], out["numerical"], reference, DT)
+    else:
+        J = [math.nan] * 9
+    trial = Trial(J, float(out["peak_actuator_force"]), float(out["peak_displacement"]),
+                  float(out["peak_velocity"]), bool(out["ok"]), float(out["failure_time"]), wall)
+    if keep_signals:
+        trial.signals = {k: out[k] for k in ("measured", "displacement", "actuator_force", "command", "numerical",
+                                              "feedback_force") + (("step_seconds",) if timing else ())}
+        trial.signals["reference"] = reference
+        trial.signals["time"] = np.arange(out["rows"]) * DT
+    return trial
+
+
+def _numerical(numerical, case: BenchmarkCase, exp, scheme: str):
+    if numerical is None:
+        return R.LinearSubstructure(partition(case, exp.specimen()), DT, getattr(R.SubstructureScheme, scheme))
+    if isinstance(numerical, R.NumericalSubstructure):
+        return numerical
+    return R.PythonSubstructure(numerical)
+
+
+_REFERENCE_CACHE: dict[tuple, np.ndarray] = {}
+
+
+def case_reference(case: BenchmarkCase, record: Record, scale: float = EQ_INTENSITY) -> np.ndarray:
+    """The reference displacements (N x 3) on the 4096 Hz grid, cached per process."""
+    key = (case.number, case.source, hashlib.sha256(case.C.tobytes() + case.K.tobytes() + case.M.tobytes()).hexdigest(),
+           record.name, record.source, record.acceleration.size, float(record.acceleration.sum()), scale)
+    if key not in _REFERENCE_CACHE:
+        if len(_REFERENCE_CACHE) > 8:
+            _REFERENCE_CACHE.clear()
+        _REFERENCE_CACHE[key] = _reference(case, record, scale)
+    return _REFERENCE_CACHE[key]
+
+
+def _reference(case: BenchmarkCase, record: Record, scale: float) -> np.ndarray:
+    n = record.samples()
+    ag = scale * np.interp(np.arange(n) * DT, record.time, record.acceleration)
+    return reference_response(case.M, case.C, case.K, ag, DT)
+
+
+def case_psi(case: BenchmarkCase) -> float:
+    sp = nominal_plant().specimen()
+    return psi(case.M, case.C, case.K, sp.m, sp.c, sp.k)
+
+
+def _perturbed_job(rig, trial: int, case: BenchmarkCase, record: Record, controller: str, seed: int,
+                   scale: float, csi_derivative_block: bool = False) -> dict[str, Any]:
+    """One perturbed trial in a sweep worker (the rig argument of sh.sweep is unused)."""
+    plant = perturbed_plant(seed, case.number, trial, csi_derivative_block)
+    t = run_trial(case, record, controller, plant=plant, seed=seed, scale=scale,
+                  reference=case_reference(case, record, scale))
+    out = {f"J{i + 1}": t.J[i] for i in range(9)}
+    out.update(ok=t.ok, max_force_N=t.max_force_N, max_displacement_m=t.max_displacement_m,
+               max_velocity_m_per_s=t.max_velocity_m_per_s, wall_time=t.wall_time,
+               k_e=plant.k_e, beta1=plant.beta1, beta2=plant.beta2, a3=plant.a3)
+    return out
+
+
+def run_case(case: BenchmarkCase, record: Record, controller: str = "sample", perturbed: int = 0, seed: int = 0,
+             scale: float = EQ_INTENSITY, executor=None, max_workers: int | None = None,
+             progress: bool = True, keep_signals: bool = False,
+             csi_derivative_block: bool = False) -> dict[str, Any]:
+    """The nominal trial and ``perturbed`` perturbed trials (through ``sh.sweep``) of one case.
+
+    Returns ``{"nominal": {...}, "perturbed": {...} (if any), "trial": Trial, "table": DataFrame | None}``.
+    """
+    ref = case_reference(case, record, scale)
+    nom = run_trial(case, record, controller, plant=nominal_plant(csi_derivative_block), seed=seed, scale=scale,
+                    reference=ref, keep_signals=keep_signals)
+    res: dict[str, Any] = {"nominal": {"J": nom.J, "max_force_N": nom.max_force_N,
+                                       "max_displacement_m": nom.max_displacement_m,
+                                       "max_velocity_m_per_s": nom.max_velocity_m_per_s,
+                                       "capacity_exceeded": nom.capacity_exceeded, "ok": nom.ok,
+                                       "PSI": case_psi(case)},
+                           "trial": nom, "table": None}
+    if perturbed > 0:
+        from ..sweep import sweep
+        df = sweep(grid={"trial": list(range(1, perturbed + 1))}, run=_perturbed_job,
+                   fixed={"case": case, "record": record, "controller": controller, "seed": seed, "scale": scale,
+                          "csi_derivative_block": bool(csi_derivative_block)},
+                   executor=executor, max_workers=max_workers, progress=progress)
+        df = df.drop(columns=["case", "record", "csi_derivative_block"])
+        if "error" in df.columns and df["error"].notna().any():
+            raise RuntimeError(f"perturbed trial failed: {df['error'].dropna().iloc[0]}")
+        Js = df[[f"J{i + 1}" for i in range(9)]].to_numpy(dtype=float)
+        res["perturbed"] = {"J_mean": [float(v) for v in np.mean(Js, axis=0)],
+                            "J_std": [float(v) for v in np.std(Js, axis=0, ddof=1)] if perturbed > 1 else [0.0] * 9,
+                            "runs": int(perturbed), "stable": int(df["ok"].sum()),
+                            "capacity_exceeded": int((df["max_force_N"] >= FORCE_LIMIT).sum())}
+        res["table"] = df
+    return res

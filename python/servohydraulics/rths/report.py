@@ -1,0 +1,201 @@
+"""The whole benchmark for a set of cases: results.json, a markdown report
+with the J table, tracking and J plots (matplotlib Figures saved to files)."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..atomic import FileSet
+from .benchmark import CONTROLLERS, FORCE_LIMIT, run_case
+from .data import EQ_INTENSITY, embedded_case, load_case, load_record, synthetic_record
+from .evaluation import J_NAMES
+
+__all__ = ["run_benchmark", "write_outputs", "j_table"]
+
+SYNTHETIC_LABEL = ("EMBEDDED DEFAULT: reference structure rebuilt from the published parameters, driven by a "
+                   "SYNTHETIC ground motion. These are NOT the benchmark's records or results.")
+
+
+def parse_cases(text: str | Sequence[int]) -> list[int]:
+    if isinstance(text, str):
+        try:
+            cases = [int(v) for v in text.split(",") if v.strip()]
+        except ValueError:
+            raise ValueError(f"invalid cases = {text!r}: expected a comma-separated list of 1, 2, 3, 4") from None
+    else:
+        cases = [int(v) for v in text]
+    if not cases or any(c not in (1, 2, 3, 4) for c in cases):
+        raise ValueError(f"invalid cases = {text!r}: expected a comma-separated list of 1, 2, 3, 4")
+    return cases
+
+
+def run_benchmark(data: str | Path | None = None, record: str = "elcentro", cases: str | Sequence[int] = "1,2,3,4",
+                  controller: str = "sample", perturbed: int = 0, seed: int = 0, scale: float = EQ_INTENSITY,
+                  workers: int | None = None, progress: bool = True, csi: str = "exact") -> dict[str, Any]:
+    """Runs the benchmark: per case the nominal trial (signals kept) and
+    ``perturbed`` perturbed trials (through ``sh.sweep`` on one process pool).
+
+    ``csi``: ``"exact"`` (a2 x', the spec's default) or ``"derivative-block"`` (the code's
+    Simulink Derivative block, BENCHMARK.md 2.1).
+    Without ``data``: the embedded default (published parameters, synthetic
+    ground motion), labelled as not the benchmark's.
+    Returns ``{"results": <results.json content>, "trials": {case: Trial}, "tables": {case: DataFrame}}``.
+    """
+    case_list = parse_cases(cases)
+    if csi not in ("exact", "derivative-block"):
+        raise ValueError(f"invalid csi = {csi!r}: expected 'exact' or 'derivative-block'")
+    if controller not in CONTROLLERS:
+        raise ValueError(f"invalid controller = {controller!r}: expected one of {sorted(CONTROLLERS)}")
+    if isinstance(perturbed, bool) or int(perturbed) != perturbed or perturbed < 0:
+        raise ValueError(f"invalid perturbed = {perturbed!r}: expected an integer >= 0")
+    if data is None:
+        rec = load_record(None, "chirp") if record == "chirp" else synthetic_record()
+        load = embedded_case
+    else:
+        rec = load_record(data, record)
+        load = lambda n: load_case(data, n)  # noqa: E731
+    results: dict[str, Any] = {"cases": {}}
+    meta = {"record": rec.name, "record_source": rec.source, "synthetic": rec.synthetic,
+            "controller": controller, "controller_description": CONTROLLERS[controller][1],
+            "eq_intensity": scale, "seed": seed, "perturbed_runs": int(perturbed), "fs_Hz": 4096,
+            "J_names": list(J_NAMES), "force_limit_N": FORCE_LIMIT, "csi": csi}
+    if rec.synthetic:
+        meta["label"] = SYNTHETIC_LABEL
+    elif data is None:
+        meta["label"] = ("EMBEDDED DEFAULT: reference structure rebuilt from the published parameters, driven by the "
+                         "benchmark's chirp (no published results).")
+    trials, tables = {}, {}
+    executor = ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1) if perturbed > 0 else None
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+        bar = tqdm(total=len(case_list) * (1 + int(perturbed)), desc="rths-benchmark", unit="run")
+    try:
+        for n in case_list:
+            case = load(n)
+            out = run_case(case, rec, controller, perturbed=int(perturbed), seed=seed, scale=scale,
+                           executor=executor, progress=False, keep_signals=True,
+                           csi_derivative_block=csi == "derivative-block")
+            nom = out["nominal"]
+            entry: dict[str, Any] = {"nominal": {"J": nom["J"], "max_force_N": nom["max_force_N"],
+                                                 "max_displacement_m": nom["max_displacement_m"],
+                                                 "PSI": nom["PSI"]}}
+            if perturbed > 0:
+                p = out["perturbed"]
+                entry["perturbed"] = {"J_mean": p["J_mean"], "J_std": p["J_std"], "runs": p["runs"]}
+                meta.setdefault("perturbed_stable", {})[str(n)] = p["stable"]
+                meta.setdefault("perturbed_capacity_exceeded", {})[str(n)] = p["capacity_exceeded"]
+                tables[n] = out["table"]
+            meta.setdefault("case_source", {})[str(n)] = case.source
+            meta.setdefault("max_velocity_m_per_s", {})[str(n)] = nom["max_velocity_m_per_s"]
+            results["cases"][str(n)] = entry
+            trials[n] = out["trial"]
+            if bar is not None:
+                bar.update(1 + int(perturbed))
+    finally:
+        if bar is not None:
+            bar.close()
+        if executor is not None:
+            executor.shutdown(wait=True)
+    results["meta"] = meta
+    return {"results": results, "trials": trials, "tables": tables}
+
+
+def _fmt(v: float, nd: int = 2) -> str:
+    return "nan" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.{nd}f}"
+
+
+def j_table(results: dict[str, Any]) -> str:
+    """The J table (markdown): one row per case, nominal and (if run) perturbed mean +- std."""
+    head = "| Case | Trial | " + " | ".join(n.split()[0] for n in J_NAMES) + " | max f [kN] | PSI |\n"
+    head += "|" + " --- |" * 13 + "\n"
+    rows = []
+    for n, e in results["cases"].items():
+        nom = e["nominal"]
+        rows.append(f"| {n} | nominal | " + " | ".join(_fmt(v) for v in nom["J"])
+                    + f" | {nom['max_force_N'] / 1e3:.2f} | {nom['PSI']:.3f} |")
+        if "perturbed" in e:
+            p = e["perturbed"]
+            rows.append(f"| {n} | perturbed ({p['runs']}) | "
+                        + " | ".join(f"{_fmt(m)} ± {_fmt(s)}" for m, s in zip(p["J_mean"], p["J_std"])) + " | | |")
+    return head + "\n".join(rows) + "\n"
+
+
+def _plots(run: dict[str, Any], out: Path, files_out: "FileSet") -> list[str]:
+    from matplotlib.figure import Figure
+    files = []
+    trials = run["trials"]
+    fig = Figure(figsize=(9, 2.4 * len(trials)))
+    for i, (n, t) in enumerate(trials.items()):
+        s = t.signals
+        ax = fig.add_subplot(len(trials), 1, i + 1)
+        tt = s["time"]
+        k = int(np.argmax(np.abs(s["numerical"][:, 0])))
+        win = (tt > tt[k] - 1.0) & (tt < tt[k] + 1.0)
+        ax.plot(tt[win], 1e3 * s["numerical"][win, 0], label="desired y_n(1)")
+        ax.plot(tt[win], 1e3 * s["measured"][win], label="measured x_m", lw=0.8)
+        ax.plot(tt[win], 1e3 * s["reference"][win, 0], "--", label="reference floor 1", lw=0.8)
+        ax.set_ylabel(f"case {n}\n[mm]")
+        if i == 0:
+            ax.legend(loc="upper right", fontsize=7)
+    fig.axes[-1].set_xlabel("time [s]")
+    fig.tight_layout()
+    fig.savefig(files_out.path(out / "tracking.png"), dpi=110)
+    files.append("tracking.png")
+    fig = Figure(figsize=(9, 3.5))
+    ax = fig.add_subplot(1, 1, 1)
+    cases = list(run["results"]["cases"].items())
+    width = 0.8 / max(1, len(cases))
+    x = np.arange(1, 9)
+    for j, (n, e) in enumerate(cases):
+        mean = np.array(e["perturbed"]["J_mean"][1:]) if "perturbed" in e else np.array(e["nominal"]["J"][1:])
+        std = np.array(e["perturbed"]["J_std"][1:]) if "perturbed" in e else None
+        ax.bar(x + (j - (len(cases) - 1) / 2) * width, mean, width, yerr=std, label=f"case {n}")
+    ax.set_xticks(x)
+    ax.set_xticklabels([f"J{i}" for i in range(2, 10)])
+    ax.set_ylabel("[%]")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(files_out.path(out / "criteria.png"), dpi=110)
+    files.append("criteria.png")
+    return files
+
+
+def write_outputs(run: dict[str, Any], out: str | Path) -> Path:
+    """results.json, report.md, tracking.png and criteria.png in ``out``, renamed
+    into place together once all are written (atomic.FileSet: no half-written file)."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    with FileSet() as files:
+        _write_all(run, out, files)
+    return out
+
+
+def _write_all(run: dict[str, Any], out: Path, files: FileSet) -> None:
+    res = run["results"]
+    files.write_text(out / "results.json", json.dumps(res, indent=2, allow_nan=True))
+    _plots(run, out, files)
+    meta = res["meta"]
+    lines = ["# RTHS benchmark (Silva et al. 2020)", ""]
+    if meta.get("label"):
+        lines += [f"**{meta['label']}**", ""]
+    lines += [f"- record: {meta['record']} × {meta['eq_intensity']} ({meta['record_source']})",
+              f"- controller: {meta['controller']}: {meta['controller_description']}",
+              f"- noise seed / perturbation seed: {meta['seed']}; perturbed runs per case: {meta['perturbed_runs']}",
+              f"- CSI: {meta['csi']} ({'a2 dx/dt' if meta['csi'] == 'exact' else 'the code Derivative block'})",
+              "- J in the official code's order (F4_evaluation.m): J1 [ms], J2-J9 [%]; PSI = log10(tau_cr / ms)", ""]
+    lines += [j_table(res), ""]
+    flagged = [n for n, e in res["cases"].items() if e["nominal"]["max_force_N"] >= FORCE_LIMIT]
+    lines += [f"Actuator capacity (max|f| >= {FORCE_LIMIT / 1e3:.1f} kN) exceeded in the nominal trial of case(s): "
+              f"{', '.join(flagged) if flagged else 'none'}."]
+    if "perturbed_stable" in meta:
+        lines += [f"Perturbed trials that ran to the end (stable), per case: {meta['perturbed_stable']}."]
+    lines += ["", "![tracking](tracking.png)", "", "![criteria](criteria.png)", ""]
+    files.write_text(out / "report.md", "\n".join(lines))
