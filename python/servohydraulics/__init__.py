@@ -127,6 +127,7 @@ __all__ = [
     "SolverOptions",
     "copy_rig",
     "diagnose",
+    "identify",
     "linearize",
     "load_rig",
     "make_plant",

@@ -8,8 +8,12 @@
   (friction, hysteresis) are left for stage 2.
 * :func:`fit_time` (stage 2): the records' commands simulated through the
   nonlinear model (the fast integrator, RK4 with the substep count fixed at
-  the start so the residual is a smooth function of the keys), the residual
-  (sim - measured) / std(measured) of every channel minimised by
+  the start so the residual is a smooth function of the keys; CVODE if the
+  start is too stiff for it), the residual (sim - measured) / std(measured) of
+  every channel, weighted by the inverse of that channel's rms residual at the
+  start (channels fitted as well as the model allows weigh in equally: a
+  linear spring-dashpot standing in for an MR damper leaves a 40 % force
+  residual that would otherwise pull the loop's keys), minimised by
   ``scipy.optimize.least_squares`` (trust region reflective, Jacobian by
   forward differences of 0.1 % steps in the fitting coordinates).
 
@@ -25,7 +29,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..response import Response, SimulationError
-from ..rig import Rig
+from ..rig import Error, Rig
 from ..simulate import make_plant, solver_options
 from .frf import FrequencyResponse, command_band, h1
 from .keys import Coordinates
@@ -91,11 +95,10 @@ def fit_frequency(records: list[Response], rig: Rig, coords: Coordinates, mode: 
     def residual(z: np.ndarray, active: np.ndarray) -> np.ndarray:
         zz = np.zeros(len(coords.keys))
         zz[active] = z
-        r = coords.apply(rig, zz)
         out = []
         for rec, ch, f, H, coh in targets:
-            try:
-                Hm = linear_response(r, mode, x0s[id(rec)], (ch,), f)[0]
+            try:  # an invalid rig (ValueError naming the key) or a singular model: a failed point
+                Hm = linear_response(coords.apply(rig, zz), mode, x0s[id(rec)], (ch,), f)[0]
             except (ValueError, np.linalg.LinAlgError):
                 return np.full(sum(2 * t[2].size for t in targets), FAILED)
             e = np.sqrt(coh) * (Hm - H) / np.abs(H)
@@ -117,37 +120,65 @@ def fit_frequency(records: list[Response], rig: Rig, coords: Coordinates, mode: 
     return StageResult(z, float(sol.cost), int(sol.nfev), sol.fun), fitted
 
 
+MAX_RK4_SUBSTEPS = 200
+
+
 def fixed_rk4(rig: Rig, records: list[Response], mode: str, margin: float = 2.0):
-    """RK4 options with the substep count fixed at ``margin`` times the automatic count of the start."""
+    """RK4 options with the substep count fixed at ``margin`` times the automatic count
+    of the start; CVODE when that count would exceed ``MAX_RK4_SUBSTEPS``."""
     dt = min(r.dt for r in records)
-    n = make_plant(rig, mode, dt, solver_options(method="rk4"), initial_displacement(records[0])).rk4_substeps
+    try:
+        n = make_plant(rig, mode, dt, solver_options(method="rk4"), initial_displacement(records[0])).rk4_substeps
+    except Error:
+        n = MAX_RK4_SUBSTEPS + 1
+    if margin * n > MAX_RK4_SUBSTEPS:
+        return solver_options(method="cvode")
     return solver_options(method="rk4", rk4_substeps=max(1, int(np.ceil(margin * n))))
 
 
 def time_residual(rig: Rig, records: list[Response], mode: str, channels: tuple[str, ...], options,
-                  dt: float | None = None) -> np.ndarray:
-    """(sim - measured) / std(measured) of every record and channel, concatenated."""
+                  dt: float | None = None, weights: dict | None = None) -> np.ndarray:
+    """w_ch (sim - measured) / std(measured) of every record and channel, concatenated
+    (w_ch = 1 unless ``weights`` gives it)."""
     out = []
     for rec in records:
         try:
             sim = simulate_record(rig, rec, mode, dt=dt, options=options)
-        except SimulationError:
+        except (SimulationError, ValueError):
             sim = None
         for ch in channels:
             m = np.asarray(rec.channels[ch], dtype=float)
             s = sim[ch] if sim is not None and np.all(np.isfinite(sim[ch])) else None
-            out.append(np.full(m.size, FAILED) if s is None else (s - m) / np.std(m))
+            w = 1.0 if weights is None else weights[ch]
+            out.append(np.full(m.size, FAILED) if s is None else w * (s - m) / np.std(m))
     return np.concatenate(out)
+
+
+def channel_weights(rig: Rig, records: list[Response], mode: str, channels: tuple[str, ...], options,
+                    dt: float | None = None) -> dict[str, float]:
+    """1 / (rms normalised residual) of each channel over all records at ``rig`` (floored at 1e-3)."""
+    e = time_residual(rig, records, mode, channels, options, dt)
+    sizes = [rec.time.size for rec in records for _ in channels]
+    parts = np.split(e, np.cumsum(sizes)[:-1])
+    names = [ch for _ in records for ch in channels]
+    return {ch: 1.0 / max(float(np.sqrt(np.mean(np.concatenate([p for p, n in zip(parts, names) if n == ch])
+                                                    ** 2))), 1e-3) for ch in channels}
 
 
 def fit_time(records: list[Response], rig: Rig, coords: Coordinates, z0: np.ndarray, mode: str,
              channels: tuple[str, ...], options, dt: float | None = None, max_nfev: int = 60,
-             progress=None) -> StageResult:
+             progress=None, weights: dict | None = None) -> StageResult:
     """Stage 2 from z0 (see the module docstring)."""
+    n = sum(rec.time.size for rec in records) * len(channels)
+
     def residual(z: np.ndarray) -> np.ndarray:
         if progress is not None:
             progress.update(1)
-        return time_residual(coords.apply(rig, z), records, mode, channels, options, dt)
+        try:
+            r = coords.apply(rig, z)
+        except ValueError:  # the step left the rig's valid range: a failed point
+            return np.full(n, FAILED)
+        return time_residual(r, records, mode, channels, options, dt, weights)
 
     lo, hi = coords.bounds()
     sol = least_squares(residual, np.clip(z0, lo, hi), bounds=(lo, hi), method="trf", jac="2-point",
@@ -155,5 +186,5 @@ def fit_time(records: list[Response], rig: Rig, coords: Coordinates, z0: np.ndar
     return StageResult(sol.x, float(sol.cost), int(sol.nfev), sol.fun, sol.jac)
 
 
-__all__ = ["MIN_COHERENCE", "StageResult", "fit_frequency", "fit_time", "fixed_rk4", "frequency_targets",
+__all__ = ["MAX_RK4_SUBSTEPS", "MIN_COHERENCE", "StageResult", "channel_weights", "fit_frequency", "fit_time", "fixed_rk4", "frequency_targets",
            "linear_response", "time_residual"]

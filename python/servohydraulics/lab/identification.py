@@ -32,7 +32,7 @@ from ..records import read_record
 from ..response import Response
 from ..rig import Rig, load_rig, save_rig
 from .compare import Comparison, channels_of, compare, write_json
-from .fitting import StageResult, fit_frequency, fit_time, fixed_rk4
+from .fitting import StageResult, channel_weights, fit_frequency, fit_time, fixed_rk4
 from .generic import generic_rig
 from .keys import LOOP_KEYS, Coordinates, check_keys, specimen_keys, use_specimen
 from .run import simulate_record
@@ -63,6 +63,8 @@ class Identification:
     rho1: float = 0.0
     nfev: dict = field(default_factory=dict)
     runtime_s: dict = field(default_factory=dict)
+    weights: dict = field(default_factory=dict)  #: channel -> weight of its normalised residual
+    integrator: str = "rk4"
 
     def to_dict(self) -> dict[str, Any]:
         units = _units()
@@ -72,7 +74,7 @@ class Identification:
                                "stage1": self.stage1_values[k], "std": self.std[k],
                                "interval": list(self.intervals[k])} for k in self.keys},
             "correlation": {"keys": list(self.keys), "matrix": np.round(self.correlation, 4).tolist()},
-            "flags": self.flags, "n_eff": self.n_eff, "rho1": self.rho1, "nfev": self.nfev,
+            "flags": self.flags, "channel_weights": self.weights, "integrator": self.integrator, "n_eff": self.n_eff, "rho1": self.rho1, "nfev": self.nfev,
             "runtime_s": self.runtime_s,
             "records": [{"record": b.name, "before": {c: b.channels[c]["nrmse_pct"] for c in b.channels},
                          "after": {c: a.channels[c]["nrmse_pct"] for c in a.channels}}
@@ -196,8 +198,9 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
     t0 = time.perf_counter()
     from tqdm.auto import tqdm
 
+    weights = channel_weights(coords.apply(start, z1), recs, mode, chans, options, dt)
     with tqdm(desc="identify (simulations)", unit="sim", disable=not progress, leave=False) as bar:
-        s2 = fit_time(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar)
+        s2 = fit_time(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar, weights)
     nfev["time"], runtime["time"] = s2.nfev, time.perf_counter() - t0
     cov, corr, n_eff, rho = uncertainty(s2, coords)
     zq = float(norm.ppf(0.5 + LEVEL / 2))
@@ -221,7 +224,7 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         stage1_values={k: (float(s1_vals[i]) if k in stage1_keys else None) for i, k in enumerate(keys)},
         intervals=intervals, std=std, correlation=corr,
         flags=separability_flags(keys, values, intervals, corr), before=before, after=after,
-        generic_start=generic, n_eff=float(n_eff), rho1=float(rho), nfev=nfev, runtime_s=runtime)
+        generic_start=generic, weights=weights, integrator=options.method.name.lower(), n_eff=float(n_eff), rho1=float(rho), nfev=nfev, runtime_s=runtime)
 
 
 __all__ = ["Comparison", "Identification", "as_records", "identify", "separability_flags", "uncertainty"]

@@ -50,6 +50,9 @@ SPECIMEN_EFFECT = {"linear": None, "bouc_wen": "bouc_wen", "mr_damper": "mr_damp
 #: f_v -> 1 MHz), equal in the data but too stiff for a fixed-step integrator.
 RANGES = {"f_v": (1.0, 300.0), "zeta_v": (0.1, 2.0)}
 
+#: log-space keys move at most a factor exp(30) ~ 1e13 from their start
+Z_LOG_MAX = 30.0
+
 SIGNED_KEYS = frozenset({"mr_x0", "mr_alpha_b", "mr_c0_b", "mr_c1_b", "x_contact"})
 
 
@@ -121,7 +124,8 @@ class Coordinates:
         b = _bounds()
         lo = np.array([-np.inf if (g or ">" not in b.get(k, "")) else -s / sc
                        for k, g, s, sc in zip(self.keys, self.log, self.start, self.scale)])
-        hi = np.full(lo.size, np.inf)
+        lo = np.where(self.log, -Z_LOG_MAX, lo)
+        hi = np.where(self.log, Z_LOG_MAX, np.inf)
         for i, k in enumerate(self.keys):
             if k in RANGES:
                 lo[i], hi[i] = self.z(np.full(len(self.keys), RANGES[k][0]))[i], \
