@@ -74,7 +74,7 @@ class Identification:
                                "stage1": self.stage1_values[k], "std": self.std[k],
                                "interval": list(self.intervals[k])} for k in self.keys},
             "correlation": {"keys": list(self.keys), "matrix": np.round(self.correlation, 4).tolist()},
-            "flags": self.flags, "channel_weights": self.weights, "integrator": self.integrator, "n_eff": self.n_eff, "rho1": self.rho1, "nfev": self.nfev,
+            "derived": derived(self.rig, self.mode), "flags": self.flags, "channel_weights": self.weights, "integrator": self.integrator, "n_eff": self.n_eff, "rho1": self.rho1, "nfev": self.nfev,
             "runtime_s": self.runtime_s,
             "records": [{"record": b.name, "before": {c: b.channels[c]["nrmse_pct"] for c in b.channels},
                          "after": {c: a.channels[c]["nrmse_pct"] for c in a.channels}}
@@ -100,6 +100,16 @@ class Identification:
         write_json(out / "identification.json", self.to_dict())
         (out / "report.md").write_text(self.markdown())
         return out / "report.md"
+
+
+def derived(rig: Rig, mode: str) -> dict[str, float]:
+    """What the records determine even where the keys trade off: the loop gain
+    G_p C_F K_s K_v / A [1/s] in displacement control (the closed-loop corner of
+    the integrating loop; a generic start's G_p alone depends on its scaling)."""
+    if mode != "displacement":
+        return {}
+    return {"loop_gain_1_per_s": float(rig.G_p * rig.C_F_disp * rig.K_s * rig.K_v / rig.A),
+            "valve_lag_s": float(2.0 * rig.zeta_v / (2.0 * np.pi * rig.f_v))}
 
 
 def _units() -> dict[str, str]:

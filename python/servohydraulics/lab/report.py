@@ -23,6 +23,8 @@ def identification_markdown(ident) -> str:
         lo, hi = p["interval"]
         lines.append(f"| `{k}` | {p['unit']} | {_v(p['start'])} | {_v(p['stage1'])} | {_v(p['value'])} | "
                      f"[{lo:.5g}, {hi:.5g}] |")
+    for k, v in d["derived"].items():
+        lines.append(f"\nDerived: `{k}` = {v:.5g}")
     lines += ["", "## Correlations", "", "| | " + " | ".join(ident.keys) + " |",
               "|---" * (len(ident.keys) + 1) + "|"]
     for i, k in enumerate(ident.keys):
