@@ -1,6 +1,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include "busy.hpp"
 #include "servohydraulics/compensators.hpp"
 
 namespace py = pybind11;
@@ -11,8 +12,8 @@ void expose_compensators(py::module_& m) {
                         "Phase lead (T s + 1)/(alpha T s + 1), Tustin prewarped at w_p (default 1/(T sqrt(alpha)))")
       .def(py::init<double, double, double, double>(), py::arg("T"), py::arg("alpha"), py::arg("dt"),
            py::arg("prewarp") = 0.0)
-      .def("reset", &PhaseLead::reset, py::arg("u0") = 0.0)
-      .def("step", &PhaseLead::step, py::arg("u"))
+      .def("reset", bindings::guarded(&PhaseLead::reset, "PhaseLead.reset"), py::arg("u0") = 0.0)
+      .def("step", bindings::guarded(&PhaseLead::step, "PhaseLead.step"), py::arg("u"))
       .def(
           "filter",
           [](PhaseLead& f, py::array_t<double, py::array::c_style | py::array::forcecast> u) {
@@ -22,6 +23,7 @@ void expose_compensators(py::module_& m) {
             double* dst = y.mutable_data();
             const auto n = static_cast<std::size_t>(u.shape(0));
             {
+              bindings::BusyGuard busy({&f}, "PhaseLead.filter");
               py::gil_scoped_release release;
               f.filter(src, dst, n);
             }
@@ -49,8 +51,9 @@ void expose_compensators(py::module_& m) {
       .value("Nonlinear", VelocityFeedbackCompensator::Kind::Nonlinear);
   vfc.def(py::init<const Rig&, VelocityFeedbackCompensator::Kind, double, double, double>(), py::arg("model"),
           py::arg("kind"), py::arg("lead_T"), py::arg("alpha"), py::arg("dt"))
-      .def("reset", &VelocityFeedbackCompensator::reset)
-      .def("step", &VelocityFeedbackCompensator::step, py::arg("velocity"), py::arg("force_error"),
+      .def("reset", bindings::guarded(&VelocityFeedbackCompensator::reset, "VelocityFeedbackCompensator.reset"))
+      .def("step", bindings::guarded(&VelocityFeedbackCompensator::step, "VelocityFeedbackCompensator.step"),
+           py::arg("velocity"), py::arg("force_error"),
            py::arg("pressure"))
       .def_property_readonly("kind", &VelocityFeedbackCompensator::kind)
       .def_property_readonly("forward_gain", &VelocityFeedbackCompensator::forward_gain)

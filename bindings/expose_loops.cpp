@@ -6,6 +6,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "busy.hpp"
 #include "channels_py.hpp"
 #include "protocol.hpp"
 #include "servohydraulics/controllers.hpp"
@@ -92,12 +93,17 @@ void expose_loops(py::module_& m) {
   py::class_<EftController>(m, "EftController",
                             "EFT controller (Fig 1a): sensors at t_k and a_g -> force command [N]")
       .def(py::init<const EftConfig&, const Rig&>(), py::arg("config"), py::arg("model"))
-      .def("reset", &EftController::reset)
-      .def("command", [](EftController& c, const Output& s, double ag) { return c.command(s, ag); },
+      .def("reset", bindings::guarded(&EftController::reset, "EftController.reset"))
+      .def("command",
+           [](EftController& c, const Output& s, double ag) {
+             bindings::require_idle(&c, "EftController.command");
+             return c.command(s, ag);
+           },
            py::arg("sensors"), py::arg("ground_acceleration"))
       .def(
           "command_output",
           [](EftController& c, const Output& s, double ag) {
+            bindings::require_idle(&c, "EftController.command_output");
             EftOutput o;
             c.command(s, ag, &o);
             return o;
@@ -109,10 +115,15 @@ void expose_loops(py::module_& m) {
   py::class_<EffectiveForceTest>(m, "EffectiveForceTest", "Effective force testing loop (force control, Fig 1a)")
       .def(py::init<const Rig&, const EftConfig&, const std::optional<Rig>&>(), py::arg("rig"), py::arg("config"),
            py::arg("model") = py::none())
-      .def("reset", &EffectiveForceTest::reset)
+      .def("reset",
+           [](EffectiveForceTest& t) {
+             bindings::require_idle(&t, "EffectiveForceTest.reset");
+             t.reset();
+           })
       .def(
           "step",
           [](EffectiveForceTest& t, double ag) {
+            bindings::require_idle(&t, "EffectiveForceTest.step");
             EftOutput o;
             Status s = t.step(ag, o);
             return py::make_tuple(s, o);
@@ -127,6 +138,8 @@ void expose_loops(py::module_& m) {
             RunSummary sum;
             const double* a = ag.data();
             {
+              bindings::BusyGuard busy({&t, &t.plant(), &t.controller(), &t.compensator()},
+                                       "EffectiveForceTest.run");
               py::gil_scoped_release release;
               sum = run_eft(t, a, n, rows.data());
             }
@@ -174,14 +187,18 @@ void expose_loops(py::module_& m) {
   py::class_<RpsdController>(m, "RpsdController",
                              "RPsD controller (Figs 1b, 7): sensors at t_k, a_g, P_ext -> displacement command [m]")
       .def(py::init<const RpsdConfig&, const Rig&>(), py::arg("config"), py::arg("physical"))
-      .def("reset", &RpsdController::reset)
+      .def("reset", bindings::guarded(&RpsdController::reset, "RpsdController.reset"))
       .def("command",
-           [](RpsdController& c, const Output& s, double ag, double pe, double fe) { return c.command(s, ag, pe, fe); },
+           [](RpsdController& c, const Output& s, double ag, double pe, double fe) {
+             bindings::require_idle(&c, "RpsdController.command");
+             return c.command(s, ag, pe, fe);
+           },
            py::arg("sensors"), py::arg("ground_acceleration"), py::arg("external_force") = 0.0,
            py::arg("restoring_force_error") = 0.0)
       .def(
           "command_output",
           [](RpsdController& c, const Output& s, double ag, double pe, double fe) {
+            bindings::require_idle(&c, "RpsdController.command_output");
             RpsdOutput o;
             c.command(s, ag, pe, fe, &o);
             return o;
@@ -196,10 +213,15 @@ void expose_loops(py::module_& m) {
   py::class_<RealTimePseudoDynamicTest>(m, "RealTimePseudoDynamicTest",
                                         "Real-time pseudodynamic testing loop (displacement control, Figs 1b, 7)")
       .def(py::init<const Rig&, const RpsdConfig&>(), py::arg("rig"), py::arg("config"))
-      .def("reset", &RealTimePseudoDynamicTest::reset)
+      .def("reset",
+           [](RealTimePseudoDynamicTest& t) {
+             bindings::require_idle(&t, "RealTimePseudoDynamicTest.reset");
+             t.reset();
+           })
       .def(
           "step",
           [](RealTimePseudoDynamicTest& t, double ag, double pe, double fe) {
+            bindings::require_idle(&t, "RealTimePseudoDynamicTest.step");
             RpsdOutput o;
             Status s = t.step(ag, pe, fe, o);
             return py::make_tuple(s, o);
@@ -216,6 +238,7 @@ void expose_loops(py::module_& m) {
             RunSummary sum;
             const double* a = ag.data();
             {
+              bindings::BusyGuard busy({&t, &t.plant(), &t.controller()}, "RealTimePseudoDynamicTest.run");
               py::gil_scoped_release release;
               sum = run_rpsd(t, a, pp, pf, n, rows.data());
             }

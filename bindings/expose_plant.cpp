@@ -1,13 +1,53 @@
+#include <string>
+#include <vector>
+
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "busy.hpp"
 #include "channels_py.hpp"
 #include "protocol.hpp"
 #include "servohydraulics/plant.hpp"
 
 namespace py = pybind11;
 using namespace servohydraulics;
+
+namespace {
+// The active part of a state vector (Dynamics::num_states entries) to and from NumPy.
+State to_state(const Dynamics& d, const std::vector<double>& y) {
+  if (static_cast<int>(y.size()) != d.num_states())
+    throw py::value_error("invalid y (length) = " + std::to_string(y.size()) + ": this plant has " +
+                          std::to_string(d.num_states()) + " states (Dynamics.states)");
+  State s{};
+  for (std::size_t i = 0; i < y.size(); ++i) s[i] = y[i];
+  return s;
+}
+py::array_t<double> from_state(const Dynamics& d, const State& y) {
+  py::array_t<double> out(d.num_states());
+  for (int i = 0; i < d.num_states(); ++i) out.mutable_data()[i] = y[i];
+  return out;
+}
+py::tuple state_table(const Dynamics& d) {
+  py::tuple t(static_cast<std::size_t>(d.num_states()));
+  for (int i = 0; i < d.num_states(); ++i) {
+    const StateInfo& s = d.state_info(i);
+    t[i] = py::make_tuple(s.name, s.unit, s.doc);
+  }
+  return t;
+}
+py::dict layout_dict(const Dynamics& d) {
+  const StateLayout& L = d.layout();
+  py::dict out;
+  out["num_states"] = L.num_states;
+  out["bw_z"] = L.bw_z;
+  out["mr_y"] = L.mr_y;
+  out["mr_z"] = L.mr_y >= 0 ? L.mr_y + 1 : -1;
+  out["pade"] = L.pade;
+  out["pade_order"] = L.pade_order;
+  return out;
+}
+}  // namespace
 
 void expose_plant(py::module_& m) {
   py::enum_<ControlMode>(m, "ControlMode")
@@ -22,8 +62,11 @@ void expose_plant(py::module_& m) {
     si.value(kStates[i].name, static_cast<StateIndex>(i), kStates[i].doc);
     states[i] = py::make_tuple(kStates[i].name, kStates[i].unit);
   }
-  m.attr("STATES") = states;
+  m.attr("STATES") = states;  // the base states; Dynamics.states adds the switched-on elements'
   m.attr("NUM_STATES") = static_cast<int>(kNumStates);
+  m.attr("MAX_STATES") = static_cast<int>(kMaxStates);
+  m.attr("MAX_PADE_ORDER") = static_cast<int>(kMaxPadeOrder);
+  m.attr("MAX_DELAY_SAMPLES") = static_cast<int>(kMaxDelaySamples);
 
   // Output: one read-only attribute per channel of kPlantChannels, and the flags.
   py::class_<Output> output(m, "Output");
@@ -78,36 +121,66 @@ void expose_plant(py::module_& m) {
   py::class_<Dynamics>(m, "Dynamics", "Right-hand side, analytic Jacobian and outputs of the plant")
       .def(py::init<const Rig&, ControlMode>(), py::arg("rig"), py::arg("mode"))
       .def("rhs",
-           [](const Dynamics& d, const State& y, double u, double u_rate) {
-             State yd;
+           [](const Dynamics& d, const std::vector<double>& yv, double u, double u_rate) {
+             const State y = to_state(d, yv);
+             State yd{};
              d.rhs(y.data(), {u, u_rate}, yd.data());
-             return yd;
+             return from_state(d, yd);
            },
            py::arg("y"), py::arg("u"), py::arg("u_rate") = 0.0)
       .def("jacobian",
-           [](const Dynamics& d, const State& y, double u, double u_rate) {
+           [](const Dynamics& d, const std::vector<double>& yv, double u, double u_rate) {
+             const State y = to_state(d, yv);
              Jacobian J;
              d.jacobian(y.data(), {u, u_rate}, J);
-             return J;
+             const int n = d.num_states();
+             py::array_t<double> out({n, n});
+             auto a = out.mutable_unchecked<2>();
+             for (int i = 0; i < n; ++i)
+               for (int j = 0; j < n; ++j) a(i, j) = J[i][j];
+             return out;
            },
            py::arg("y"), py::arg("u"), py::arg("u_rate") = 0.0)
       .def("outputs",
-           [](const Dynamics& d, const State& y, double u) {
+           [](const Dynamics& d, const std::vector<double>& yv, double u) {
+             const State y = to_state(d, yv);
              Output o;
              d.outputs(y.data(), {u, 0.0}, o);
              return o;
            },
            py::arg("y"), py::arg("u"))
-      .def("equilibrium", &Dynamics::equilibrium, py::arg("x0"))
+      .def("specimen_force",
+           [](const Dynamics& d, const std::vector<double>& yv) {
+             const State y = to_state(d, yv);
+             return d.specimen_force(y.data());
+           },
+           py::arg("y"), "Force of the Bouc-Wen and MR damper specimens at state y [N] (0 when off)")
+      .def("equilibrium", [](const Dynamics& d, double x0) { return from_state(d, d.equilibrium(x0)); },
+           py::arg("x0"))
       .def("operating_point",
            [](const Dynamics& d, double x0) {
              const Dynamics::OperatingPoint op = d.operating_point(x0);
-             py::array_t<double> y0(kNumStates);
-             for (int i = 0; i < kNumStates; ++i) y0.mutable_data()[i] = op.y0[i];
-             return py::make_tuple(y0, op.u0);
+             return py::make_tuple(from_state(d, op.y0), op.u0);
            },
            py::arg("x0"),
            "(y0, u0): the equilibrium state at displacement x0 [m] and the held command that keeps it at rest")
+      .def_property_readonly("num_states", &Dynamics::num_states,
+                             "active length of the state vector (base states and the switched-on elements')")
+      .def_property_readonly("states", &state_table, "((name, unit, doc), ...) of the active states, in order")
+      .def_property_readonly("layout", &layout_dict,
+                             "indices of the elements' states: bw_z, mr_y, mr_z, pade (first), pade_order; -1: off")
+      .def_property_readonly("pade",
+                             [](const Dynamics& d) {
+                               const Dynamics::Pade& P = d.pade();
+                               py::dict out;
+                               out["order"] = P.order;
+                               out["tau"] = P.tau;
+                               out["a"] = std::vector<double>(P.a, P.a + P.order);
+                               out["c"] = std::vector<double>(P.c, P.c + P.order);
+                               out["d"] = P.d;
+                               return out;
+                             },
+                             "the Pade loop delay's realisation q' = (A' q + e_N w) / tau, out = c q + d w")
       .def("structure_forces", py::vectorize(&Dynamics::structure_force), py::arg("x"), py::arg("v"),
            py::arg("z") = 0.0,
            "The structure's force against the applied one in Eq (5), f_s(x) + c v + F_f(v, z) [N]: "
@@ -127,10 +200,16 @@ void expose_plant(py::module_& m) {
   py::class_<Plant>(m, "Plant", "The plant stepped at the controller rate (CVODE between samples)")
       .def(py::init<const Rig&, ControlMode, double, const SolverOptions&>(), py::arg("rig"), py::arg("mode"),
            py::arg("dt"), py::arg("options") = SolverOptions{})
-      .def("reset", &Plant::reset, py::arg("x0") = 0.0, py::arg("t0") = 0.0)
-      .def("reset_state", &Plant::reset_state, py::arg("y0"), py::arg("t0") = 0.0)
+      .def("reset", bindings::guarded(&Plant::reset, "Plant.reset"), py::arg("x0") = 0.0, py::arg("t0") = 0.0)
+      .def("reset_state",
+           [](Plant& p, const std::vector<double>& y0, double t0) {
+             bindings::require_idle(&p, "Plant.reset_state");
+             p.reset_state(to_state(p.dynamics(), y0), t0);
+           },
+           py::arg("y0"), py::arg("t0") = 0.0)
       .def("step",
            [](Plant& p, double u) {
+             bindings::require_idle(&p, "Plant.step");
              Output o;
              Status s = p.step(u, o);
              return py::make_tuple(s, o);
@@ -138,6 +217,7 @@ void expose_plant(py::module_& m) {
            py::arg("command"))
       .def("observe",
            [](const Plant& p) {
+             bindings::require_idle(&p, "Plant.observe");
              Output o;
              p.observe(o);
              return o;
@@ -145,7 +225,9 @@ void expose_plant(py::module_& m) {
       .def_property_readonly("time", &Plant::time)
       .def_property_readonly("rk4_substeps", &Plant::rk4_substeps)
       .def_property_readonly("dt", &Plant::dt)
-      .def_property_readonly("state", &Plant::state)
+      .def_property_readonly("state", [](const Plant& p) { return from_state(p.dynamics(), p.state()); })
+      .def_property_readonly("states", [](const Plant& p) { return state_table(p.dynamics()); },
+                             "((name, unit, doc), ...) of the active states, in order")
       .def_property_readonly("dynamics", &Plant::dynamics, py::return_value_policy::reference_internal)
       .def_property_readonly("total_internal_steps", &Plant::total_internal_steps)
       .def_property_readonly("total_rhs_evals", &Plant::total_rhs_evals)

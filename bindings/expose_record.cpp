@@ -1,6 +1,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include "busy.hpp"
 #include "channels_py.hpp"
 #include "servohydraulics/record.hpp"
 
@@ -33,6 +34,7 @@ void expose_record(py::module_& m) {
         const double* u = command.data();
         RunSummary sum;
         {
+          bindings::BusyGuard busy({&plant}, "run_record");
           py::gil_scoped_release release;
           sum = run_record(plant, u, n, ch);
         }

@@ -55,9 +55,11 @@ void expose_rig(py::module_& m) {
       .def_readwrite("b", &FlowCurve::b)
       .def_readwrite("opening", &FlowCurve::opening)
       .def_readwrite("flow", &FlowCurve::flow)
-      .def("eval", &FlowCurve::eval, py::arg("x"))
-      .def("slope", &FlowCurve::slope, py::arg("x"))
-      .def("inverse", &FlowCurve::inverse, py::arg("q"))
+      // A table curve is assigned field by field, so it is validated where it is used
+      // (ValueError naming the field): never an out-of-bounds read (rig.cpp).
+      .def("eval", [](const FlowCurve& f, double x) { return f.validate(), f.eval(x); }, py::arg("x"))
+      .def("slope", [](const FlowCurve& f, double x) { return f.validate(), f.slope(x); }, py::arg("x"))
+      .def("inverse", [](const FlowCurve& f, double q) { return f.validate(), f.inverse(q); }, py::arg("q"))
       .def("validate", &FlowCurve::validate);
   add_protocol(fc, {"kind", "b", "opening", "flow"});
 

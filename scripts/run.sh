@@ -4,10 +4,13 @@
 #   scripts/run.sh demo    the main job on built-in defaults (plots + summaries in demo_out/)
 #   scripts/run.sh test    all tests: C++ (ctest) and Python (pytest)
 #   scripts/run.sh bench   the step-time benchmarks (docs/benchmarks.md)
+#   scripts/run.sh sanitize  the C++ tests (with the SUNDIALS failure injection) and a short
+#                          Python smoke run under AddressSanitizer, UBSan and LeakSanitizer
+#                          (docs/robustness.md)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
-venv="$root/.venv"
+venv=${VENV:-"$root/.venv"}
 py=${PYTHON:-python3}
 jobs=${JOBS:-2}
 
@@ -39,10 +42,34 @@ python_env() {
 
 cxx_tests() {
   local b="$root/build/ctest"
+  # SH_BUILD_FMU: the FMU binary and its C-ABI test (the FMI headers come from the venv's fmpy)
   "$venv/bin/cmake" -S "$root" -B "$b" -G Ninja -DSH_BUILD_TESTS=ON -DCMAKE_BUILD_TYPE=Release \
+    -DSH_BUILD_FMU=ON -DPython_EXECUTABLE="$venv/bin/python" \
     -DCMAKE_MAKE_PROGRAM="$venv/bin/ninja" >/dev/null
   "$venv/bin/cmake" --build "$b" -j "$jobs"
   PATH="$venv/bin:$PATH" "$venv/bin/ctest" --test-dir "$b" --output-on-failure -j "$jobs"
+}
+
+# A small Debug build: the core and the C++ tests at -O1 with ASan + UBSan (+ LSan, part of
+# ASan on Linux), the Python module's glue at -O0 linked to them; nothing else (no packaging
+# test, no examples).  Any report fails the run.
+sanitize() {
+  local b="$root/build/sanitize"
+  local flags="-O1;-g;-fno-omit-frame-pointer;-fsanitize=address,undefined;-fno-sanitize-recover=all"
+  local pybind; pybind=$("$venv/bin/python" -c 'import pybind11; print(pybind11.get_cmake_dir())')
+  "$venv/bin/cmake" -S "$root" -B "$b" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG=-O0 \
+    -DSH_BUILD_TESTS=ON -DSH_BUILD_PYTHON=ON -DSH_SANITIZE="$flags" -DCMAKE_MAKE_PROGRAM="$venv/bin/ninja" \
+    -DPython_EXECUTABLE="$venv/bin/python" -Dpybind11_DIR="$pybind" >/dev/null
+  "$venv/bin/cmake" --build "$b" -j "$jobs"
+  export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1
+  export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+  PATH="$venv/bin:$PATH" "$venv/bin/ctest" --test-dir "$b" --output-on-failure -j "$jobs" -L core
+  # Python smoke: the sanitized _core inside an unsanitized interpreter (libasan preloaded).
+  # The interpreter's own allocations at exit are not ours: leaks are checked by the C++ tests.
+  # libstdc++ preloaded too: ASan must find the real __cxa_throw when it starts.
+  local asan; asan="$(${CXX:-c++} -print-file-name=libasan.so) $(${CXX:-c++} -print-file-name=libstdc++.so)"
+  LD_PRELOAD="$asan" ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 PYTHONPATH="$root/python" \
+    SERVOHYDRAULICS_CORE_DIR="$b" "$venv/bin/python" "$root/tests/python/sanitize_smoke.py"
 }
 
 case "${1:-}" in
@@ -63,8 +90,12 @@ case "${1:-}" in
     system_deps; python_env
     PATH="$venv/bin:$PATH" "$venv/bin/python" "$root/benchmarks/run.py"
     ;;
+  sanitize)
+    [ -x "$venv/bin/python" ] || { system_deps; python_env; }
+    sanitize
+    ;;
   *)
-    echo "usage: scripts/run.sh demo|test|bench" >&2
+    echo "usage: scripts/run.sh demo|test|bench|sanitize" >&2
     exit 2
     ;;
 esac

@@ -3,7 +3,10 @@
 // (detail/cvode_integrator, detail/rk4_integrator) held in a std::variant.
 #include "servohydraulics/plant.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
+#include <type_traits>
 #include <utility>
 #include <variant>
 
@@ -24,6 +27,40 @@ SolverOptions checked(const SolverOptions& o, double dt) {
   o.validate();
   return o;
 }
+
+// A digital delay in whole samples plus a fraction in [0, 1) of dt.
+struct SampleDelay {
+  int whole = 0;
+  double frac = 0.0;
+  bool any() const noexcept { return whole > 0 || frac > 0.0; }
+};
+
+// delay [s] in samples of dt, at most kMaxDelaySamples; within 1e-9 of a whole sample is that sample.
+SampleDelay sample_delay(const char* field, double delay, double dt) {
+  const double q = delay / dt;
+  const std::string why = "must be at most " + std::to_string(kMaxDelaySamples) + " samples of dt = " +
+                          std::to_string(dt) + " s (" + std::to_string(q) + " samples) [s]";
+  require(std::isfinite(q) && q <= kMaxDelaySamples + 1e-9, field, delay, why.c_str());
+  SampleDelay d;
+  d.whole = static_cast<int>(std::floor(q + 1e-9));
+  d.frac = q - d.whole;
+  if (d.frac < 1e-9) d.frac = 0.0;
+  return d;
+}
+
+// The last values of a sampled signal, index j = samples since reset (fixed capacity: no allocation).
+struct History {
+  static constexpr int kSize = kMaxDelaySamples + 3;
+  double v[kSize] = {};
+  // Value j, or the first one for j < 0 (the signal held its first value before the reset).
+  double at(long j) const noexcept { return v[(j < 0 ? 0 : j) % kSize]; }
+  void put(long j, double x) noexcept { v[j % kSize] = x; }
+  // The value delay d before sample j: linear interpolation between the neighbouring samples.
+  double delayed(long j, const SampleDelay& d) const noexcept {
+    const double a = at(j - d.whole);
+    return d.frac == 0.0 ? a : (1.0 - d.frac) * a + d.frac * at(j - d.whole - 1);
+  }
+};
 
 // Built in place (CvodeIntegrator is pinned: CVODE holds its address).
 Integrator make_integrator(const Dynamics& dyn, double dt, const SolverOptions& opt) {
@@ -46,10 +83,44 @@ struct Plant::Impl {
   bool have_prev_u = false;
   bool failed = false;
   Integrator integ;
+  // Digital delays (docs/specimens.md): the command's, and the measured displacement's and force's.
+  SampleDelay cmd_delay, disp_delay, force_delay;
+  History commands, displacements, forces;
 
   Impl(const Rig& rig, ControlMode mode, double dt_, const SolverOptions& o)
       : dyn(rig, mode), opt(checked(o, dt_)), dt(dt_), integ(make_integrator(dyn, dt, opt)) {
     if (auto* rk4 = std::get_if<detail::Rk4Integrator>(&integ)) opt.rk4_substeps = rk4->substeps();
+    const Rig& r = dyn.rig();
+    cmd_delay = sample_delay("command_delay", r.command_delay, dt);
+    disp_delay = sample_delay("measurement_delay_displacement", r.measurement_delay_displacement, dt);
+    force_delay = sample_delay("measurement_delay_force", r.measurement_delay_force, dt);
+  }
+
+  // Integrate from t to t_end with input `in`; RK4 takes `substeps` (0: its own count).
+  Status advance(const Dynamics::Input& in, double t_end, int substeps) noexcept {
+    return std::visit(
+        [&](auto& integ) {
+          using T = std::decay_t<decltype(integ)>;
+          if constexpr (std::is_same_v<T, detail::Rk4Integrator>)
+            return integ.advance(dyn, in, y, t, t_end, substeps);
+          else
+            return integ.advance(dyn, in, y, t, t_end);
+        },
+        integ);
+  }
+
+  // The held input that command j sets: its value and its rate (last increment / dt; 0 for the first).
+  Dynamics::Input held(long j) const noexcept {
+    const double rate = j <= 0 ? 0.0 : (commands.at(j) - commands.at(j - 1)) / dt;
+    return {commands.at(j), rate};
+  }
+  Status advance_delayed(double t_next) noexcept;
+  void record_measurements() noexcept {
+    if (!disp_delay.any() && !force_delay.any()) return;
+    Output o;
+    dyn.outputs(y.data(), input, o);
+    displacements.put(k, o.displacement);
+    forces.put(k, o.force);
   }
 
   bool state_ok() const noexcept {
@@ -81,6 +152,34 @@ void Plant::reset_state(const State& y0, double t0) noexcept {
   m.have_prev_u = false;
   m.failed = false;
   std::visit([&](auto& integ) { integ.reset(m.y, m.t); }, m.integ);
+  m.record_measurements();
+}
+
+// With a command delay of (D + f) samples, command j holds over [t_j + (D + f) dt, t_(j+1) + (D + f) dt):
+// over sample k the held value is command k-D-1 until t_k + f dt, then command k-D.  Both parts are
+// integrated exactly as any sample (CVODE stops at the switch; RK4 shares its substeps between them).
+Status Plant::Impl::advance_delayed(double t_next) noexcept {
+  const long j = k - cmd_delay.whole;
+  if (cmd_delay.frac == 0.0) {
+    input = held(j);
+    return advance(input, t_next, 0);
+  }
+  const double t_switch = t0 + (static_cast<double>(k) + cmd_delay.frac) * dt;
+  int n1 = 0, n2 = 0;
+  if (const auto* rk4 = std::get_if<detail::Rk4Integrator>(&integ)) {
+    const int n = rk4->substeps();
+    n1 = std::max(1, static_cast<int>(std::lround(cmd_delay.frac * n)));
+    n2 = std::max(1, n - n1);
+  }
+  input = held(j - 1);
+  Status first = advance(input, t_switch, n1);
+  if (!first.ok()) return first;
+  input = held(j);
+  Status st = advance(input, t_next, n2);
+  st.internal_steps += first.internal_steps;
+  st.rhs_evals += first.rhs_evals;
+  st.restarted = st.restarted || first.restarted;
+  return st;
 }
 
 Status Plant::step(double command, Output& out) noexcept {
@@ -100,26 +199,39 @@ Status Plant::step(double command, Output& out) noexcept {
     observe(out);
     return st;
   }
-  // Zero-order hold: the command is held over the sample, its rate is the last increment / dt.
-  m.input.u = command;
-  m.input.u_rate = m.have_prev_u ? (command - m.prev_u) / m.dt : 0.0;
-  m.prev_u = command;
-  m.have_prev_u = true;
-
   const double t_next = m.t0 + static_cast<double>(m.k + 1) * m.dt;
-  Status st = std::visit([&](auto& integ) { return integ.advance(m.dyn, m.input, m.y, m.t, t_next); }, m.integ);
+  Status st;
+  if (!m.cmd_delay.any()) {
+    // Zero-order hold: the command is held over the sample, its rate is the last increment / dt.
+    m.input.u = command;
+    m.input.u_rate = m.have_prev_u ? (command - m.prev_u) / m.dt : 0.0;
+    m.prev_u = command;
+    m.have_prev_u = true;
+    st = std::visit([&](auto& integ) { return integ.advance(m.dyn, m.input, m.y, m.t, t_next); }, m.integ);
+  } else {
+    m.commands.put(m.k, command);
+    st = m.advance_delayed(t_next);
+  }
   if (st.ok() && !m.state_ok()) {
     st.code = Status::NonFinite;
   }
-  if (st.ok()) ++m.k;
-  else m.failed = true;
+  if (st.ok()) {
+    ++m.k;
+    m.record_measurements();
+  } else {
+    m.failed = true;
+  }
   observe(out);
   return st;
 }
 
 void Plant::observe(Output& out) const noexcept {
-  out.time = impl_->t;
-  impl_->dyn.outputs(impl_->y.data(), impl_->input, out);
+  const Impl& m = *impl_;
+  out.time = m.t;
+  m.dyn.outputs(m.y.data(), m.input, out);
+  // Acquisition delays: the measured channels as the controller sees them (docs/specimens.md).
+  if (m.disp_delay.any()) out.displacement = m.displacements.delayed(m.k, m.disp_delay);
+  if (m.force_delay.any()) out.force = m.forces.delayed(m.k, m.force_delay);
 }
 
 double Plant::time() const noexcept { return impl_->t; }

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <string>
 
 #include "servohydraulics/parameters.hpp"
+#include "servohydraulics/state.hpp"
 
 namespace servohydraulics {
 
@@ -20,6 +22,14 @@ std::size_t segment(const std::vector<double>& xs, double a) noexcept {
   i = i == 0 ? 0 : i - 1;
   return std::min(i, xs.size() - 2);
 }
+
+// A table the interpolation can index: at least 2 points and as many flows as
+// openings.  eval/slope/inverse are noexcept and on the hot path, so a table
+// that is not (assigned field by field and never validated) gives NaN, which
+// the integrators report as a NonFinite status, never an out-of-bounds read;
+// the Python binding validates before it calls them (ValueError naming the field).
+bool indexable(const FlowCurve& fc) noexcept { return fc.opening.size() >= 2 && fc.flow.size() == fc.opening.size(); }
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }  // namespace
 
 double FlowCurve::eval(double x) const noexcept {
@@ -28,6 +38,7 @@ double FlowCurve::eval(double x) const noexcept {
   if (kind == Kind::Rational) {
     g = a / (1.0 + b * a);
   } else {
+    if (!indexable(*this)) return kNaN;
     const std::size_t i = segment(opening, a);
     const double s = (flow[i + 1] - flow[i]) / (opening[i + 1] - opening[i]);
     g = flow[i] + s * (a - opening[i]);
@@ -41,6 +52,7 @@ double FlowCurve::slope(double x) const noexcept {
     const double d = 1.0 + b * a;
     return 1.0 / (d * d);
   }
+  if (!indexable(*this)) return kNaN;
   const std::size_t i = segment(opening, a);
   return (flow[i + 1] - flow[i]) / (opening[i + 1] - opening[i]);
 }
@@ -54,6 +66,7 @@ double FlowCurve::inverse(double q) const noexcept {
     const double aa = std::min(a, amax);
     x = aa / (1.0 - b * aa);
   } else {
+    if (!indexable(*this)) return kNaN;
     const auto it = std::upper_bound(flow.begin(), flow.end(), a);
     std::size_t i = static_cast<std::size_t>(it - flow.begin());
     i = i == 0 ? 0 : i - 1;
@@ -76,9 +89,10 @@ void FlowCurve::validate() const {
   require(opening[0] == 0.0, "flow_curve.opening[0]", opening[0], "must be 0");
   require(flow[0] == 0.0, "flow_curve.flow[0]", flow[0], "must be 0 (no flow at null)");
   for (std::size_t i = 1; i < opening.size(); ++i) {
-    require(std::isfinite(opening[i]) && opening[i] > opening[i - 1], "flow_curve.opening[i]", opening[i],
+    const std::string at = "[" + std::to_string(i) + "]";
+    require(std::isfinite(opening[i]) && opening[i] > opening[i - 1], ("flow_curve.opening" + at).c_str(), opening[i],
             "must be finite and strictly increasing");
-    require(std::isfinite(flow[i]) && flow[i] > flow[i - 1], "flow_curve.flow[i]", flow[i],
+    require(std::isfinite(flow[i]) && flow[i] > flow[i - 1], ("flow_curve.flow" + at).c_str(), flow[i],
             "must be finite and strictly increasing (the curve must be invertible)");
   }
 }
@@ -88,6 +102,7 @@ const char* bound_text(Bound b) noexcept {
     case Bound::Positive: return "finite and > 0";
     case Bound::NonNegative: return "finite and >= 0";
     case Bound::AtLeastOne: return "finite and >= 1";
+    case Bound::PadeOrder: return "an integer in 1..6";
   }
   return "";
 }
@@ -97,6 +112,7 @@ bool within(Bound b, double v) noexcept {
     case Bound::Positive: return finite_positive(v);
     case Bound::NonNegative: return finite_nonneg(v);
     case Bound::AtLeastOne: return std::isfinite(v) && v >= 1.0;
+    case Bound::PadeOrder: return std::isfinite(v) && v >= 1.0 && v <= kMaxPadeOrder && v == std::floor(v);
   }
   return false;
 }

@@ -34,7 +34,7 @@ except ImportError as e:  # pragma: no cover - only without a built core
         f"build directory made by scripts/dev-build.sh ({e})"
     ) from e
 
-from ._core import ControlMode, Dynamics, FlowCurve, Plant, SolverOptions  # noqa: E402
+from ._core import ConcurrentUseError, ControlMode, Dynamics, FlowCurve, Plant, SolverOptions  # noqa: E402
 from .controllers import EftController, RpsdController  # noqa: E402
 from .loops import run_eft, run_rpsd, run_tracking  # noqa: E402
 from .records import read_record, write_record  # noqa: E402
@@ -65,6 +65,7 @@ _LAZY = {
     "diagnose": (".diagnosis", "diagnose"),
     "Diagnosis": (".diagnosis", "Diagnosis"),
     "reproduce": (".paper.reproduce", "reproduce"),
+    "export_fmu": (".fmu", "export_fmu"),
 }
 
 #: Deprecated names, kept for one release: name -> (replacement, object).
@@ -113,6 +114,7 @@ _sys.modules[__name__].__class__ = _Package
 
 __all__ = [
     "PARAMETERS",
+    "ConcurrentUseError",
     "ControlMode",
     "Diagnosis",
     "Dynamics",
@@ -127,6 +129,7 @@ __all__ = [
     "SolverOptions",
     "copy_rig",
     "diagnose",
+    "export_fmu",
     "identify",
     "linearize",
     "load_rig",

@@ -4,6 +4,7 @@ command's work lives in its own module."""
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Sequence
 
@@ -101,12 +102,37 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Runs a command.  Exit codes: 0 done, 1 the run failed (a solver failure or
+    an internal error), 2 bad input or a file that cannot be read or written,
+    130 interrupted; every failure is one line on stderr, never a traceback
+    (``SERVOHYDRAULICS_DEBUG=1`` re-raises for a traceback)."""
     args = build_parser().parse_args(argv)
+    where = f"servohydraulics {args.command}"
     try:
         return int(args.func(args) or 0)
-    except (ValueError, FileNotFoundError) as e:
-        print(f"servohydraulics {args.command}: error: {e}", file=sys.stderr)
-        return 2
+    except Exception as e:  # noqa: BLE001 - the one place that turns any failure into a message
+        if os.environ.get("SERVOHYDRAULICS_DEBUG"):
+            raise
+        code, text = _failure(e)
+        print(f"{where}: error: {text}", file=sys.stderr)
+        return code
+    except KeyboardInterrupt:
+        print(f"{where}: interrupted", file=sys.stderr)
+        return 130
+
+
+def _failure(e: Exception) -> tuple[int, str]:
+    """(exit code, one-line message) of an exception escaping a command."""
+    from .response import SimulationError
+
+    text = " ".join(str(e).split()) or type(e).__name__
+    if isinstance(e, (ValueError, OSError)):  # bad input; files (OSError messages name the file)
+        if isinstance(e, OSError) and e.filename and str(e.filename) not in text:
+            text = f"{e.filename}: {text}"
+        return 2, text
+    if isinstance(e, SimulationError):
+        return 1, text
+    return 1, f"internal error ({type(e).__name__}: {text}); please report it with the command line"
 
 
 if __name__ == "__main__":

@@ -47,16 +47,27 @@ def _positive(name: str, value: float) -> float:
     return float(value)
 
 
+#: Longest time axis made here: 50 M samples (7 h at 2 kHz, 400 MB per channel).
+MAX_SAMPLES = 50_000_000
+
+
 def time_axis(duration: float, dt: float = DT) -> np.ndarray:
-    """t_k = k dt for k = 0..round(duration/dt) [s]."""
+    """t_k = k dt for k = 0..round(duration/dt) [s] (at most MAX_SAMPLES samples)."""
     _positive("duration", duration)
     _positive("dt", dt)
-    return np.arange(int(round(duration / dt)) + 1) * dt
+    n = duration / dt
+    if not n < MAX_SAMPLES:
+        raise ValueError(f"invalid duration = {duration!r} s at dt = {dt!r} s: {n:.3g} samples, more than "
+                         f"the {MAX_SAMPLES:,} allowed")
+    return np.arange(int(round(n)) + 1) * dt
 
 
 def sine(amplitude: float, frequency: float, duration: float, dt: float = DT, phase: float = 0.0) -> np.ndarray:
     """amplitude * sin(2 pi f t + phase); frequency [Hz], duration and dt [s]."""
     _positive("frequency", frequency)
+    for name, v in (("amplitude", amplitude), ("phase", phase)):
+        if not math.isfinite(v):
+            raise ValueError(f"invalid {name} = {v!r}: must be finite")
     t = time_axis(duration, dt)
     return amplitude * np.sin(2 * np.pi * frequency * t + phase)
 

@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike
 from . import _core
 from .response import Response, finish
 from .rig import Rig
-from .simulate import simulate
+from .simulate import _assign, simulate
 from .simulate import solver_options as _solver_options
 
 COMPENSATION = {"none": _core.VelocityFeedbackCompensator.Kind.None_,
@@ -82,10 +82,15 @@ def _renamed(old: str, old_value, new: str, new_value):
 
 
 def _set(cfg: object, **values) -> None:
-    """Set the config fields that were given (None keeps the core's default)."""
-    for name, v in values.items():
-        if v is not None:
-            setattr(cfg, name, v)
+    """Set the config fields that were given (None keeps the core's default); a value the
+    C++ field cannot hold is a ValueError naming it (simulate._assign)."""
+    _assign(cfg, **values)
+
+
+def _integer(name: str, v) -> int:
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v != int(v):
+        raise ValueError(f"invalid {name} = {v!r}: expected a whole number")
+    return int(v)
 
 
 def _choice(name: str, v: str, table: dict):
@@ -103,7 +108,7 @@ def eft_config(dt: float | None = None, compensation: str = "linear", lead_T: fl
     _set(cfg, dt=dt, alpha=alpha, mass=mass, plant_options=solver_options)
     cfg.compensation = _choice("compensation", compensation, COMPENSATION)
     cfg.lead_T = _nonneg("lead_T", _default(lead_T, cfg, "lead_T"))
-    cfg.compute_delay = int(compute_delay)
+    _set(cfg, compute_delay=_integer("compute_delay", compute_delay))
     cfg.validate()
     return cfg
 
@@ -168,10 +173,10 @@ def rpsd_config(dt: float | None = None, m_m: float | None = None, c_m: float | 
     if delay_T is None and restoring_force == "calculated_displacement":
         delay_T = 0.0
     cfg.delay_T = _nonneg("delay_T", _default(delay_T, cfg, "delay_T"))
-    cfg.physical_mass_fraction = physical_mass_fraction
+    _set(cfg, physical_mass_fraction=physical_mass_fraction)
     cfg.subtract_mass = None if subtract_mass is None else _nonneg("subtract_mass", subtract_mass)
     cfg.subtract_damping = None if subtract_damping is None else _nonneg("subtract_damping", subtract_damping)
-    cfg.compute_delay = int(compute_delay)
+    _set(cfg, compute_delay=_integer("compute_delay", compute_delay))
     cfg.validate()
     return cfg
 

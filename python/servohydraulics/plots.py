@@ -17,6 +17,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
 
+from .atomic import write_with
 from .excitations import TWO_PI
 NOTE = ("Simulated counterpart. The paper's measured curves are not available: "
         "compare with the paper's stated numbers (reproduction.md).")
@@ -34,8 +35,7 @@ def new_figure(title: str, nrows: int = 1, ncols: int = 1, figsize=(8.0, 5.0), *
 def save(fig, path: Path) -> Path:
     """Tight layout (room for the note), save as PNG at 110 dpi."""
     fig.tight_layout(rect=(0, 0.04, 1, 0.96))
-    fig.savefig(path, dpi=110)
-    return Path(path)
+    return write_with(path, lambda tmp: fig.savefig(tmp, dpi=110))
 
 
 def bode(ax_mag, ax_phase, sys_: ct.LTI, f: ArrayLike, label: str, db: bool = False, **style) -> None:

@@ -39,10 +39,12 @@ UNIT_SUFFIXED_COLUMNS = {"time_s": "time", "command_m": "command", "command_N": 
 
 def _columns(path: Path, header: str) -> list[str]:
     names = [UNIT_SUFFIXED_COLUMNS.get(h.strip(), h.strip()) for h in header.split(",")]
-    twice = sorted({n for n in names if names.count(n) > 1})
-    if twice:
-        raise ValueError(f"{path}: column(s) {twice} given twice (unit-suffixed names count as their channel)")
+    seen: set[str] = set()
     for i, n in enumerate(names):
+        if n in seen:
+            raise ValueError(f"{path}: column {n!r} appears twice in the header (columns {i + 1} and "
+                             f"{names.index(n) + 1})")
+        seen.add(n)
         if n in DEPRECATED_COLUMNS:
             warnings.warn(f"{path}: column {n!r} is deprecated; name it {DEPRECATED_COLUMNS[n]!r}",
                           DeprecationWarning, stacklevel=3)
@@ -62,10 +64,18 @@ def read_record(path: str | Path) -> Response:
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"record file not found: {path}")
-    with path.open() as f:
-        names = _columns(path, f.readline().strip())
+    if path.is_dir():
+        raise ValueError(f"record file {path} is a directory")
+    try:  # utf-8-sig: a byte-order mark (spreadsheet export) is not part of the first column's name
+        lines = path.read_text(encoding="utf-8-sig").splitlines()
+    except UnicodeDecodeError as e:
+        raise ValueError(f"{path}: not a UTF-8 text file ({e.reason} at byte {e.start})") from None
+    names = _columns(path, lines[0].strip() if lines else "")
+    rows = [ln for ln in lines[1:] if ln.strip()]
+    if not rows:
+        raise ValueError(f"{path}: no data rows after the header")
     try:
-        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+        data = np.loadtxt(rows, delimiter=",", ndmin=2)
     except ValueError as e:
         raise ValueError(f"{path}: could not parse numbers: {e}") from None
     if data.shape[1] != len(names):

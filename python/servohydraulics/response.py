@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
+from .atomic import atomic_path
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -286,7 +287,8 @@ class Response:
 
     def to_csv(self, path: str | Path) -> Path:
         """Writes every channel to a record CSV (``time, command, displacement,
-        force`` first); ``read_record`` reads it back.  Returns the path."""
+        force`` first); ``read_record`` reads it back.  Returns the path.  The file is
+        written whole or not at all (``atomic``: an OSError naming it on failure)."""
         path = Path(path)
         missing = [c for c in REQUIRED if c not in self.channels]
         if missing:
@@ -300,7 +302,8 @@ class Response:
             if not np.all(np.isfinite(c)):
                 raise ValueError(f"cannot write {path}: channel {n!r} has non-finite values")
         uniform_dt(cols[0], f"cannot write {path}")
-        np.savetxt(path, np.column_stack(cols), delimiter=",", header=",".join(names), comments="", fmt="%.10g")
+        with atomic_path(path) as tmp:
+            np.savetxt(tmp, np.column_stack(cols), delimiter=",", header=",".join(names), comments="", fmt="%.10g")
         return path
 
 

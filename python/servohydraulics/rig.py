@@ -1,8 +1,9 @@
 """Rig parameters: the paper's presets and TOML rig files.
 
 A rig file is TOML with one table per subsystem and keys named after the
-symbols of Zhao et al. (2003), Table I, in SI units.  Unknown keys are an
-error.  ``PARAMETERS`` (keys, units, sources) and ``EFFECTS`` come from the
+symbols of Zhao et al. (2003), Table I, in SI units; the specimens
+(Bouc-Wen, MR damper) are in ``[specimen]`` and the delays inside the loop in
+``[delays]`` (docs/specimens.md).  Unknown keys are an error.  ``PARAMETERS`` (keys, units, sources) and ``EFFECTS`` come from the
 core's one parameter table (``_core.RIG_PARAMETERS``, ``_core.EFFECTS``); the
 README's key table is generated from it (``python -m servohydraulics.rig``).
 ``Rig`` has ``==``, ``repr``, ``copy.copy`` and pickle from the binding.
@@ -18,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from . import _core
+from .atomic import write_text
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -86,7 +88,11 @@ def rig_to_dict(rig: Rig) -> dict[str, dict[str, Any]]:
 def _number(where: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ValueError(f"invalid {where} = {value!r}: expected a number")
-    v = float(value)
+    try:
+        v = float(value)
+    except OverflowError:  # an integer beyond the double range
+        raise ValueError(f"invalid {where} = an integer of {value.bit_length()} bits: too large for a number "
+                         "(> 1.8e308)") from None
     if not math.isfinite(v):
         raise ValueError(f"invalid {where} = {value!r}: must be finite")
     return v
@@ -161,13 +167,16 @@ def load_rig(path: str | Path) -> Rig:
     """Reads a TOML rig file over the calibrated preset (keys not given keep
     the preset's values)."""
     path = Path(path)
-    try:
-        with path.open("rb") as f:
-            data = tomllib.load(f)
+    try:  # utf-8-sig: an editor's byte-order mark is not TOML
+        data = tomllib.loads(path.read_bytes().decode("utf-8-sig"))
     except FileNotFoundError:
         raise FileNotFoundError(f"rig file not found: {path}") from None
-    except tomllib.TOMLDecodeError as e:
+    except UnicodeDecodeError as e:
+        raise ValueError(f"rig file {path} is not UTF-8 text ({e.reason} at byte {e.start})") from None
+    except (tomllib.TOMLDecodeError, ValueError) as e:  # ValueError: e.g. an integer of > 4300 digits
         raise ValueError(f"rig file {path} is not valid TOML: {e}") from None
+    except IsADirectoryError:
+        raise ValueError(f"rig file {path} is a directory") from None
     try:
         return rig_from_dict(data)
     except ValueError as e:
@@ -175,12 +184,11 @@ def load_rig(path: str | Path) -> Rig:
 
 
 def save_rig(rig: Rig, path: str | Path) -> Path:
-    """Writes every parameter of the rig to a TOML file (SI units)."""
+    """Writes every parameter of the rig to a TOML file (SI units), whole or not at all."""
     rig.validate()
     path = Path(path)
     header = "# servohydraulics rig file: SI units, keys after Zhao et al. (2003) Table I\n"
-    path.write_text(header + tomli_w.dumps(rig_to_dict(rig)))
-    return path
+    return write_text(path, header + tomli_w.dumps(rig_to_dict(rig)))
 
 
 def parameter_table() -> str:

@@ -12,6 +12,9 @@ from .excitations import time_axis
 from .response import Response, SimulationError, finish
 from .rig import Rig
 
+#: Largest initial displacement [m]: the plant's divergence guard (plant.cpp, kMaxDisplacement).
+MAX_X0 = 100.0
+
 MODES = {
     "displacement": _core.ControlMode.Displacement,
     "force": _core.ControlMode.Force,
@@ -34,16 +37,25 @@ def solver_options(method: str = "cvode", rtol: float = 1e-6, restart: str = "on
     o = _core.SolverOptions()
     o.method = METHODS[method]
     o.restart = RESTARTS[restart]
-    o.rtol = rtol
-    o.rk4_substeps = rk4_substeps
-    o.max_steps_per_sample = max_steps_per_sample
-    o.max_order = max_order
-    if rk4_h_rho is not None:
-        o.rk4_h_rho = rk4_h_rho
-    if rk4_v_ref is not None:
-        o.rk4_v_ref = rk4_v_ref
+    _assign(o, rtol=rtol, rk4_substeps=rk4_substeps, max_steps_per_sample=max_steps_per_sample,
+            max_order=max_order, rk4_h_rho=rk4_h_rho, rk4_v_ref=rk4_v_ref)
     o.validate()
     return o
+
+
+def _assign(obj: object, **fields) -> None:
+    """Sets the binding's fields (None: keep its default); a value the C++ type cannot
+    hold (a string, an integer beyond 32 bits) is a ValueError naming the field."""
+    for name, value in fields.items():
+        if value is None:
+            continue
+        try:
+            setattr(obj, name, value)
+        except TypeError:
+            kind = type(getattr(obj, name)).__name__
+            text = f"an integer of {value.bit_length()} bits" if isinstance(value, int) else repr(value)
+            raise ValueError(f"invalid {name} = {text}: expected a value of type {kind} in the range of "
+                             "the C++ field") from None
 
 
 def _check_dt(dt: float) -> float:
@@ -80,8 +92,9 @@ def make_plant(rig: Rig, mode: str, dt: float = 5e-4, options: _core.SolverOptio
     """Constructs and resets a plant (validates everything, raises ValueError)."""
     if mode not in MODES:
         raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(MODES)}")
-    if not math.isfinite(x0):
-        raise ValueError(f"invalid x0 = {x0!r}: must be finite [m]")
+    if not math.isfinite(x0) or abs(x0) > MAX_X0:
+        raise ValueError(f"invalid x0 = {x0!r}: must be finite and within +-{MAX_X0:g} m (the plant's "
+                         "divergence guard)")
     plant = _core.Plant(rig, MODES[mode], _check_dt(dt), options or _core.SolverOptions())
     plant.reset(float(x0))
     return plant

@@ -110,7 +110,7 @@ void check_overrun() {
 int main() {
   // The counter must see C++ and C allocations, including those made inside
   // SUNDIALS (CVodeCreate, N_VNew_Serial, ...).
-  {
+  if (sh_test::kCountingAllocations) {
     sh_test::AllocationCounter counter;
     std::vector<double>* v = new std::vector<double>(16);
     delete v;
@@ -134,8 +134,10 @@ int main() {
   }
   std::printf("construction: %ld allocations with RK4, %ld with CVODE (SUNDIALS' own mallocs are seen)\n",
               rk4_construct, cvode_construct);
-  CHECK(rk4_construct >= 1);
-  CHECK(cvode_construct >= rk4_construct + 5);
+  if (sh_test::kCountingAllocations) {
+    CHECK(rk4_construct >= 1);
+    CHECK(cvode_construct >= rk4_construct + 5);
+  }
 
   SolverOptions cvode;
   SolverOptions never;

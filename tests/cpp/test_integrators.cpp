@@ -47,7 +47,7 @@ void check_no_leak_on_throw() {
   }
   CHECK(threw);
   CHECK(what.find("priming step") != std::string::npos);  // thrown after every SUNDIALS object existed
-  CHECK(allocated >= 6);                                  // context, 2 vectors, matrix, solver, CVODE memory
+  CHECK(allocated >= 6 || !sh_test::kCountingAllocations);  // context, 2 vectors, matrix, solver, CVODE memory
   CHECK(allocated == freed);
   std::printf("throwing constructor: %ld allocations, %ld frees (%s)\n", allocated, freed, what.c_str());
 }
@@ -68,7 +68,7 @@ void check_no_leak_on_success() {
     allocated = counter.count();
     freed = counter.frees();
   }
-  CHECK(allocated >= 6);
+  CHECK(allocated >= 6 || !sh_test::kCountingAllocations);
   CHECK(allocated == freed);
   // A Plant whose RK4 integrator refuses the rig (too many automatic substeps) frees the rest.
   {
@@ -83,7 +83,7 @@ void check_no_leak_on_success() {
       threw = true;
     }
     CHECK(threw);
-    CHECK(counter.count() > 0 && counter.count() == counter.frees());
+    CHECK((counter.count() > 0 || !sh_test::kCountingAllocations) && counter.count() == counter.frees());
   }
   // A whole Plant, CVODE and RK4, balances as well.
   for (auto method : {SolverOptions::Method::CvodeBdf, SolverOptions::Method::Rk4}) {

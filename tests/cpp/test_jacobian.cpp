@@ -1,7 +1,9 @@
 // Analytic Jacobian df/dy, input gradient df/du and the linearised output
 // matrices (C, D) against central finite differences of Dynamics::rhs and
 // Dynamics::outputs, at many fixed-seed random states, in every control mode
-// and for every combination of the nine effect switches.
+// and for every combination of the twelve effect switches (the nine of the
+// paper's plant, the Bouc-Wen and MR damper specimens and the Pade loop delay,
+// whose states are appended: every loop runs over Dynamics::num_states()).
 //
 // States are drawn away from the model's kinks (where the derivative is not
 // defined or the finite difference straddles a switch): spring contact
@@ -35,7 +37,19 @@ using namespace servohydraulics;
 namespace {
 
 constexpr double kScale[kNumStates] = {1e-2, 1e-1, 1e6, 1e-1, 1e1, 1e-4};  // x [m], v [m/s], p [Pa], x_v [-], x_v' [1/s], z [m]
+
+// Scale of state j of this plant: the base states above; Bouc-Wen z and the MR damper's y, z [m];
+// the Pade states [V].
+double scale(const Dynamics& dyn, int j) {
+  const StateLayout& L = dyn.layout();
+  if (j < kNumStates) return kScale[j];
+  if (j == L.bw_z || j == L.mr_y || (L.mr_y >= 0 && j == L.mr_y + 1)) return 1e-3;
+  return 1.0;
+}
+// Ultimate |z| of a Bouc-Wen law, (A / (beta + gamma))^(1/n).
+double ultimate(double A, double bg, double n) { return bg > 0.0 ? std::pow(A / bg, 1.0 / n) : 0.01; }
 constexpr double kRelStep = 1e-6;
+constexpr int kOut = LinearModel::kOutputs;  // the linearised output channels
 constexpr double kScaledTol = 1e-6;
 constexpr double kElementTol = 1e-5;
 
@@ -51,6 +65,9 @@ void set_effects(Effects& e, unsigned mask) {
   e.drive_saturation = mask & 64u;
   e.spool_saturation = mask & 128u;
   e.lugre_friction = mask & 256u;
+  e.bouc_wen_hysteresis = mask & 512u;
+  e.mr_damper = mask & 1024u;
+  e.loop_delay = mask & 2048u;
 }
 
 struct Draw {
@@ -65,6 +82,19 @@ bool away_from_kinks(const Dynamics& dyn, const Draw& d) {
   const double margin_x = 1e-5, margin_v = 1e-3, margin_s = 1e-4;
   if (r.effects.spring_softening && std::fabs(std::fabs(y[kX]) - r.x_contact) < margin_x) return false;
   if (dyn.lugre() && std::fabs(y[kV]) < 1e-6) return false;  // |v| in the bristle equation
+  // Bouc-Wen laws: |w| (w the deformation rate) and, with n = 1, |z|.
+  const StateLayout& L = dyn.layout();
+  if (L.bw_z >= 0) {
+    if (std::fabs(y[kV]) < margin_v) return false;
+    if (r.bw_n == 1.0 && std::fabs(y[L.bw_z]) < 1e-6) return false;
+  }
+  if (L.mr_y >= 0) {
+    const double cs = (r.mr_c0_a + r.mr_c0_b * r.mr_voltage) + (r.mr_c1_a + r.mr_c1_b * r.mr_voltage);
+    const double ydot = ((r.mr_alpha_a + r.mr_alpha_b * r.mr_voltage) * y[L.mr_y + 1] +
+                         (r.mr_c0_a + r.mr_c0_b * r.mr_voltage) * y[kV] + r.mr_k0 * (y[kX] - y[L.mr_y])) / cs;
+    if (std::fabs(y[kV] - ydot) < margin_v) return false;
+    if (r.mr_n == 1.0 && std::fabs(y[L.mr_y + 1]) < 1e-6) return false;
+  }
   if (dyn.mode() == ControlMode::Free) return true;
   Output o;
   dyn.outputs(y, d.in, o);
@@ -97,6 +127,13 @@ Draw draw(sh_test::Randomizer& rnd, const Dynamics& dyn) {
   d.y[kXv] = rnd.signed_uniform(0.0, 1.3 * r.x_v_max);
   d.y[kXvDot] = rnd.signed_uniform(0.0, 50.0);
   d.y[kZ] = rnd.signed_uniform(0.0, 1.5 * r.stribeck_ratio * r.F_c / r.sigma_0);  // bristle deflection [m]
+  const StateLayout& L = dyn.layout();
+  if (L.bw_z >= 0) d.y[L.bw_z] = rnd.signed_uniform(0.0, 1.5 * ultimate(r.bw_A, r.bw_beta + r.bw_gamma, r.bw_n));
+  if (L.mr_y >= 0) {
+    d.y[L.mr_y] = d.y[kX] + rnd.signed_uniform(0.0, 0.01);
+    d.y[L.mr_y + 1] = rnd.signed_uniform(0.0, 1.5 * ultimate(r.mr_A, r.mr_beta + r.mr_gamma, r.mr_n));
+  }
+  for (int k = 0; k < L.pade_order; ++k) d.y[L.pade + k] = rnd.signed_uniform(0.0, 5.0);
   if (dyn.mode() == ControlMode::Displacement) {
     d.in.u = rnd.signed_uniform(0.0, 0.06);
     d.in.u_rate = rnd.signed_uniform(0.0, 0.5);
@@ -109,7 +146,7 @@ Draw draw(sh_test::Randomizer& rnd, const Dynamics& dyn) {
 // Step of state j at this draw: relative to the scale, and well inside the
 // friction regularisation width when v is in its steep part.
 double fd_step(const Dynamics& dyn, const Draw& d, int j) {
-  double h = kRelStep * kScale[j];
+  double h = kRelStep * scale(dyn, j);
   if (j == kV && std::fabs(d.y[kV]) < 10.0 * dyn.rig().v_stick) h = 1e-4 * dyn.rig().v_stick;
   return h;
 }
@@ -151,8 +188,9 @@ Stats check_dynamics(const Dynamics& dyn, sh_test::Randomizer& rnd, int wanted, 
     Draw d = draw(rnd, dyn);
     if (!away_from_kinks(dyn, d)) continue;
     // Also every perturbed point must stay on the same side of every kink.
+    const int n = dyn.num_states();
     bool all_away = true;
-    for (int j = 0; j < kNumStates && all_away; ++j)
+    for (int j = 0; j < n && all_away; ++j)
       for (double sgn : {-1.0, 1.0}) {
         Draw p = d;
         p.y[j] += sgn * fd_step(dyn, d, j);
@@ -172,15 +210,15 @@ Stats check_dynamics(const Dynamics& dyn, sh_test::Randomizer& rnd, int wanted, 
     dyn.jacobian(d.y.data(), d.in, J, &B);
     State f;
     dyn.rhs(d.y.data(), d.in, f.data());
-    double T[kNumStates];
-    for (int i = 0; i < kNumStates; ++i) {
+    double T[kMaxStates];
+    for (int i = 0; i < n; ++i) {
       T[i] = std::fabs(f[i]) + std::fabs(B[i]) * (std::fabs(d.in.u) + su);
-      for (int k = 0; k < kNumStates; ++k) T[i] += std::fabs(J[i][k]) * (std::fabs(d.y[k]) + kScale[k]);
+      for (int k = 0; k < n; ++k) T[i] += std::fabs(J[i][k]) * (std::fabs(d.y[k]) + scale(dyn, k));
     }
-    for (int j = 0; j < kNumStates; ++j) {
-      double col[kNumStates];
-      for (int i = 0; i < kNumStates; ++i) col[i] = J[i][j];
-      compare_column("J", j, col, kNumStates, fd_step(dyn, d, j), kScale[j], T,
+    for (int j = 0; j < n; ++j) {
+      double col[kMaxStates];
+      for (int i = 0; i < n; ++i) col[i] = J[i][j];
+      compare_column("J", j, col, n, fd_step(dyn, d, j), scale(dyn, j), T,
                      [&](double e, double* out) {
                        State y = d.y;
                        y[j] += e;
@@ -188,7 +226,7 @@ Stats check_dynamics(const Dynamics& dyn, sh_test::Randomizer& rnd, int wanted, 
                      },
                      st, where);
     }
-    compare_column("B", kNumStates, B.data(), kNumStates, kRelStep * su, su, T,
+    compare_column("B", n, B.data(), n, kRelStep * su, su, T,
                    [&](double e, double* out) {
                      Dynamics::Input in = d.in;
                      in.u += e;
@@ -204,20 +242,21 @@ Stats check_dynamics(const Dynamics& dyn, sh_test::Randomizer& rnd, int wanted, 
     auto channels = [&](const State& y, double u, double* out) {
       Output o;
       dyn.outputs(y.data(), {u, 0.0}, o);
-      const double v[8] = {o.displacement, o.velocity, o.acceleration, o.force, o.pressure, o.spool, o.drive, o.flow};
-      std::copy(v, v + 8, out);
+      const double v[kOut] = {o.displacement, o.velocity, o.acceleration, o.force, o.pressure,
+                              o.spool,        o.drive,    o.flow,         o.specimen_force};
+      std::copy(v, v + kOut, out);
     };
-    double o0[8];
+    double o0[kOut];
     channels(d0.y, d0.in.u, o0);
-    double To[8];
-    for (int i = 0; i < 8; ++i) {
+    double To[kOut];
+    for (int i = 0; i < kOut; ++i) {
       To[i] = std::fabs(o0[i]) + std::fabs(lm.D(i)) * (std::fabs(d0.in.u) + su);
-      for (int k = 0; k < kNumStates; ++k) To[i] += std::fabs(lm.C(i, k)) * (std::fabs(d0.y[k]) + kScale[k]);
+      for (int k = 0; k < n; ++k) To[i] += std::fabs(lm.C(i, k)) * (std::fabs(d0.y[k]) + scale(dyn, k));
     }
-    for (int j = 0; j < kNumStates; ++j) {
-      double col[8];
-      for (int i = 0; i < 8; ++i) col[i] = lm.C(i, j);
-      compare_column("C", j, col, 8, fd_step(dyn, d0, j), kScale[j], To,
+    for (int j = 0; j < n; ++j) {
+      double col[kOut];
+      for (int i = 0; i < kOut; ++i) col[i] = lm.C(i, j);
+      compare_column("C", j, col, kOut, fd_step(dyn, d0, j), scale(dyn, j), To,
                      [&](double e, double* out) {
                        State y = d0.y;
                        y[j] += e;
@@ -225,22 +264,23 @@ Stats check_dynamics(const Dynamics& dyn, sh_test::Randomizer& rnd, int wanted, 
                      },
                      st, where);
     }
-    double Dcol[8];
-    for (int i = 0; i < 8; ++i) Dcol[i] = lm.D(i);
-    compare_column("D", kNumStates, Dcol, 8, kRelStep * su, su, To,
+    double Dcol[kOut];
+    for (int i = 0; i < kOut; ++i) Dcol[i] = lm.D(i);
+    compare_column("D", n, Dcol, kOut, kRelStep * su, su, To,
                    [&](double e, double* out) { channels(d0.y, d0.in.u + e, out); }, st, where);
     // linearize's A, B are the Jacobian at u_rate = 0; inactive states have no dynamics.
     Jacobian J0;
     State B0;
     dyn.jacobian(d0.y.data(), d0.in, J0, &B0);
-    for (int i = 0; i < kNumStates; ++i) {
+    CHECK(lm.A.rows() == n && lm.A.cols() == n && lm.C.cols() == n && static_cast<int>(lm.active.size()) == n);
+    for (int i = 0; i < n; ++i) {
       CHECK(lm.B(i) == B0[i]);
-      for (int k = 0; k < kNumStates; ++k) CHECK(lm.A(i, k) == J0[i][k]);
+      for (int k = 0; k < n; ++k) CHECK(lm.A(i, k) == J0[i][k]);
       if (!lm.active[i]) {
         State fi;
         dyn.rhs(d0.y.data(), d0.in, fi.data());
         CHECK(fi[i] == 0.0);
-        for (int k = 0; k < kNumStates; ++k) CHECK(lm.A(i, k) == 0.0);
+        for (int k = 0; k < n; ++k) CHECK(lm.A(i, k) == 0.0);
       }
     }
   }
@@ -264,8 +304,8 @@ int main() {
     worst = std::max(worst, st.worst_scaled);
   };
 
-  // Every combination of the nine effect switches, calibrated preset.
-  for (unsigned mask = 0; mask < 512; ++mask)
+  // Every combination of the twelve effect switches, calibrated preset.
+  for (unsigned mask = 0; mask < 4096; ++mask)
     for (ControlMode mode : modes) {
       Rig rig = zhao2003();
       set_effects(rig.effects, mask);
@@ -296,6 +336,21 @@ int main() {
   Rig derivative = zhao2003();
   derivative.G_d = 0.02;  // derivative term of Eq (1), displacement control only
   run(derivative, ControlMode::Displacement, 200, "G_d = 0.02 s");
+  // The specimens and the loop delay at other parameters: n != 1, every Pade order, a voltage.
+  for (ControlMode mode : modes) {
+    Rig spec = zhao2003();
+    spec.effects.bouc_wen_hysteresis = spec.effects.mr_damper = spec.effects.loop_delay = true;
+    spec.bw_n = 2.5;
+    spec.bw_beta = 3e4;
+    spec.bw_gamma = -1e4 + 2e4;  // beta > gamma: a softening loop
+    spec.mr_voltage = 1.5;
+    spec.mr_n = 1.0;
+    for (int order = 1; order <= kMaxPadeOrder; ++order) {
+      spec.loop_delay_order = order;
+      spec.loop_delay = 1e-3 * order;
+      run(spec, mode, 40, "specimens, n 2.5 / 1, Pade order " + std::to_string(order));
+    }
+  }
   Rig underdamped = zhao2003();
   underdamped.zeta_v = 0.3;
   underdamped.f_v = 30.0;

@@ -38,7 +38,11 @@ def _every_field_changed() -> sh.Rig:
     field that save/load dropped would fall back to the preset and show."""
     rig = sh.zhao2003()
     for i, p in enumerate(PARAMETERS):
-        offset = 0.125 if p.key in ("G_d", "sigma_1") else 0.0  # defaults of 0 must change too
+        if _BOUNDS[p.key] == "an integer in 1..6":  # the Pade order: another integer
+            setattr(rig, p.key, getattr(rig, p.key) % 6 + 1)
+            continue
+        zero_default = getattr(sh.zhao2003(), p.key) == 0.0
+        offset = 0.125 * 1e-3 if zero_default else 0.0  # defaults of 0 must change too (delays: < 64 samples)
         setattr(rig, p.key, getattr(rig, p.key) * (1.0 + 0.01 * (i + 1)) + offset)
     for name in EFFECTS:
         setattr(rig.effects, name, not getattr(rig.effects, name))
@@ -81,8 +85,11 @@ def test_partial_rig_file_keeps_the_preset(tmp_path):
 
 _positive = st.floats(min_value=1e-9, max_value=1e9, allow_nan=False, allow_infinity=False)
 _nonneg = st.one_of(st.just(0.0), _positive)
-_NONNEG_KEYS = {"c", "k_2", "F_c", "m_p", "C_l", "G_p", "G_d", "sigma_1"}
-_AT_LEAST_ONE_KEYS = {"stribeck_ratio"}  # F_s / F_c >= 1
+# The bound of every key, from the core's table (parameters.hpp: kRigParameters).
+_BOUNDS = {p["key"]: p["bound"] for p in sh._core.RIG_PARAMETERS}
+_NONNEG_KEYS = {k for k, b in _BOUNDS.items() if b == "finite and >= 0"}
+_AT_LEAST_ONE_KEYS = {k for k, b in _BOUNDS.items() if b == "finite and >= 1"}  # F_s / F_c, Bouc-Wen n
+_INTEGER_KEYS = {k for k, b in _BOUNDS.items() if b == "an integer in 1..6"}  # the Pade order
 
 
 @st.composite
@@ -105,7 +112,9 @@ def _flow_curves(draw) -> sh.FlowCurve:
 def _rigs(draw) -> sh.Rig:
     rig = sh.Rig()
     for p in PARAMETERS:
-        if p.key in _AT_LEAST_ONE_KEYS:
+        if p.key in _INTEGER_KEYS:
+            setattr(rig, p.key, float(draw(st.integers(min_value=1, max_value=6))))
+        elif p.key in _AT_LEAST_ONE_KEYS:
             setattr(rig, p.key, 1.0 + draw(_nonneg))
         else:
             setattr(rig, p.key, draw(_nonneg if p.key in _NONNEG_KEYS else _positive))

@@ -98,8 +98,9 @@ def test_parameter_table_drives_validation_and_binding():
     assert [p.key for p in sh.PARAMETERS] == [row["key"] for row in rows]
     for row in rows:
         assert getattr(default, row["key"]) == row["default"]
-        bad = {"finite and > 0": 0.0, "finite and >= 0": -1.0, "finite and >= 1": 0.5}[row["bound"]]
-        for value in (bad, math.nan, math.inf):
+        bad = {"finite and > 0": (0.0,), "finite and >= 0": (-1.0,), "finite and >= 1": (0.5,),
+               "an integer in 1..6": (0.0, 2.5, 7.0)}[row["bound"]]
+        for value in (*bad, math.nan, math.inf):
             r = sh.Rig()
             setattr(r, row["key"], value)
             with pytest.raises(ValueError, match=rf"invalid {row['key']} = .*must be {row['bound']} \["):

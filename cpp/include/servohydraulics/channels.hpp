@@ -20,7 +20,9 @@ struct ChannelInfoOf {
 using ChannelInfo = ChannelInfoOf<Output>;
 
 //! Indices into kPlantChannels (and Channels::channel).
-enum class Channel : int { Time, Displacement, Velocity, Acceleration, Force, Pressure, Spool, Drive, Flow };
+enum class Channel : int {
+  Time, Displacement, Velocity, Acceleration, Force, Pressure, Spool, Drive, Flow, SpecimenForce
+};
 
 constexpr ChannelInfo kPlantChannels[] = {
     {"time", "s", "time of the sample", &Output::time},
@@ -32,6 +34,7 @@ constexpr ChannelInfo kPlantChannels[] = {
     {"spool", "-", "metering spool opening x_v", &Output::spool},
     {"drive", "V", "valve drive v", &Output::drive},
     {"flow", "m^3/s", "valve flow Q", &Output::flow},
+    {"specimen_force", "N", "force of the Bouc-Wen and MR damper specimens (0 when off)", &Output::specimen_force},
 };
 constexpr std::size_t kNumPlantChannels = sizeof(kPlantChannels) / sizeof(kPlantChannels[0]);
 
@@ -40,6 +43,8 @@ constexpr const ChannelInfo& channel_info(Channel c) noexcept { return kPlantCha
 static_assert(channel_info(Channel::Time).member == &Output::time, "kPlantChannels out of order");
 static_assert(channel_info(Channel::Force).member == &Output::force, "kPlantChannels out of order");
 static_assert(channel_info(Channel::Flow).member == &Output::flow, "kPlantChannels out of order");
-static_assert(static_cast<std::size_t>(Channel::Flow) + 1 == kNumPlantChannels, "Channel and kPlantChannels differ");
+static_assert(channel_info(Channel::SpecimenForce).member == &Output::specimen_force, "kPlantChannels out of order");
+static_assert(static_cast<std::size_t>(Channel::SpecimenForce) + 1 == kNumPlantChannels,
+              "Channel and kPlantChannels differ");
 
 }  // namespace servohydraulics

@@ -31,9 +31,10 @@ class Dynamics {
     double u0 = 0.0;  //!< the held command [m in displacement, N in force/free mode]
   };
 
-  //! Gradients of the 8 output channels (displacement, velocity, acceleration,
-  //! force, pressure, spool, drive, flow) by the states and, last, by u.
-  using OutputGradients = std::array<std::array<double, kNumStates + 1>, 8>;
+  //! Gradients of the 9 output channels (displacement, velocity, acceleration,
+  //! force, pressure, spool, drive, flow, specimen force) by the states (columns
+  //! 0..num_states()-1; the rest of the capacity is 0) and, in the last column kMaxStates, by u.
+  using OutputGradients = std::array<std::array<double, kMaxStates + 1>, 9>;
 
   void rhs(const double* y, const Input& in, double* ydot) const noexcept;
   //! J = df/dy; if B is given, also B = df/du.
@@ -48,6 +49,33 @@ class Dynamics {
   //! valve) is zero.  Free mode: u0 is the spring force.  Exact while the
   //! drive and the spool are not saturated (that rate is affine in u there).
   OperatingPoint operating_point(double x0) const noexcept;
+
+  //! The active length of the state vector: the base states plus those of the
+  //! switched-on elements (Bouc-Wen, MR damper, Pade loop delay).
+  int num_states() const noexcept { return layout_.num_states; }
+  //! Where the switchable elements' states are (-1: off).
+  const StateLayout& layout() const noexcept { return layout_; }
+  //! Name, unit and meaning of state i < num_states().
+  const StateInfo& state_info(int i) const noexcept;
+  //! Absolute scale of state i (CVODE's absolute tolerance is rtol times it): the base
+  //! states take SolverOptions::atol_scale, the appended ones this.
+  double state_scale(int i) const noexcept;
+  //! Force of the switched-on specimen elements (Bouc-Wen and MR damper) at state y [N]
+  //! (0 when both are off); part of the structure's force against the applied one.
+  double specimen_force(const double* y) const noexcept;
+  //! Upper estimate of |d z'/d z| of the hysteretic states (Bouc-Wen, MR damper) when
+  //! sliding at v_ref [m/s]: their stiffness for an explicit integrator [1/s].
+  double hysteretic_rate_bound(double v_ref) const noexcept;
+  //! The Pade loop delay's realisation: dq/dt = (A' q + e_N w) / tau, out = C' q + d w, with
+  //! A' a companion matrix whose last row is -a[0..N-1] (a monic denominator in s tau).
+  struct Pade {
+    int order = 0;
+    double tau = 0.0;
+    double a[kMaxPadeOrder] = {};  //!< denominator coefficients over the leading one
+    double c[kMaxPadeOrder] = {};  //!< output row C'
+    double d = 0.0;                //!< feedthrough (-1)^N
+  };
+  const Pade& pade() const noexcept { return pade_; }
 
   const Rig& rig() const noexcept { return rig_; }
   ControlMode mode() const noexcept { return mode_; }
@@ -72,8 +100,18 @@ class Dynamics {
  private:
   struct Algebra;  // intermediate quantities of one evaluation
   struct Friction;  // friction force, bristle rate and their gradients
+  // W: the gradient width the loops run over, a constant so that they unroll (the paper
+  // plant's kNumStates + 1, or the capacity with appended states).
+  template <int W>
   void evaluate(const double* y, const Input& in, Algebra& a) const noexcept;
+  void evaluate_any(const double* y, const Input& in, Algebra& a) const noexcept;
+  template <int W>
+  void specimen(const double* y, Algebra& a) const noexcept;
+  template <int W>
+  void loop_delay(const double* y, Algebra& a) const noexcept;
+  void jacobian_appended(const Algebra& g, Jacobian& J, State* B) const noexcept;
   Friction friction(double v, double z) const noexcept;
+  double static_force(double x) const noexcept;  // the structure's force at rest at x
 
   Rig rig_;
   ControlMode mode_;
@@ -82,6 +120,15 @@ class Dynamics {
   bool lugre_;      // LuGre friction on (coulomb_friction && lugre_friction && F_c > 0)
   double CF_;       // conversion factor of the mode [V/m or V/N]
   double wv_;       // valve natural frequency [rad/s]
+  StateLayout layout_;
+  int ku_ = kNumStates;      // gradient column of the command u (= num_states())
+  int ng_ = kNumStates + 1;  // gradient width
+  double mr_alpha_ = 0.0, mr_c0_ = 0.0, mr_c1_ = 0.0;  // MR damper coefficients at the run's voltage
+  Pade pade_;
 };
+
+//! Coefficients of the (N, N) Pade approximant of exp(-s tau) in s tau, lowest power first:
+//! den[k] = (2N-k)! N! / ((2N)! k! (N-k)!), num[k] = (-1)^k den[k].  1 <= N <= kMaxPadeOrder.
+void pade_coefficients(int order, double* num, double* den) noexcept;
 
 }  // namespace servohydraulics

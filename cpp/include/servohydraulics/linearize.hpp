@@ -3,21 +3,23 @@
 #pragma once
 
 #include <Eigen/Dense>
-#include <array>
+#include <vector>
 
 #include "servohydraulics/plant.hpp"
 
 namespace servohydraulics {
 
+//! The linearised plant over its dyn.num_states() active states (the base states,
+//! then those of the switched-on elements: Dynamics::layout, Dynamics::state_info).
 struct LinearModel {
-  static constexpr int kOutputs = 8;
-  Eigen::Matrix<double, kNumStates, kNumStates> A;
-  Eigen::Matrix<double, kNumStates, 1> B;
-  //! Rows: displacement, velocity, acceleration, force, pressure, spool, drive, flow.
-  Eigen::Matrix<double, kOutputs, kNumStates> C;
-  Eigen::Matrix<double, kOutputs, 1> D;
+  static constexpr int kOutputs = 9;
+  Eigen::MatrixXd A;  //!< n x n
+  Eigen::VectorXd B;  //!< n
+  //! Rows: displacement, velocity, acceleration, force, pressure, spool, drive, flow, specimen force.
+  Eigen::MatrixXd C;  //!< kOutputs x n
+  Eigen::VectorXd D;  //!< kOutputs
   //! States that take part in this mode/effect set (the others have zero dynamics).
-  std::array<bool, kNumStates> active{};
+  std::vector<bool> active;
 };
 
 //! Linearises about state y0 with the command held at u0 (u_rate = 0).

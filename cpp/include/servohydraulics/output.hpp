@@ -25,6 +25,7 @@ struct Output {
   double spool = 0.0;         //!< metering spool opening x_v [-]
   double drive = 0.0;         //!< valve drive v [V]
   double flow = 0.0;          //!< valve flow Q [m^3/s]
+  double specimen_force = 0.0;  //!< force of the Bouc-Wen and MR damper specimens [N] (0 when off; docs/specimens.md)
   std::uint32_t flags = 0;    //!< OutputFlag bits
 };
 

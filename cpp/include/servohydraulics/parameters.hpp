@@ -14,6 +14,7 @@ enum class Bound {
   Positive,     //!< > 0
   NonNegative,  //!< >= 0
   AtLeastOne,   //!< >= 1
+  PadeOrder,    //!< an integer in 1..kMaxPadeOrder
 };
 
 struct ParameterInfo {
@@ -73,6 +74,53 @@ inline constexpr ParameterInfo kRigParameters[] = {
     {"controller", "G_p", "-", "proportional gain", "Table I: 0.8059", Bound::NonNegative, &Rig::G_p},
     {"controller", "G_d", "s", "derivative gain", "Table I: 0.0", Bound::NonNegative, &Rig::G_d},
     {"controller", "v_max", "V", "valve drive limit", "MTS 407: +-10 V", Bound::Positive, &Rig::v_max},
+    {"specimen", "bw_k", "N/m", "Bouc-Wen stiffness (F_bw = bw_k z; small-amplitude stiffness bw_k bw_A)",
+     "not in the paper: a specimen as stiff as two springs", Bound::NonNegative, &Rig::bw_k},
+    {"specimen", "bw_A", "-", "Bouc-Wen A", "Wen (1976): 1", Bound::Positive, &Rig::bw_A},
+    {"specimen", "bw_beta", "1/m^n", "Bouc-Wen beta", "not in the paper: z_u = 1 cm with gamma",
+     Bound::NonNegative, &Rig::bw_beta},
+    {"specimen", "bw_gamma", "1/m^n", "Bouc-Wen gamma", "not in the paper: z_u = 1 cm with beta",
+     Bound::NonNegative, &Rig::bw_gamma},
+    {"specimen", "bw_n", "-", "Bouc-Wen exponent n", "Wen (1976): n >= 1; 1 (smooth yield)", Bound::AtLeastOne,
+     &Rig::bw_n},
+    {"specimen", "mr_alpha_a", "N/m", "MR damper alpha = alpha_a + alpha_b u", "Spencer et al. 1997 Table 1",
+     Bound::NonNegative, &Rig::mr_alpha_a},
+    {"specimen", "mr_alpha_b", "N/(m V)", "MR damper alpha's slope by the voltage", "Spencer et al. 1997 Table 1",
+     Bound::NonNegative, &Rig::mr_alpha_b},
+    {"specimen", "mr_c0_a", "N s/m", "MR damper viscous c0 = c0_a + c0_b u (high velocity)",
+     "Spencer et al. 1997 Table 1", Bound::Positive, &Rig::mr_c0_a},
+    {"specimen", "mr_c0_b", "N s/(m V)", "MR damper c0's slope by the voltage", "Spencer et al. 1997 Table 1",
+     Bound::NonNegative, &Rig::mr_c0_b},
+    {"specimen", "mr_c1_a", "N s/m", "MR damper c1 = c1_a + c1_b u (roll-off at low velocity)",
+     "Spencer et al. 1997 Table 1", Bound::Positive, &Rig::mr_c1_a},
+    {"specimen", "mr_c1_b", "N s/(m V)", "MR damper c1's slope by the voltage", "Spencer et al. 1997 Table 1",
+     Bound::NonNegative, &Rig::mr_c1_b},
+    {"specimen", "mr_k0", "N/m", "MR damper stiffness k0 (large velocities)", "Spencer et al. 1997 Table 1",
+     Bound::NonNegative, &Rig::mr_k0},
+    {"specimen", "mr_k1", "N/m", "MR damper accumulator stiffness k1", "Spencer et al. 1997 Table 1",
+     Bound::NonNegative, &Rig::mr_k1},
+    {"specimen", "mr_x0", "m", "MR damper accumulator initial displacement x0", "Spencer et al. 1997 Table 1",
+     Bound::NonNegative, &Rig::mr_x0},
+    {"specimen", "mr_A", "-", "MR damper Bouc-Wen A", "Spencer et al. 1997 Table 1", Bound::NonNegative,
+     &Rig::mr_A},
+    {"specimen", "mr_beta", "1/m^n", "MR damper Bouc-Wen beta (on (x'-y') abs(z)^n)", "Spencer et al. 1997 Table 1",
+     Bound::NonNegative, &Rig::mr_beta},
+    {"specimen", "mr_gamma", "1/m^n", "MR damper Bouc-Wen gamma (on abs(x'-y') z abs(z)^(n-1))",
+     "Spencer et al. 1997 Table 1", Bound::NonNegative, &Rig::mr_gamma},
+    {"specimen", "mr_n", "-", "MR damper Bouc-Wen exponent n", "Spencer et al. 1997 Table 1", Bound::AtLeastOne,
+     &Rig::mr_n},
+    {"specimen", "mr_voltage", "V", "MR damper command voltage u (constant over a run)",
+     "Spencer et al. 1997 tested 0-2.25 V", Bound::NonNegative, &Rig::mr_voltage},
+    {"delays", "command_delay", "s", "digital command delay (held command switches at t_k + delay)",
+     "not in the paper: 0; at most 64 samples", Bound::NonNegative, &Rig::command_delay},
+    {"delays", "measurement_delay_displacement", "s", "acquisition delay of the displacement channel",
+     "not in the paper: 0; at most 64 samples", Bound::NonNegative, &Rig::measurement_delay_displacement},
+    {"delays", "measurement_delay_force", "s", "acquisition delay of the force channel",
+     "not in the paper: 0; at most 64 samples", Bound::NonNegative, &Rig::measurement_delay_force},
+    {"delays", "loop_delay", "s", "analog transport delay on the valve drive (effects.loop_delay, Pade)",
+     "not in the paper: 2 ms", Bound::Positive, &Rig::loop_delay},
+    {"delays", "loop_delay_order", "-", "Pade order of loop_delay", "modelling choice: 3", Bound::PadeOrder,
+     &Rig::loop_delay_order},
 };
 
 struct EffectInfo {
@@ -91,6 +139,9 @@ inline constexpr EffectInfo kEffects[] = {
     {"drive_saturation", "valve drive limited to +-v_max", &Effects::drive_saturation},
     {"spool_saturation", "spool opening limited to +-x_v_max", &Effects::spool_saturation},
     {"lugre_friction", "LuGre presliding friction instead of the static law", &Effects::lugre_friction},
+    {"bouc_wen_hysteresis", "Bouc-Wen hysteretic specimen (state bw_z)", &Effects::bouc_wen_hysteresis},
+    {"mr_damper", "MR damper, Spencer et al. 1997 (states mr_y, mr_z)", &Effects::mr_damper},
+    {"loop_delay", "Pade transport delay loop_delay on the valve drive", &Effects::loop_delay},
 };
 
 //! The requirement of a bound, for messages and docs: "finite and > 0".

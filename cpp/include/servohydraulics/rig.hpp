@@ -13,6 +13,9 @@
 
 namespace servohydraulics {
 
+//! Longest digital delay (command or measurement) a plant accepts, in samples of its dt.
+constexpr int kMaxDelaySamples = 64;
+
 //! Normalised flow-spool opening curve g(x_v) of Fig 4(a): Q = K_v g(x_v) at
 //! zero load pressure, with g odd, g(0) = 0 and g'(0) = 1 so that K_v is the
 //! initial (null) flow gain of Eq (7).  The curve must be strictly increasing
@@ -56,6 +59,13 @@ struct Effects {
   //! static law g(v) tanh(v / v_stick); acts only with coulomb_friction on.  Off by default: Table I
   //! gives no presliding data.
   bool lugre_friction = false;
+  //! a Bouc-Wen hysteretic specimen in parallel with the structure (state bw_z; docs/specimens.md)
+  bool bouc_wen_hysteresis = false;
+  //! an MR damper (Spencer et al. 1997, states mr_y, mr_z) in parallel with the structure
+  bool mr_damper = false;
+  //! a transport delay of loop_delay [s] on the valve drive, as a Pade approximant of order
+  //! loop_delay_order (states delay_1..N; inactive in free mode)
+  bool loop_delay = false;
 };
 
 //! Parameters of the rig.  Field names follow the paper's symbols (Table I).
@@ -96,6 +106,42 @@ struct Rig {
   double G_p = 0.8059;         //!< proportional gain [-] (Table I)
   double G_d = 0.0;            //!< derivative gain [s] (Table I)
   double v_max = 10.0;         //!< valve drive limit [V]
+
+  // --- Specimen: Bouc-Wen hysteresis (effects.bouc_wen_hysteresis) ------------
+  // F_bw = bw_k z,  z' = bw_A v - bw_beta |v| |z|^(n-1) z - bw_gamma v |z|^n  (Wen 1976)
+  double bw_k = 350.4e3;    //!< Bouc-Wen stiffness: small-amplitude stiffness is bw_k bw_A [N/m]
+  double bw_A = 1.0;        //!< Bouc-Wen A [-]
+  double bw_beta = 50.0;    //!< Bouc-Wen beta [1/m^n]
+  double bw_gamma = 50.0;   //!< Bouc-Wen gamma [1/m^n]
+  double bw_n = 1.0;        //!< Bouc-Wen exponent n >= 1 [-]
+
+  // --- Specimen: MR damper, Spencer, Dyke, Sain, Carlson (1997) (effects.mr_damper) ---
+  // F = c1 y' + k1 (x - x0),  y' = (alpha z + c0 x' + k0 (x - y)) / (c0 + c1),
+  // z' = -gamma |x' - y'| z |z|^(n-1) - beta (x' - y') |z|^n + A (x' - y'),
+  // alpha, c0, c1 = (.)_a + (.)_b u with u the command voltage (held constant per run).
+  double mr_alpha_a = 140e2;   //!< alpha_a [N/m] (Spencer 1997 Table 1: 140 N/cm)
+  double mr_alpha_b = 695e2;   //!< alpha_b [N/(m V)] (695 N/(cm V))
+  double mr_c0_a = 21.0e2;     //!< c0a [N s/m] (21.0 N s/cm)
+  double mr_c0_b = 3.50e2;     //!< c0b [N s/(m V)] (3.50 N s/(cm V))
+  double mr_c1_a = 283e2;      //!< c1a [N s/m] (283 N s/cm)
+  double mr_c1_b = 2.95e2;     //!< c1b [N s/(m V)] (2.95 N s/(cm V))
+  double mr_k0 = 46.9e2;       //!< k0 [N/m] (46.9 N/cm)
+  double mr_k1 = 5.00e2;       //!< k1, accumulator stiffness [N/m] (5.00 N/cm)
+  double mr_x0 = 14.3e-2;      //!< x0, accumulator initial displacement [m] (14.3 cm)
+  double mr_A = 301.0;         //!< A [-] (301)
+  double mr_beta = 363e4;      //!< beta [1/m^2] (363 cm^-2)
+  double mr_gamma = 363e4;     //!< gamma [1/m^2] (363 cm^-2)
+  double mr_n = 2.0;           //!< n >= 1 [-] (2)
+  double mr_voltage = 0.0;     //!< command voltage u, constant over a run [V]
+
+  // --- Delays inside the loop --------------------------------------------------
+  //! digital command delay [s] (computation/communication latency): the held command
+  //! switches at t_k + command_delay; at most kMaxDelaySamples samples (checked by the plant)
+  double command_delay = 0.0;
+  double measurement_delay_displacement = 0.0;  //!< acquisition delay of the displacement channel [s]
+  double measurement_delay_force = 0.0;         //!< acquisition delay of the force channel [s]
+  double loop_delay = 2e-3;        //!< analog transport delay on the valve drive [s] (effects.loop_delay)
+  double loop_delay_order = 3.0;   //!< its Pade order, an integer in 1..kMaxPadeOrder [-]
 
   Effects effects;
 

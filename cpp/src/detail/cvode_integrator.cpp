@@ -1,51 +1,59 @@
 #include "detail/cvode_integrator.hpp"
 
+#include <cstdlib>
+#include <sstream>
 #include <string>
 
+#include "detail/sundials_check.hpp"
 #include "servohydraulics/error.hpp"
 
 namespace servohydraulics::detail {
 
 namespace {
-int check_flag(int flag, const char* call) {
-  if (flag < 0) throw Error(std::string("SUNDIALS setup call ") + call + " failed with flag " + std::to_string(flag));
-  return flag;
-}
-template <class P>
-P check_ptr(P p, const char* call) {
-  if (p == nullptr) throw Error(std::string("SUNDIALS setup call ") + call + " returned NULL");
-  return p;
-}
+constexpr const char* kSetup = "CVODE setup";
+// Every setup call through the one checked helper (sundials_check.hpp), named by its function.
+#define SH_FLAG(fn, ...) check_flag(kSetup, #fn, [&] { return fn(__VA_ARGS__); })
+#define SH_PTR(fn, ...) check_ptr(kSetup, #fn, [&] { return fn(__VA_ARGS__); })
+
 // CVODE prints its errors by default; the hot path must stay silent.  The
 // status carries the flag instead.
 void silent_error_handler(int, const char*, const char*, char*, void*) {}
+
+std::string flag_name(int flag) {
+  char* name = CVodeGetReturnFlagName(flag);  // malloc'ed by SUNDIALS
+  std::string s = name ? name : "unknown";
+  std::free(name);
+  return s;
+}
 }  // namespace
 
 CvodeIntegrator::CvodeIntegrator(const Dynamics& dyn, double dt, const SolverOptions& opt, const State& y_prime)
-    : restart_(opt.restart), dyn_(&dyn) {
-  y_.reset(check_ptr(N_VNew_Serial(kNumStates, ctx_), "N_VNew_Serial"));
-  atol_.reset(check_ptr(N_VNew_Serial(kNumStates, ctx_), "N_VNew_Serial"));
-  for (int i = 0; i < kNumStates; ++i) NV_Ith_S(atol_.get(), i) = opt.rtol * opt.atol_scale[i];
-  for (int i = 0; i < kNumStates; ++i) NV_Ith_S(y_.get(), i) = 0.0;
-  mem_.reset(check_ptr(CVodeCreate(CV_BDF, ctx_), "CVodeCreate"));
+    : restart_(opt.restart), dyn_(&dyn), n_(dyn.num_states()) {
+  // The vectors and the matrix have the active length (the base states and the switched-on elements').
+  y_.reset(SH_PTR(N_VNew_Serial, n_, ctx_));
+  atol_.reset(SH_PTR(N_VNew_Serial, n_, ctx_));
+  for (int i = 0; i < n_; ++i)
+    NV_Ith_S(atol_.get(), i) = opt.rtol * (i < kNumStates ? opt.atol_scale[i] : dyn.state_scale(i));
+  for (int i = 0; i < n_; ++i) NV_Ith_S(y_.get(), i) = 0.0;
+  mem_.reset(SH_PTR(CVodeCreate, CV_BDF, ctx_));
   void* cv = mem_.get();
-  check_flag(CVodeInit(cv, &CvodeIntegrator::rhs, 0.0, y_.get()), "CVodeInit");
-  check_flag(CVodeSetUserData(cv, this), "CVodeSetUserData");
-  check_flag(CVodeSetErrHandlerFn(cv, silent_error_handler, nullptr), "CVodeSetErrHandlerFn");
-  check_flag(CVodeSVtolerances(cv, opt.rtol, atol_.get()), "CVodeSVtolerances");
-  J_.reset(check_ptr(SUNDenseMatrix(kNumStates, kNumStates, ctx_), "SUNDenseMatrix"));
-  LS_.reset(check_ptr(SUNLinSol_Dense(y_.get(), J_.get(), ctx_), "SUNLinSol_Dense"));
-  check_flag(CVodeSetLinearSolver(cv, LS_.get(), J_.get()), "CVodeSetLinearSolver");
-  check_flag(CVodeSetJacFn(cv, &CvodeIntegrator::jac), "CVodeSetJacFn");
-  check_flag(CVodeSetMaxNumSteps(cv, opt.max_steps_per_sample), "CVodeSetMaxNumSteps");
-  check_flag(CVodeSetMaxOrd(cv, opt.max_order), "CVodeSetMaxOrd");
+  SH_FLAG(CVodeInit, cv, &CvodeIntegrator::rhs, 0.0, y_.get());
+  SH_FLAG(CVodeSetUserData, cv, this);
+  SH_FLAG(CVodeSetErrHandlerFn, cv, silent_error_handler, nullptr);
+  SH_FLAG(CVodeSVtolerances, cv, opt.rtol, atol_.get());
+  J_.reset(SH_PTR(SUNDenseMatrix, n_, n_, ctx_));
+  LS_.reset(SH_PTR(SUNLinSol_Dense, y_.get(), J_.get(), ctx_));
+  SH_FLAG(CVodeSetLinearSolver, cv, LS_.get(), J_.get());
+  SH_FLAG(CVodeSetJacFn, cv, &CvodeIntegrator::jac);
+  SH_FLAG(CVodeSetMaxNumSteps, cv, opt.max_steps_per_sample);
+  SH_FLAG(CVodeSetMaxOrd, cv, opt.max_order);
   // A held command that jumps (a step input) makes the right-hand side
   // discontinuous at the sample start; with Restart::Never the BDF history
   // straddles it and CVODE's default of 7 error-test failures is not enough
   // to cut h down to the jump (CV_ERR_FAILURE; tests/cpp/test_status.cpp).
-  check_flag(CVodeSetMaxErrTestFails(cv, 20), "CVodeSetMaxErrTestFails");
-  check_flag(CVodeSetMaxHnilWarns(cv, -1), "CVodeSetMaxHnilWarns");
-  if (opt.max_internal_step > 0.0) check_flag(CVodeSetMaxStep(cv, opt.max_internal_step), "CVodeSetMaxStep");
+  SH_FLAG(CVodeSetMaxErrTestFails, cv, 20);
+  SH_FLAG(CVodeSetMaxHnilWarns, cv, -1);
+  if (opt.max_internal_step > 0.0) SH_FLAG(CVodeSetMaxStep, cv, opt.max_internal_step);
   prime(y_prime, dt);
 }
 
@@ -56,12 +64,21 @@ CvodeIntegrator::CvodeIntegrator(const Dynamics& dyn, double dt, const SolverOpt
 // (CVodeReInit keeps that memory).
 void CvodeIntegrator::prime(const State& y_prime, double dt) {
   in_ = {};
-  for (int i = 0; i < kNumStates; ++i) NV_Ith_S(y_.get(), i) = y_prime[i];
-  check_flag(CVodeReInit(mem_.get(), 0.0, y_.get()), "CVodeReInit");
-  check_flag(CVodeSetStopTime(mem_.get(), dt), "CVodeSetStopTime");
+  for (int i = 0; i < n_; ++i) NV_Ith_S(y_.get(), i) = y_prime[i];
+  SH_FLAG(CVodeReInit, mem_.get(), 0.0, y_.get());
+  SH_FLAG(CVodeSetStopTime, mem_.get(), dt);
   sunrealtype tret = 0.0;
-  check_flag(CVode(mem_.get(), dt, y_.get(), &tret, CV_ONE_STEP), "CVode (priming step)");
+  const int flag = inject_setup_fault() ? -1 : CVode(mem_.get(), dt, y_.get(), &tret, CV_ONE_STEP);
+  if (flag < 0) {
+    std::ostringstream s;
+    s << kSetup << ": the priming step (one internal step from the equilibrium at x = 0, command 0, "
+      << "t = 0 towards dt = " << dt << " s) failed at t = " << tret << " s: CVode returned flag " << flag << " ("
+      << flag_name(flag) << "); the rig's equilibrium or right-hand side is not finite there, or it is too stiff";
+    throw Error(s.str());
+  }
 }
+#undef SH_FLAG
+#undef SH_PTR
 
 int CvodeIntegrator::rhs(sunrealtype, N_Vector yv, N_Vector ydot, void* user) {
   auto* self = static_cast<CvodeIntegrator*>(user);
@@ -73,8 +90,8 @@ int CvodeIntegrator::jac(sunrealtype, N_Vector yv, N_Vector, SUNMatrix Jm, void*
   auto* self = static_cast<CvodeIntegrator*>(user);
   Jacobian Jl;
   self->dyn_->jacobian(N_VGetArrayPointer(yv), self->in_, Jl);
-  for (int i = 0; i < kNumStates; ++i)
-    for (int j = 0; j < kNumStates; ++j) SM_ELEMENT_D(Jm, i, j) = Jl[i][j];
+  for (int i = 0; i < self->n_; ++i)
+    for (int j = 0; j < self->n_; ++j) SM_ELEMENT_D(Jm, i, j) = Jl[i][j];
   return 0;
 }
 
@@ -82,7 +99,7 @@ void CvodeIntegrator::reset(const State& y, double t) noexcept {
   steps_done_ = rhs_done_ = restarts_ = 0;
   in_ = {};
   // CVodeReInit also zeroes the counters of the current run, so that the totals restart.
-  for (int i = 0; i < kNumStates; ++i) NV_Ith_S(y_.get(), i) = y[i];
+  for (int i = 0; i < n_; ++i) NV_Ith_S(y_.get(), i) = y[i];
   CVodeReInit(mem_.get(), t, y_.get());
   need_reinit_ = false;
 }
@@ -107,7 +124,7 @@ Status CvodeIntegrator::advance(const Dynamics& dyn, const Dynamics::Input& in, 
   Status st;
   if (need_reinit_) {
     accumulate_counters();
-    for (int i = 0; i < kNumStates; ++i) NV_Ith_S(y_.get(), i) = y[i];
+    for (int i = 0; i < n_; ++i) NV_Ith_S(y_.get(), i) = y[i];
     CVodeReInit(cv, t, y_.get());
     need_reinit_ = false;
     st.restarted = true;
@@ -124,7 +141,7 @@ Status CvodeIntegrator::advance(const Dynamics& dyn, const Dynamics::Input& in, 
   CVodeGetNumRhsEvals(cv, &nf1);
   st.internal_steps = static_cast<int>(ns1 - ns0);
   st.rhs_evals = static_cast<int>(nf1 - nf0);
-  for (int i = 0; i < kNumStates; ++i) y[i] = NV_Ith_S(y_.get(), i);
+  for (int i = 0; i < n_; ++i) y[i] = NV_Ith_S(y_.get(), i);
   t = tret;
   if (flag < 0) {
     st.code = flag == CV_TOO_MUCH_WORK ? Status::TooMuchWork : Status::SolverFailure;

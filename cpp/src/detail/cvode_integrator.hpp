@@ -70,6 +70,7 @@ class CvodeIntegrator {
   SolverOptions::Restart restart_;
   const Dynamics* dyn_;     // what the callbacks evaluate (set before every CVode call)
   Dynamics::Input in_{};    // the held input of the current sample
+  int n_;                   // active states (Dynamics::num_states)
   bool need_reinit_ = true;
   long steps_done_ = 0, rhs_done_ = 0, restarts_ = 0;  // totals of past CVODE runs (ReInit resets its counters)
 };

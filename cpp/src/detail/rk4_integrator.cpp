@@ -17,9 +17,10 @@ int rk4_automatic_substeps(const Dynamics& dyn, double dt, const SolverOptions& 
   const State y0 = dyn.equilibrium(0.0);
   Jacobian J;
   dyn.jacobian(y0.data(), {}, J);
-  Eigen::Matrix<double, kNumStates, kNumStates> A;
-  for (int i = 0; i < kNumStates; ++i)
-    for (int j = 0; j < kNumStates; ++j) A(i, j) = J[i][j];
+  const int ns = dyn.num_states();
+  Eigen::MatrixXd A(ns, ns);
+  for (int i = 0; i < ns; ++i)
+    for (int j = 0; j < ns; ++j) A(i, j) = J[i][j];
   double rho = A.eigenvalues().cwiseAbs().maxCoeff();
   // LuGre: the bristle rate sigma_0 |v| / g(v) is 0 at rest and grows with the sliding speed.  Bound
   // |v| by v_ref: given, or the no-load actuator speed K_v g(x_v_max) / A (1 m/s in free mode, no actuator).
@@ -29,6 +30,14 @@ int rk4_automatic_substeps(const Dynamics& dyn, double dt, const SolverOptions& 
         dyn.mode() == ControlMode::Free ? 1.0 : r.K_v * dyn.flow_gain(std::min(r.x_v_max, 1.0)) / r.A;
     const double v_ref = opt.rk4_v_ref > 0.0 ? opt.rk4_v_ref : v_no_load;
     rho = std::max(rho, r.sigma_0 * v_ref / r.F_c);
+  }
+  // Hysteretic specimens (Bouc-Wen, MR damper): their z' stiffens with the sliding speed, bounded alike.
+  const StateLayout& L = dyn.layout();
+  if (L.bw_z >= 0 || L.mr_y >= 0) {
+    const Rig& r = dyn.rig();
+    const double v_no_load =
+        dyn.mode() == ControlMode::Free ? 1.0 : r.K_v * dyn.flow_gain(std::min(r.x_v_max, 1.0)) / r.A;
+    rho = std::max(rho, dyn.hysteretic_rate_bound(opt.rk4_v_ref > 0.0 ? opt.rk4_v_ref : v_no_load));
   }
   const double n = std::ceil(dt * rho / opt.rk4_h_rho);
   require(std::isfinite(n) && n <= 100000.0, "rk4_substeps (automatic)", n,
@@ -42,20 +51,21 @@ Rk4Integrator::Rk4Integrator(const Dynamics& dyn, double dt, const SolverOptions
     : substeps_(opt.rk4_substeps > 0 ? opt.rk4_substeps : rk4_automatic_substeps(dyn, dt, opt)) {}
 
 Status Rk4Integrator::advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t,
-                              double t_next) noexcept {
+                              double t_next, int substeps) noexcept {
   Status st;
-  const int n = substeps_;
+  const int n = substeps > 0 ? substeps : substeps_;
+  const int ns = dyn.num_states();
   const double h = (t_next - t) / n;
-  double k1[kNumStates], k2[kNumStates], k3[kNumStates], k4[kNumStates], tmp[kNumStates];
+  double k1[kMaxStates], k2[kMaxStates], k3[kMaxStates], k4[kMaxStates], tmp[kMaxStates] = {};
   for (int s = 0; s < n; ++s) {
     dyn.rhs(y.data(), in, k1);
-    for (int i = 0; i < kNumStates; ++i) tmp[i] = y[i] + 0.5 * h * k1[i];
+    for (int i = 0; i < ns; ++i) tmp[i] = y[i] + 0.5 * h * k1[i];
     dyn.rhs(tmp, in, k2);
-    for (int i = 0; i < kNumStates; ++i) tmp[i] = y[i] + 0.5 * h * k2[i];
+    for (int i = 0; i < ns; ++i) tmp[i] = y[i] + 0.5 * h * k2[i];
     dyn.rhs(tmp, in, k3);
-    for (int i = 0; i < kNumStates; ++i) tmp[i] = y[i] + h * k3[i];
+    for (int i = 0; i < ns; ++i) tmp[i] = y[i] + h * k3[i];
     dyn.rhs(tmp, in, k4);
-    for (int i = 0; i < kNumStates; ++i) y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+    for (int i = 0; i < ns; ++i) y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
   }
   t = t_next;
   st.internal_steps = n;

@@ -15,7 +15,10 @@ class Rk4Integrator {
   Rk4Integrator(const Dynamics& dyn, double dt, const SolverOptions& options);
 
   void reset(const State&, double) noexcept { steps_done_ = rhs_done_ = 0; }
-  Status advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t, double t_next) noexcept;
+  //! RK4 from t to t_next with the input held, in `substeps` equal substeps (0: the configured
+  //! count; the plant passes a share of it for each part of a sample split by a command delay).
+  Status advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t, double t_next,
+                 int substeps = 0) noexcept;
 
   int substeps() const noexcept { return substeps_; }
   long total_steps() const noexcept { return steps_done_; }

@@ -146,7 +146,8 @@ def linearize(rig: Rig, mode: str = "displacement", x0: float = 0.0, u0: float |
     B = np.asarray(lm.B).reshape(-1, 1)[keep]
     C = np.asarray(lm.C)[np.ix_(rows, keep)]
     D = np.asarray(lm.D).reshape(-1, 1)[rows]
-    plant = ct.ss(A, B, C, D, inputs=["u"], outputs=need, states=[STATES[i] for i in keep],
+    names = [s[0] for s in dyn.states]  # the base states, then the switched-on elements' (specimens, loop delay)
+    plant = ct.ss(A, B, C, D, inputs=["u"], outputs=need, states=[names[i] for i in keep],
                   name="plant")
     return _close_compensators(plant, r, mode, comp, outs)
 

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic import FileSet, WriteError
 from ..rig import save_rig
 
 
@@ -26,15 +27,20 @@ def _clean(o):
 
 
 def write_outputs(d, out: Path) -> Path:
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "diagnosis.json").write_text(json.dumps(_clean(d.to_dict()), indent=2))
-    save_rig(d.rig, out / "rig_updated.toml")
-    figs = _plots(d, out)
-    (out / "report.md").write_text(_markdown(d, figs))
+    """Writes the files together: all of them, or (on an OSError naming the file) none."""
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise WriteError(out, e.errno, f"[Errno {e.errno}] {e.strerror}") from None
+    with FileSet() as files:
+        files.write_text(out / "diagnosis.json", json.dumps(_clean(d.to_dict()), indent=2))
+        save_rig(d.rig, files.path(out / "rig_updated.toml"))
+        figs = _plots(d, out, files)
+        files.write_text(out / "report.md", _markdown(d, figs))
     return out
 
 
-def _plots(d, out: Path) -> dict:
+def _plots(d, out: Path, files: FileSet) -> dict:
     """Draws the report's figures (``matplotlib.figure.Figure`` objects, saved
     as PNG to ``out``); returns their file names by kind."""
     if not d.plots:
@@ -44,7 +50,7 @@ def _plots(d, out: Path) -> dict:
     for kind, fig in figs.items():
         if fig is not None:
             fig.tight_layout()
-            fig.savefig(out / names[kind], dpi=110)
+            fig.savefig(files.path(out / names[kind]), dpi=110)
     return {kind: names[kind] for kind, fig in figs.items() if fig is not None}
 
 

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
+from ..atomic import write_text, write_with
 from ..rig import save_rig, zhao2003
 from . import experiments as xp
 
@@ -91,9 +92,10 @@ def run_demo(out: str | Path = "demo_out", quick: bool = False) -> dict:
     summary = {"natural_frequency_hz": fd.frequency, "free_decay_damping_ratio": fd.damping_ratio,
                "displacement_gain_at_2hz": sweeps.gain_2hz, "eq13_rolloff_hz": w_c / (2 * math.pi),
                "force_gain_min": direct.min_gain, "force_gain_min_at_hz": direct.min_frequency}
-    _plot(rig, fd, sweeps, w_c, direct).savefig(out / "demo.png", dpi=110)
+    fig = _plot(rig, fd, sweeps, w_c, direct)
+    write_with(out / "demo.png", lambda tmp: fig.savefig(tmp, dpi=110))
     lines = _summary_lines(out, quick, summary)
-    (out / "summary.md").write_text("\n".join(lines) + "\n")
+    write_text(out / "summary.md", "\n".join(lines) + "\n")
     print("\n".join(lines[4:-2]))
     print(f"wrote {out / 'demo.png'}, {out / 'summary.md'}, {out / 'rig.toml'}")
     return summary

@@ -8,6 +8,8 @@ from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from ..atomic import write_text
+
 
 @dataclass
 class Reproduction:
@@ -40,8 +42,7 @@ def write_markdown(rep: Reproduction, path: Path, notes: Sequence[str]) -> Path:
     lines += ["", "## Figures", ""] + [f"- `{Path(f).name}`" for f in rep.figures]
     lines += ["", "## Notes", ""] + [f"- {n}" for n in notes]
     lines.append("- section wall times [s]: " + ", ".join(f"{k} {v:.1f}" for k, v in rep.section_times.items()))
-    path.write_text("\n".join(lines) + "\n")
-    return path
+    return write_text(path, "\n".join(lines) + "\n")
 
 
 def _json_num(v: float):
@@ -51,9 +52,8 @@ def _json_num(v: float):
 
 
 def write_json(rep: Reproduction, path: Path) -> Path:
-    path.write_text(json.dumps(
+    return write_text(path, json.dumps(
         {"runtime_s": rep.runtime, "agree": rep.agree_count, "section_times_s": rep.section_times, "rows": [
             {**asdict(r), "agree": r.agree, "lo": _json_num(r.lo), "hi": _json_num(r.hi),
              "our_value": _json_num(r.our_value)} for r in rep.rows],
          "figures": [str(f) for f in rep.figures]}, indent=1))
-    return path

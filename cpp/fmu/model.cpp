@@ -1,0 +1,330 @@
+#include "model.hpp"
+
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <sstream>
+
+#include "servohydraulics/parameters.hpp"
+
+namespace servohydraulics::fmu {
+
+const char* to_string(Kind kind) noexcept {
+  switch (kind) {
+    case Kind::Plant: return "plant";
+    case Kind::Eft: return "eft";
+    case Kind::Rpsd: return "rpsd";
+  }
+  return "?";
+}
+const char* to_string(Type t) noexcept {
+  switch (t) {
+    case Type::Real: return "Real";
+    case Type::Integer: return "Integer";
+    case Type::Boolean: return "Boolean";
+    case Type::Enumeration: return "Enumeration";
+  }
+  return "?";
+}
+const char* to_string(Causality c) noexcept {
+  switch (c) {
+    case Causality::Parameter: return "parameter";
+    case Causality::Input: return "input";
+    case Causality::Output: return "output";
+  }
+  return "?";
+}
+const char* to_string(Variability v) noexcept {
+  switch (v) {
+    case Variability::Fixed: return "fixed";
+    case Variability::Tunable: return "tunable";
+    case Variability::Discrete: return "discrete";
+    case Variability::Continuous: return "continuous";
+  }
+  return "?";
+}
+
+Kind parse_kind(const std::string& name) {
+  for (Kind k : {Kind::Plant, Kind::Eft, Kind::Rpsd})
+    if (name == to_string(k)) return k;
+  throw Error("invalid kind = \"" + name + "\": expected one of plant, eft, rpsd");
+}
+
+ControlMode parse_mode(const std::string& name) {
+  for (ControlMode m : {ControlMode::Displacement, ControlMode::Force, ControlMode::Free})
+    if (name == servohydraulics::to_string(m)) return m;
+  throw Error("invalid mode = \"" + name + "\": expected one of displacement, force, free");
+}
+
+void resolve_defaults(Settings& s) {
+  s.eft.dt = s.dt;
+  s.rpsd.dt = s.dt;
+  if (s.kind == Kind::Eft && !s.eft.mass) s.eft.mass = EftController(s.eft, s.rig).mass();
+  if (s.kind == Kind::Rpsd && !(s.rpsd.k_m && s.rpsd.subtract_mass && s.rpsd.subtract_damping)) {
+    const RpsdController c(s.rpsd, s.rig);
+    s.rpsd.k_m = c.k_m();
+    s.rpsd.subtract_mass = c.subtract_mass();
+    s.rpsd.subtract_damping = c.subtract_damping();
+  }
+}
+
+int find(const std::vector<Variable>& vars, const std::string& name) noexcept {
+  for (std::size_t i = 0; i < vars.size(); ++i)
+    if (vars[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+namespace {
+
+std::string expected_items(const Variable& var) {
+  std::ostringstream s;
+  for (std::size_t i = 0; i < var.items.size(); ++i) s << (i ? ", " : "") << var.items[i] << " (" << i << ")";
+  return s.str();
+}
+
+[[noreturn]] void bad_value(const std::string& name, double value, const std::string& expected) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "invalid " << name << " = " << value << ": " << expected;
+  throw Error(s.str());
+}
+
+// --------------------------------------------------------------- builders
+Variable base(std::string name, Type type, Causality c, Variability var, std::string unit, std::string doc) {
+  Variable x;
+  x.name = std::move(name);
+  x.type = type;
+  x.causality = c;
+  x.variability = var;
+  x.unit = std::move(unit);
+  x.doc = std::move(doc);
+  return x;
+}
+
+using RealRef = std::function<double&(Values&)>;
+
+Variable real(std::string name, std::string unit, std::string doc, Causality c, Variability var, RealRef ref) {
+  Variable x = base(std::move(name), Type::Real, c, var, std::move(unit), std::move(doc));
+  x.get = [ref](const Values& v) { return ref(const_cast<Values&>(v)); };
+  if (c != Causality::Output) x.set = [ref](Values& v, double d) { ref(v) = d; };
+  return x;
+}
+
+Variable parameter(std::string name, std::string unit, std::string doc, RealRef ref) {
+  return real(std::move(name), std::move(unit), std::move(doc), Causality::Parameter, Variability::Fixed, ref);
+}
+
+//! A config field that is "none = from the rig" in the core; explicit here (resolve_defaults).
+Variable resolved(std::string name, std::string unit, std::string doc,
+                  std::function<std::optional<double>&(Values&)> ref) {
+  Variable x = base(std::move(name), Type::Real, Causality::Parameter, Variability::Fixed, std::move(unit),
+                    std::move(doc));
+  x.get = [ref](const Values& v) {
+    const auto& o = ref(const_cast<Values&>(v));
+    return o ? *o : std::numeric_limits<double>::quiet_NaN();
+  };
+  x.set = [ref](Values& v, double d) { ref(v) = d; };
+  return x;
+}
+
+template <class I>
+Variable integer(std::string name, std::string doc, std::function<I&(Values&)> ref) {
+  Variable x = base(name, Type::Integer, Causality::Parameter, Variability::Fixed, "", std::move(doc));
+  x.get = [ref](const Values& v) { return static_cast<double>(ref(const_cast<Values&>(v))); };
+  x.set = [ref, name](Values& v, double d) {
+    if (!(std::fabs(d) < 1e15) || d != std::floor(d)) bad_value(name, d, "expected a whole number");
+    ref(v) = static_cast<I>(d);
+  };
+  return x;
+}
+
+template <class E>
+Variable enumeration(std::string name, std::string type_name, std::vector<std::string> items, std::string doc,
+                     std::function<E&(Values&)> ref) {
+  Variable x = base(name, Type::Enumeration, Causality::Parameter, Variability::Fixed, "", std::move(doc));
+  x.type_name = std::move(type_name);
+  x.items = std::move(items);
+  x.get = [ref](const Values& v) { return static_cast<double>(static_cast<int>(ref(const_cast<Values&>(v)))); };
+  const std::string expected = "expected one of " + expected_items(x);
+  const double n = static_cast<double>(x.items.size());
+  x.set = [ref, name, expected, n](Values& v, double d) {
+    if (!(d >= 0.0 && d < n) || d != std::floor(d)) bad_value(name, d, expected);
+    ref(v) = static_cast<E>(static_cast<int>(d));
+  };
+  return x;
+}
+
+// ------------------------------------------------------------ the groups
+void add_rig(std::vector<Variable>& out, Kind kind) {
+  for (const ParameterInfo& p : kRigParameters) {
+    // The plant's servo-controller settings (gains, conversion factors, drive
+    // limit) are what an operator tunes online: the FMU rebuilds the plant at
+    // the current state.  The hardware's parameters, and every parameter of a
+    // controller FMU (its compensators are built from them), are fixed.
+    const bool tunable = kind == Kind::Plant && std::string(p.section) == "controller";
+    const auto member = p.member;
+    Variable x = real(std::string(p.section) + "." + p.key, p.unit, std::string(p.doc) + " (" + p.source + ")",
+                      Causality::Parameter, tunable ? Variability::Tunable : Variability::Fixed,
+                      [member](Values& v) -> double& { return v.settings.rig.*member; });
+    x.in_rig = true;
+    out.push_back(std::move(x));
+  }
+  for (const EffectInfo& e : kEffects) {
+    const auto member = e.member;
+    const std::string name = std::string("effects.") + e.key;
+    Variable x = base(name, Type::Boolean, Causality::Parameter, Variability::Fixed, "", e.doc);
+    x.in_rig = true;
+    x.get = [member](const Values& v) { return v.settings.rig.effects.*member ? 1.0 : 0.0; };
+    x.set = [member, name](Values& v, double d) {
+      if (d != 0.0 && d != 1.0) bad_value(name, d, "expected a Boolean");
+      v.settings.rig.effects.*member = d != 0.0;
+    };
+    out.push_back(std::move(x));
+  }
+}
+
+void add_sensors(std::vector<Variable>& out) {
+  for (const ChannelInfo& c : kPlantChannels) {
+    if (c.member == &Output::time) continue;  // the FMU's own time
+    const auto member = c.member;
+    out.push_back(real(std::string("sensors.") + c.name, c.unit, std::string("sensor input: ") + c.doc,
+                       Causality::Input, Variability::Continuous,
+                       [member](Values& v) -> double& { return v.sensors.*member; }));
+  }
+}
+
+//! A controller's channel table as outputs, less the channels that echo an input of the same name.
+template <class Row, std::size_t N>
+void add_outputs(std::vector<Variable>& out, const ChannelInfoOf<Row> (&table)[N], Row Values::*row) {
+  for (const auto& c : table) {
+    if (find(out, c.name) >= 0) continue;
+    const auto member = c.member;
+    out.push_back(real(c.name, c.unit, c.doc, Causality::Output, Variability::Discrete,
+                       [row, member](Values& v) -> double& { return (v.*row).*member; }));
+  }
+}
+
+void add_dt(std::vector<Variable>& out) {
+  out.push_back(parameter("dt", "s", "controller sample time: every doStep is a whole number of samples",
+                          [](Values& v) -> double& { return v.settings.dt; }));
+}
+
+void add_plant(std::vector<Variable>& out, ControlMode mode) {
+  out.push_back(real("command", mode == ControlMode::Displacement ? "m" : "N",
+                     "command held over each sample (displacement [m] or force [N] per the control mode)",
+                     Causality::Input, Variability::Continuous, [](Values& v) -> double& { return v.command; }));
+  for (const ChannelInfo& c : kPlantChannels) {
+    if (c.member == &Output::time) continue;
+    const auto member = c.member;
+    out.push_back(real(c.name, c.unit, c.doc, Causality::Output, Variability::Continuous,
+                       [member](Values& v) -> double& { return v.plant_out.*member; }));
+  }
+  Variable flags = base("flags", Type::Integer, Causality::Output, Variability::Discrete, "",
+                        "OutputFlag bits: 1 capacity, 2 supply-limited, 4 spool saturated, 8 drive saturated, "
+                        "16 stroke exceeded");
+  flags.get = [](const Values& v) { return static_cast<double>(v.plant_out.flags); };
+  out.push_back(std::move(flags));
+  add_dt(out);
+  out.push_back(parameter("x0", "m", "initial displacement (static equilibrium there)",
+                          [](Values& v) -> double& { return v.settings.x0; }));
+  // The names of SolverOptions::Method, in the enum's order (those of simulate.py's METHODS); a new
+  // method needs its name here, else exporting with it is a ValueError naming solver.method.
+  out.push_back(enumeration<SolverOptions::Method>(
+      "solver.method", "SolverMethod", {"cvode", "rk4"}, "the plant's ODE integrator (solver_options.hpp)",
+      [](Values& v) -> SolverOptions::Method& { return v.settings.solver.method; }));
+  out.push_back(enumeration<SolverOptions::Restart>(
+      "solver.restart", "SolverRestart", {"on_input_change", "never"}, "CVODE restart on a command jump",
+      [](Values& v) -> SolverOptions::Restart& { return v.settings.solver.restart; }));
+  out.push_back(parameter("solver.rtol", "", "CVODE relative tolerance",
+                          [](Values& v) -> double& { return v.settings.solver.rtol; }));
+  out.push_back(integer<int>("solver.rk4_substeps", "RK4 substeps per sample (0 = automatic)",
+                             [](Values& v) -> int& { return v.settings.solver.rk4_substeps; }));
+  out.push_back(integer<long>("solver.max_steps_per_sample", "cap on CVODE internal steps in one sample",
+                              [](Values& v) -> long& { return v.settings.solver.max_steps_per_sample; }));
+}
+
+void add_eft(std::vector<Variable>& out) {
+  out.push_back(real("ground_acceleration", "m/s^2", "ground acceleration a_g(t_k)", Causality::Input,
+                     Variability::Continuous, [](Values& v) -> double& { return v.ground_acceleration; }));
+  add_sensors(out);
+  add_outputs(out, kEftChannels, &Values::eft_out);
+  add_dt(out);
+  out.push_back(resolved("eft.mass", "kg", "m in P_eff = -m a_g",
+                         [](Values& v) -> std::optional<double>& { return v.settings.eft.mass; }));
+  out.push_back(enumeration<VelocityFeedbackCompensator::Kind>(
+      "eft.compensation", "Compensation", {"none", "linear", "nonlinear"}, "velocity feedback compensation",
+      [](Values& v) -> VelocityFeedbackCompensator::Kind& { return v.settings.eft.compensation; }));
+  out.push_back(parameter("eft.lead_T", "s", "phase lead on the compensation (0 = none)",
+                          [](Values& v) -> double& { return v.settings.eft.lead_T; }));
+  out.push_back(parameter("eft.alpha", "", "phase-lead constant",
+                          [](Values& v) -> double& { return v.settings.eft.alpha; }));
+  out.push_back(integer<int>("eft.compute_delay", "samples of compute delay on the command",
+                             [](Values& v) -> int& { return v.settings.eft.compute_delay; }));
+}
+
+void add_rpsd_config(std::vector<Variable>& out) {
+  using Opt = std::optional<double>;
+  out.push_back(parameter("rpsd.m_m", "kg", "modelled mass of Eq (15)",
+                          [](Values& v) -> double& { return v.settings.rpsd.model.m_m; }));
+  out.push_back(parameter("rpsd.c_m", "N s/m", "modelled damping of Eq (15)",
+                          [](Values& v) -> double& { return v.settings.rpsd.model.c_m; }));
+  out.push_back(resolved("rpsd.k_m", "N/m", "stiffness of the displacement-based restoring forces",
+                         [](Values& v) -> Opt& { return v.settings.rpsd.k_m; }));
+  out.push_back(enumeration<IntegrationScheme>(
+      "rpsd.scheme", "IntegrationScheme", {"central_difference", "explicit_newmark"}, "integration scheme of Eq (15)",
+      [](Values& v) -> IntegrationScheme& { return v.settings.rpsd.scheme; }));
+  out.push_back(enumeration<RestoringForce>(
+      "rpsd.restoring_force", "RestoringForce",
+      {"calculated_displacement", "measured_displacement", "measured_force", "measured_force_corrected"},
+      "restoring force option (a)-(d)", [](Values& v) -> RestoringForce& { return v.settings.rpsd.restoring_force; }));
+  out.push_back(enumeration<ForceMeasurement>(
+      "rpsd.force_measurement", "ForceMeasurement", {"load_cell", "actuator_pressure"},
+      "measured force: load cell or p A",
+      [](Values& v) -> ForceMeasurement& { return v.settings.rpsd.force_measurement; }));
+  out.push_back(parameter("rpsd.amplitude_T", "s", "amplitude compensation T_d on the command (0 = none)",
+                          [](Values& v) -> double& { return v.settings.rpsd.amplitude_T; }));
+  out.push_back(parameter("rpsd.delay_T", "s", "delay compensation T_ld on the restoring force (0 = none)",
+                          [](Values& v) -> double& { return v.settings.rpsd.delay_T; }));
+  out.push_back(parameter("rpsd.alpha", "", "phase-lead constant of both networks",
+                          [](Values& v) -> double& { return v.settings.rpsd.alpha; }));
+  out.push_back(resolved("rpsd.subtract_mass", "kg", "option (d): mass times measured acceleration removed",
+                         [](Values& v) -> Opt& { return v.settings.rpsd.subtract_mass; }));
+  out.push_back(resolved("rpsd.subtract_damping", "N s/m", "option (d): damping times measured velocity removed",
+                         [](Values& v) -> Opt& { return v.settings.rpsd.subtract_damping; }));
+  out.push_back(integer<int>("rpsd.compute_delay", "samples of compute delay on the command",
+                             [](Values& v) -> int& { return v.settings.rpsd.compute_delay; }));
+}
+
+void add_rpsd(std::vector<Variable>& out) {
+  out.push_back(real("ground_acceleration", "m/s^2", "ground acceleration a_g(t_k)", Causality::Input,
+                     Variability::Continuous, [](Values& v) -> double& { return v.ground_acceleration; }));
+  out.push_back(real("external_force", "N", "external force P_ext into the solver", Causality::Input,
+                     Variability::Continuous, [](Values& v) -> double& { return v.external_force; }));
+  out.push_back(real("restoring_force_error", "N", "error added to the restoring force", Causality::Input,
+                     Variability::Continuous, [](Values& v) -> double& { return v.restoring_force_error; }));
+  add_sensors(out);
+  add_outputs(out, kRpsdChannels, &Values::rpsd_out);
+  add_dt(out);
+  add_rpsd_config(out);
+}
+
+}  // namespace
+
+int item_index(const Variable& var, const std::string& item) {
+  for (std::size_t i = 0; i < var.items.size(); ++i)
+    if (var.items[i] == item) return static_cast<int>(i);
+  throw Error("invalid " + var.name + " = \"" + item + "\": expected one of " + expected_items(var));
+}
+
+std::vector<Variable> variables(Kind kind, ControlMode mode) {
+  std::vector<Variable> out;
+  switch (kind) {
+    case Kind::Plant: add_plant(out, mode); break;
+    case Kind::Eft: add_eft(out); break;
+    case Kind::Rpsd: add_rpsd(out); break;
+  }
+  add_rig(out, kind);
+  return out;
+}
+
+}  // namespace servohydraulics::fmu

@@ -1,0 +1,172 @@
+// The FMU binary as a host tool uses it: dlopen, the fmi2* functions by name.
+// - The plant FMU stepped sample by sample equals Plant::step on the same
+//   commands, bit for bit (the same core inside).
+// - After initialisation, fmi2SetReal / fmi2DoStep / fmi2GetReal allocate
+//   nothing, for the plant and both controllers (the counter sees the binary's
+//   malloc calls: its static C++ runtime calls glibc's malloc, which this
+//   executable interposes).
+// - A bad parameter is fmi2Error with a message naming it; two instances in one
+//   process do not share state.
+#include <dlfcn.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "alloc_counter.hpp"
+#include "check.hpp"
+#include "fmi2Functions.h"
+#include "model.hpp"
+
+namespace fmu = servohydraulics::fmu;
+using servohydraulics::ControlMode;
+
+namespace {
+
+std::string g_log;  // the last message the FMU logged
+void logger(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String message, ...) {
+  char buf[1024];
+  va_list args;
+  va_start(args, message);
+  std::vsnprintf(buf, sizeof buf, message, args);
+  va_end(args);
+  g_log = buf;
+}
+const fmi2CallbackFunctions kCallbacks = {logger, nullptr, nullptr, nullptr, nullptr};
+
+struct Api {
+  void* lib = dlopen(SH_FMU_BINARY, RTLD_NOW | RTLD_LOCAL);
+  template <class T>
+  T* get(const char* name) const { return reinterpret_cast<T*>(dlsym(lib, name)); }
+  fmi2InstantiateTYPE* instantiate = get<fmi2InstantiateTYPE>("fmi2Instantiate");
+  fmi2SetupExperimentTYPE* setup = get<fmi2SetupExperimentTYPE>("fmi2SetupExperiment");
+  fmi2EnterInitializationModeTYPE* enter = get<fmi2EnterInitializationModeTYPE>("fmi2EnterInitializationMode");
+  fmi2ExitInitializationModeTYPE* exit = get<fmi2ExitInitializationModeTYPE>("fmi2ExitInitializationMode");
+  fmi2SetRealTYPE* set_real = get<fmi2SetRealTYPE>("fmi2SetReal");
+  fmi2GetRealTYPE* get_real = get<fmi2GetRealTYPE>("fmi2GetReal");
+  fmi2DoStepTYPE* do_step = get<fmi2DoStepTYPE>("fmi2DoStep");
+  fmi2FreeInstanceTYPE* free_instance = get<fmi2FreeInstanceTYPE>("fmi2FreeInstance");
+};
+
+//! A resources directory for an FMU of this kind over the default rig.
+std::string resources(const char* kind, const char* mode) {
+  char tmpl[] = "/tmp/sh_fmu_test_XXXXXX";
+  const std::string dir = mkdtemp(tmpl);
+  std::ofstream(dir + "/fmu.toml") << "kind = \"" << kind << "\"\nmode = \"" << mode << "\"\nguid = \"{test}\"\n";
+  std::ofstream(dir + "/rig.toml") << "# the core's default rig\n";
+  return dir;
+}
+
+fmi2ValueReference vr(fmu::Kind kind, ControlMode mode, const char* name) {
+  const int i = fmu::find(fmu::variables(kind, mode), name);
+  CHECK(i >= 0);
+  return static_cast<fmi2ValueReference>(i);
+}
+
+fmi2Component start(const Api& api, const std::string& dir, const char* name) {
+  const std::string uri = "file://" + dir;
+  sh_test::AllocationCounter counter;
+  fmi2Component c = api.instantiate(name, fmi2CoSimulation, "{test}", uri.c_str(), &kCallbacks, fmi2False, fmi2False);
+  CHECK(counter.count() > 10);  // the counter sees the binary's allocations (so its zeros below mean something)
+  CHECK(c != nullptr);
+  CHECK(api.setup(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) == fmi2OK);
+  CHECK(api.enter(c) == fmi2OK);
+  CHECK(api.exit(c) == fmi2OK);
+  return c;
+}
+
+void plant_equals_core(const Api& api) {
+  const double dt = 5e-4;
+  const std::string dir = resources("plant", "displacement");
+  fmi2Component a = start(api, dir, "a"), b = start(api, dir, "b");
+  const fmi2ValueReference u_vr = vr(fmu::Kind::Plant, ControlMode::Displacement, "command");
+  const fmi2ValueReference out_vr[2] = {vr(fmu::Kind::Plant, ControlMode::Displacement, "displacement"),
+                                        vr(fmu::Kind::Plant, ControlMode::Displacement, "force")};
+  servohydraulics::Plant plant(servohydraulics::Rig{}, ControlMode::Displacement, dt);
+  plant.reset(0.0, 0.0);
+  servohydraulics::Output out;
+  long allocations = 0, mismatches = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const double u = 0.01 * std::sin(2 * M_PI * 2.0 * k * dt), zero = 0.0;
+    plant.step(u, out);
+    double y[2], yb[2];
+    sh_test::AllocationCounter counter;
+    api.set_real(a, &u_vr, 1, &u);
+    api.set_real(b, &u_vr, 1, &zero);  // the other instance holds 0
+    const fmi2Status st = api.do_step(a, k * dt, dt, fmi2True);
+    api.do_step(b, k * dt, dt, fmi2True);
+    api.get_real(a, out_vr, 2, y);
+    api.get_real(b, out_vr, 2, yb);
+    allocations += counter.count();
+    CHECK(st == fmi2OK);
+    if (y[0] != out.displacement || y[1] != out.force || yb[0] != 0.0) ++mismatches;
+  }
+  CHECK(mismatches == 0);
+  CHECK(allocations == 0);
+  api.free_instance(a);
+  api.free_instance(b);
+}
+
+//! A controller stepped with sensor inputs and a_g: no allocation, finite outputs.
+void controller_allocates_nothing(const Api& api, fmu::Kind kind, const char* name, const char* mode) {
+  const std::string dir = resources(name, mode);
+  fmi2Component c = start(api, dir, name);
+  const ControlMode m = fmu::parse_mode(mode);
+  const fmi2ValueReference in[3] = {vr(kind, m, "ground_acceleration"), vr(kind, m, "sensors.velocity"),
+                                    vr(kind, m, "sensors.displacement")};
+  const fmi2ValueReference cmd = vr(kind, m, "command");
+  long allocations = 0, bad = 0;
+  for (int k = 0; k < 1000; ++k) {
+    const double t = k * 5e-4, x[3] = {std::sin(10 * t), 0.01 * std::cos(10 * t), 0.001 * std::sin(10 * t)};
+    double u = NAN;
+    sh_test::AllocationCounter counter;
+    api.set_real(c, in, 3, x);
+    api.get_real(c, &cmd, 1, &u);
+    const fmi2Status st = api.do_step(c, t, 5e-4, fmi2True);
+    allocations += counter.count();
+    if (st != fmi2OK || !std::isfinite(u)) ++bad;
+  }
+  CHECK(bad == 0);
+  CHECK(allocations == 0);
+  api.free_instance(c);
+}
+
+void bad_parameter_is_an_error(const Api& api) {
+  const std::string dir = resources("plant", "force");
+  fmi2Component c = api.instantiate("bad", fmi2CoSimulation, "{test}", ("file://" + dir).c_str(), &kCallbacks,
+                                    fmi2False, fmi2False);
+  const fmi2ValueReference k = vr(fmu::Kind::Plant, ControlMode::Force, "structure.k");
+  const double minus = -5.0;
+  CHECK(api.enter(c) == fmi2OK);
+  CHECK(api.set_real(c, &k, 1, &minus) == fmi2OK);
+  CHECK(api.exit(c) == fmi2Error);
+  CHECK(g_log.find("k = -5") != std::string::npos);
+  api.free_instance(c);
+  // a wrong GUID and a missing resource directory: no instance, a message
+  CHECK(api.instantiate("x", fmi2CoSimulation, "{other}", ("file://" + dir).c_str(), &kCallbacks, fmi2False,
+                        fmi2False) == nullptr);
+  CHECK(g_log.find("GUID") != std::string::npos);
+  CHECK(api.instantiate("x", fmi2CoSimulation, "{test}", "file:///nonexistent/resources", &kCallbacks, fmi2False,
+                        fmi2False) == nullptr);
+  CHECK(g_log.find("cannot read") != std::string::npos);
+}
+
+}  // namespace
+
+int main() {
+  Api api;
+  CHECK(api.lib != nullptr);
+  if (!api.lib) {
+    std::fprintf(stderr, "dlopen %s: %s\n", SH_FMU_BINARY, dlerror());
+    return sh_test::report("test_fmu_binary");
+  }
+  plant_equals_core(api);
+  controller_allocates_nothing(api, fmu::Kind::Eft, "eft", "force");
+  controller_allocates_nothing(api, fmu::Kind::Rpsd, "rpsd", "displacement");
+  bad_parameter_is_an_error(api);
+  return sh_test::report("test_fmu_binary");
+}
