@@ -123,12 +123,29 @@ def fit_frequency(records: list[Response], rig: Rig, coords: Coordinates, mode: 
 MAX_RK4_SUBSTEPS = 200
 
 
+#: the hysteretic specimens' rate bound uses this multiple of the records' peak velocity
+V_REF_MARGIN = 2.0
+
+
+def records_peak_velocity(records: list[Response]) -> float:
+    """The largest 99.9th percentile of |velocity| [m/s] over the records (displacement
+    low-passed at 200 Hz and differenced)."""
+    from .generic import record_scales
+
+    return max(record_scales(r)["v_pk"] for r in records)
+
+
 def fixed_rk4(rig: Rig, records: list[Response], mode: str, margin: float = 2.0):
     """RK4 options with the substep count fixed at ``margin`` times the automatic count
-    of the start; CVODE when that count would exceed ``MAX_RK4_SUBSTEPS``."""
+    of the start; CVODE when that count would exceed ``MAX_RK4_SUBSTEPS``.  The
+    automatic count bounds a hysteretic specimen's rate with the sliding speed
+    ``V_REF_MARGIN`` times the records' peak velocity (not the actuator's no-load
+    speed: a record shows how fast the rig moved)."""
     dt = min(r.dt for r in records)
+    v_ref = V_REF_MARGIN * max(records_peak_velocity(records), 1e-4)
     try:
-        n = make_plant(rig, mode, dt, solver_options(method="rk4"), initial_displacement(records[0])).rk4_substeps
+        n = make_plant(rig, mode, dt, solver_options(method="rk4", rk4_v_ref=v_ref),
+                       initial_displacement(records[0])).rk4_substeps
     except Error:
         n = MAX_RK4_SUBSTEPS + 1
     if margin * n > MAX_RK4_SUBSTEPS:
@@ -165,26 +182,98 @@ def channel_weights(rig: Rig, records: list[Response], mode: str, channels: tupl
                                                     ** 2))), 1e-3) for ch in channels}
 
 
+#: least_squares' stopping tolerances: a relative cost change below 1e-4 is far below
+#: what separates the models compared here (NRMSE differences of 0.1 %)
+FTOL, XTOL = 1e-4, 1e-6
+
+#: relative forward-difference step of the time-domain Jacobian (in the fitting coordinates)
+DIFF_STEP = 1e-3
+
+
+def default_workers() -> int:
+    """Threads for the Jacobian's columns: the core releases the GIL while it simulates."""
+    import os
+
+    return max(1, min(2, os.cpu_count() or 1))
+
+
+def forward_jacobian(fun, z: np.ndarray, f0: np.ndarray, hi: np.ndarray, workers: int) -> np.ndarray:
+    """Forward differences of ``fun`` at z (steps DIFF_STEP max(1, |z_i|), backwards at an
+    upper bound), the columns evaluated on ``workers`` threads."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    h = DIFF_STEP * np.maximum(1.0, np.abs(z))
+    h = np.where(z + h > hi, -h, h)
+
+    def column(i: int) -> np.ndarray:
+        zi = z.copy()
+        zi[i] += h[i]
+        return (fun(zi) - f0) / h[i]
+
+    if workers <= 1:
+        cols = [column(i) for i in range(z.size)]
+    else:
+        with ThreadPoolExecutor(max_workers=workers) as pool:
+            cols = list(pool.map(column, range(z.size)))
+    return np.column_stack(cols)
+
+
 def fit_time(records: list[Response], rig: Rig, coords: Coordinates, z0: np.ndarray, mode: str,
              channels: tuple[str, ...], options, dt: float | None = None, max_nfev: int = 60,
-             progress=None, weights: dict | None = None) -> StageResult:
-    """Stage 2 from z0 (see the module docstring)."""
+             progress=None, weights: dict | None = None, active: np.ndarray | None = None,
+             workers: int | None = None) -> StageResult:
+    """Stage 2 from z0 (see the module docstring): the ``active`` keys (default all)
+    move, the others stay at z0; the Jacobian's columns run on ``workers`` threads.
+    The result's z covers every key; its ``jac`` the active ones."""
     n = sum(rec.time.size for rec in records) * len(channels)
+    act = np.ones(z0.size, dtype=bool) if active is None else np.asarray(active, dtype=bool)
+    workers = default_workers() if workers is None else int(workers)
+    cache: dict = {}
 
-    def residual(z: np.ndarray) -> np.ndarray:
+    def full(za: np.ndarray) -> np.ndarray:
+        z = np.array(z0, dtype=float)
+        z[act] = za
+        return z
+
+    def residual(za: np.ndarray) -> np.ndarray:
         if progress is not None:
             progress.update(1)
         try:
-            r = coords.apply(rig, z)
+            r = coords.apply(rig, full(za))
         except ValueError:  # the step left the rig's valid range: a failed point
             return np.full(n, FAILED)
         return time_residual(r, records, mode, channels, options, dt, weights)
 
-    lo, hi = coords.bounds()
-    sol = least_squares(residual, np.clip(z0, lo, hi), bounds=(lo, hi), method="trf", jac="2-point",
-                        diff_step=1e-3, x_scale=1.0, xtol=1e-8, ftol=1e-8, max_nfev=max_nfev)
-    return StageResult(sol.x, float(sol.cost), int(sol.nfev), sol.fun, sol.jac)
+    def fun(za: np.ndarray) -> np.ndarray:
+        cache["z"], cache["f"] = za.copy(), residual(za)
+        return cache["f"]
+
+    lo, hi = (b[act] for b in coords.bounds())
+
+    def jac(za: np.ndarray) -> np.ndarray:
+        f0 = cache["f"] if "z" in cache and np.array_equal(cache["z"], za) else residual(za)
+        return forward_jacobian(residual, za, f0, hi, workers)
+
+    sol = least_squares(fun, np.clip(np.asarray(z0, dtype=float)[act], lo, hi), bounds=(lo, hi), method="trf",
+                        jac=jac, x_scale=1.0, xtol=XTOL, ftol=FTOL, max_nfev=max_nfev)
+    return StageResult(full(sol.x), float(sol.cost), int(sol.nfev), sol.fun, sol.jac)
 
 
-__all__ = ["MAX_RK4_SUBSTEPS", "MIN_COHERENCE", "StageResult", "channel_weights", "fit_frequency", "fit_time", "fixed_rk4", "frequency_targets",
-           "linear_response", "time_residual"]
+def jacobian_at(records: list[Response], rig: Rig, coords: Coordinates, z: np.ndarray, mode: str,
+                channels: tuple[str, ...], options, dt: float | None = None, weights: dict | None = None,
+                workers: int | None = None, progress=None) -> StageResult:
+    """The residual and its Jacobian over every key at z (for the uncertainty after a block-wise fit)."""
+    def residual(zz: np.ndarray) -> np.ndarray:
+        if progress is not None:
+            progress.update(1)
+        return time_residual(coords.apply(rig, zz), records, mode, channels, options, dt, weights)
+
+    f0 = residual(np.asarray(z, dtype=float))
+    J = forward_jacobian(residual, np.asarray(z, dtype=float), f0, coords.bounds()[1],
+                         default_workers() if workers is None else int(workers))
+    return StageResult(np.asarray(z, dtype=float), float(f0 @ f0) / 2, 1 + z.size, f0, J)
+
+
+__all__ = ["DIFF_STEP", "MAX_RK4_SUBSTEPS", "MIN_COHERENCE", "StageResult", "channel_weights", "default_workers",
+           "fit_frequency", "fit_time", "fixed_rk4", "forward_jacobian", "frequency_targets", "jacobian_at",
+           "linear_response", "records_peak_velocity", "time_residual"]

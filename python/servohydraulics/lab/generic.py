@@ -56,6 +56,58 @@ def specimen_kc(record: Response) -> tuple[float, float]:
     return max(float(k), 1.0), max(float(c), 0.0)
 
 
+#: MR-damper start: Bouc-Wen A and n (Spencer et al. 1997: 301, 2), c1 / c0, and the
+#: relative displacement over which z yields, as a fraction of the record's peak displacement
+MR_A, MR_N, MR_C1_OVER_C0, MR_YIELD_FRACTION = 300.0, 2.0, 10.0, 0.05
+
+
+def bingham_fit(record: Response) -> dict[str, float]:
+    """F = f_y sgn(v) + c v + k x + m a + F_0 fitted by least squares to the record
+    (x, v, a: the displacement low-passed at 200 Hz and differenced); f_y, c, m >= 0."""
+    x, v = smoothed_motion(np.asarray(record.displacement, dtype=float), record.dt)
+    a = np.gradient(v, record.dt)
+    X = np.column_stack([np.tanh(v / (0.02 * np.max(np.abs(v)))), v, x, a, np.ones_like(x)])
+    coef, *_ = np.linalg.lstsq(X, np.asarray(record.force, dtype=float), rcond=None)
+    f_y, c, k, m, _ = (float(q) for q in coef)
+    return {"f_y": max(f_y, 0.0), "c": max(c, 0.0), "k": k, "m": max(m, 0.0)}
+
+
+def mr_damper_start(rig: Rig, record: Response) -> None:
+    """Spencer MR-damper keys in ``rig`` from the record's Bingham fit (the damper's
+    yield force f_y and post-yield damping c): high-velocity force c1 / (c0 + c1)
+    (alpha z_u + c0 v) = f_y + c v with c1 = 10 c0, z_u = A x_y (yield over x_y = 5 %
+    of the peak displacement), beta = gamma = A / (2 z_u^n); k1 = max(k, 0), k0 = 0,
+    x0 = 0, voltage 0; the structure's own k, c at their floor (1 N/m, 0)."""
+    b, s = bingham_fit(record), record_scales(record)
+    ratio = MR_C1_OVER_C0 / (1.0 + MR_C1_OVER_C0)  # c1 / (c0 + c1)
+    z_u = MR_A * max(MR_YIELD_FRACTION * s["x_pk"], 1e-6)
+    rig.mr_c0_a, rig.mr_c0_b = max(b["c"], 1.0) / ratio, 0.0
+    rig.mr_c1_a, rig.mr_c1_b = MR_C1_OVER_C0 * rig.mr_c0_a, 0.0
+    rig.mr_alpha_a, rig.mr_alpha_b = max(b["f_y"], 1.0) / (ratio * z_u), 0.0
+    rig.mr_A, rig.mr_n = MR_A, MR_N
+    rig.mr_beta = rig.mr_gamma = MR_A / (2.0 * z_u**MR_N)
+    rig.mr_k0, rig.mr_k1, rig.mr_x0, rig.mr_voltage = 0.0, max(b["k"], 0.0), 0.0, 0.0
+    rig.k, rig.c, rig.m = 1.0, 0.0, max(b["m"], 0.1)
+
+
+def bouc_wen_start(rig: Rig, record: Response) -> None:
+    """Bouc-Wen keys (n = 1, A = 1) from the Bingham fit: ultimate force bw_k z_u = f_y,
+    z_u = x_y = 5 % of the peak displacement, beta = gamma = 1 / (2 z_u); c, m from the fit."""
+    b, s = bingham_fit(record), record_scales(record)
+    z_u = max(MR_YIELD_FRACTION * s["x_pk"], 1e-6)
+    rig.bw_A, rig.bw_n = 1.0, 1.0
+    rig.bw_k = max(b["f_y"], 1.0) / z_u
+    rig.bw_beta = rig.bw_gamma = 1.0 / (2.0 * z_u)
+    rig.k, rig.c, rig.m = max(b["k"], 1.0), b["c"], max(b["m"], 0.1)
+
+
+def specimen_start(rig: Rig, record: Response, specimen: str) -> None:
+    """The generic start of the ``specimen`` kind's keys from the record (``linear``:
+    :func:`specimen_kc`, already in :func:`generic_rig`)."""
+    starts = {"linear": lambda r, rec: None, "bouc_wen": bouc_wen_start, "mr_damper": mr_damper_start}
+    starts[specimen](rig, record)
+
+
 def generic_rig(record: Response) -> Rig:
     """The generic rig scaled from ``record`` (a Response with time, command, displacement, force)."""
     s = record_scales(record)
@@ -82,4 +134,5 @@ def generic_rig(record: Response) -> Rig:
     return r
 
 
-__all__ = ["BETA_E", "P_SUPPLY", "generic_rig", "record_scales", "specimen_kc"]
+__all__ = ["BETA_E", "P_SUPPLY", "bingham_fit", "bouc_wen_start", "generic_rig", "mr_damper_start", "record_scales", "specimen_start",
+           "specimen_kc"]

@@ -32,9 +32,9 @@ from ..records import read_record
 from ..response import Response
 from ..rig import Rig, load_rig, save_rig
 from .compare import Comparison, channels_of, compare, write_json
-from .fitting import StageResult, channel_weights, fit_frequency, fit_time, fixed_rk4
-from .generic import generic_rig
-from .keys import LOOP_KEYS, Coordinates, check_keys, specimen_keys, use_specimen
+from .fitting import StageResult, channel_weights, fit_frequency, fit_time, fixed_rk4, jacobian_at
+from .generic import generic_rig, specimen_start
+from .keys import FORCE_KEYS, LOOP_KEYS, Coordinates, check_keys, specimen_keys, use_specimen
 from .run import simulate_record
 
 LEVEL = 0.95
@@ -166,10 +166,38 @@ def separability_flags(keys, values: dict, intervals: dict, corr: np.ndarray) ->
     return flags
 
 
+def time_blocks(keys: tuple[str, ...], channels: tuple[str, ...], mode: str) -> list[tuple[np.ndarray, tuple]]:
+    """The time-domain stage's blocks (active keys, channels fitted), in order.  In
+    displacement control with both channels: the loop's keys (every key that is not a
+    force key, ``FORCE_KEYS``) on the displacement, then the force keys on the force (the
+    specimen sees the displacement the loop makes; the records show a tracking that does
+    not depend on the load).  Otherwise one block: every key on every channel."""
+    force = np.array([k in FORCE_KEYS for k in keys])
+    if mode == "displacement" and set(channels) >= {"displacement", "force"} and force.any() and not force.all():
+        return [(~force, ("displacement",)), (force, ("force",))]
+    return [(np.ones(len(keys), dtype=bool), channels)]
+
+
+def _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar, workers):
+    """Stage 2 block by block (:func:`time_blocks`), then the residual and Jacobian of every
+    key on every channel at the result (weights 1 / rms of each channel's residual there)."""
+    z = np.array(z1, dtype=float)
+    nfev = 0
+    blocks = time_blocks(coords.keys, chans, mode)
+    for active, block_chans in blocks:
+        w = channel_weights(coords.apply(start, z), recs, mode, block_chans, options, dt) \
+            if len(blocks) == 1 else None
+        s = fit_time(recs, start, coords, z, mode, block_chans, options, dt, max_nfev, bar, w, active, workers)
+        z, nfev = s.z, nfev + s.nfev
+    weights = channel_weights(coords.apply(start, z), recs, mode, chans, options, dt)
+    final = jacobian_at(recs, start, coords, z, mode, chans, options, dt, weights, workers, bar)
+    return StageResult(z, final.cost, nfev, final.fun, final.jac), weights
+
+
 def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | None = None,
              mode: str = "displacement", specimen: str = "linear", channels: Sequence[str] | None = None,
              dt: float | None = None, frequency_stage: bool = True, max_nfev: int = 60,
-             progress: bool = True) -> Identification:
+             progress: bool = True, workers: int | None = None) -> Identification:
     """Identifies rig keys from lab records (see the module docstring).
 
     Args:
@@ -183,6 +211,7 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         frequency_stage: run stage 1 (the H1 fit of the linearised model) before the time domain.
         max_nfev: the time-domain stage's budget of residual evaluations (Jacobians not counted).
         progress: a tqdm bar over the simulations.
+        workers: threads for the Jacobian's columns (default: up to 2).
     """
     if mode not in LOOP_KEYS:
         raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(LOOP_KEYS)}")
@@ -190,6 +219,8 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
     recs = as_records(records)
     spec = specimen_keys(specimen)
     start, generic = _start_rig(rig, recs)
+    if generic:
+        specimen_start(start, recs[0], specimen)
     use_specimen(start, specimen)
     keys = check_keys(start, fit if fit is not None else LOOP_KEYS[mode] + spec)
     chans = tuple(channels) if channels is not None else channels_of(recs[0], mode)
@@ -208,9 +239,8 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
     t0 = time.perf_counter()
     from tqdm.auto import tqdm
 
-    weights = channel_weights(coords.apply(start, z1), recs, mode, chans, options, dt)
     with tqdm(desc="identify (simulations)", unit="sim", disable=not progress, leave=False) as bar:
-        s2 = fit_time(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar, weights)
+        s2, weights = _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar, workers)
     nfev["time"], runtime["time"] = s2.nfev, time.perf_counter() - t0
     cov, corr, n_eff, rho = uncertainty(s2, coords)
     zq = float(norm.ppf(0.5 + LEVEL / 2))

@@ -34,16 +34,21 @@ from ..rig import Rig
 LOOP_KEYS = {"displacement": ("G_p", "f_v", "zeta_v"), "force": ("G_p", "f_v", "zeta_v")}
 
 SPECIMEN_KEYS = {
-    "linear": ("k", "c"),
-    "bouc_wen": ("bw_k", "bw_alpha", "bw_x_y", "bw_beta", "bw_gamma"),
-    "mr_damper": ("mr_alpha_a", "mr_c0_a", "mr_c1_a", "mr_k0", "mr_k1", "mr_beta", "mr_gamma"),
+    "linear": ("k", "c", "m"),
+    "bouc_wen": ("bw_k", "bw_beta", "bw_gamma", "c", "m"),
+    "mr_damper": ("mr_alpha_a", "mr_c0_a", "mr_c1_a", "mr_k1", "mr_beta", "mr_gamma", "m"),
 }
 
-#: every field name the issue-12 Spencer element is expected to carry (held ones included)
-MR_DAMPER_FIELDS = ("mr_alpha_a", "mr_alpha_b", "mr_c0_a", "mr_c0_b", "mr_c1_a", "mr_c1_b", "mr_k0", "mr_k1",
-                    "mr_x0", "mr_A", "mr_beta", "mr_gamma", "mr_n", "mr_eta")
+#: keys that act on the measured force and hardly on the displacement: in displacement
+#: control they are fitted on the force channel, the others on the displacement
+FORCE_KEYS = frozenset({k for ks in SPECIMEN_KEYS.values() for k in ks} |
+                       {"measurement_delay_force", "F_c", "bw_A", "bw_n", "mr_k0", "mr_x0", "mr_A", "mr_n"})
 
-SPECIMEN_EFFECT = {"linear": None, "bouc_wen": "bouc_wen", "mr_damper": "mr_damper"}
+#: the Spencer element's fields (the fitted ones and those held at one constant current)
+MR_DAMPER_FIELDS = ("mr_alpha_a", "mr_alpha_b", "mr_c0_a", "mr_c0_b", "mr_c1_a", "mr_c1_b", "mr_k0", "mr_k1",
+                    "mr_x0", "mr_A", "mr_beta", "mr_gamma", "mr_n", "mr_voltage")
+
+SPECIMEN_EFFECT = {"linear": None, "bouc_wen": "bouc_wen_hysteresis", "mr_damper": "mr_damper"}
 
 #: plausible ranges [SI] that bound a fit (the start is clipped into them).  The
 #: valve's: a fit may otherwise turn Eq (2) into a first-order lag (zeta_v -> 1e4,
@@ -53,7 +58,7 @@ RANGES = {"f_v": (1.0, 300.0), "zeta_v": (0.1, 2.0)}
 #: log-space keys move at most a factor exp(30) ~ 1e13 from their start
 Z_LOG_MAX = 30.0
 
-SIGNED_KEYS = frozenset({"mr_x0", "mr_alpha_b", "mr_c0_b", "mr_c1_b", "x_contact"})
+SIGNED_KEYS = frozenset({"x_contact"})
 
 
 def _bounds() -> dict[str, str]:
@@ -152,5 +157,5 @@ class Coordinates:
         return float(self.start[i] + z * self.scale[i])
 
 
-__all__ = ["LOOP_KEYS", "RANGES", "MR_DAMPER_FIELDS", "SIGNED_KEYS", "SPECIMEN_EFFECT", "SPECIMEN_KEYS", "Coordinates",
+__all__ = ["FORCE_KEYS", "LOOP_KEYS", "RANGES", "MR_DAMPER_FIELDS", "SIGNED_KEYS", "SPECIMEN_EFFECT", "SPECIMEN_KEYS", "Coordinates",
            "check_keys", "specimen_keys", "use_specimen"]
