@@ -85,36 +85,73 @@ def smoothed_motion(displacement: ArrayLike, dt: float, cutoff_hz: float = 200.0
     return x, np.gradient(x, dt)
 
 
-def spencer_force(displacement: ArrayLike, dt: float, p: SpencerParameters,
-                  cutoff_hz: float = 200.0) -> np.ndarray:
+def _spencer_rates(p: SpencerParameters, xt: float, vt: float, y: float, z: float) -> tuple[float, float]:
+    ydot = (p.alpha * z + p.k0 * (xt - y) + p.c0 * vt) / (p.c0 + p.c1)
+    r = vt - ydot
+    az = abs(z)
+    return ydot, -p.gamma * abs(r) * az ** (p.n - 1.0) * z - p.beta * r * az**p.n + p.A * r
+
+
+def spencer_force(displacement: ArrayLike, dt: float, p: SpencerParameters, cutoff_hz: float = 200.0,
+                  method: str = "rk4", substeps: int = 10) -> np.ndarray:
     """Damper force [N] of the modified Bouc-Wen model driven by a measured
     displacement [m] sampled at dt [s] (smoothed as :func:`smoothed_motion`),
-    starting with y = x and z = 0; LSODA with the motion interpolated linearly."""
+    starting with y = x and z = 0, the motion interpolated linearly between samples.
+
+    ``method="rk4"``: classical RK4 with ``substeps`` steps per sample (a plain
+    Python loop, a few seconds for 60 000 samples); ``"lsoda"``: SciPy's LSODA
+    (rtol 1e-6, at most one sample per step; ten times slower), the reference
+    the RK4 is checked against (tests/python/test_lab_baselines.py)."""
     x_m, v_m = smoothed_motion(displacement, dt, cutoff_hz)
     x, v = 1e3 * x_m, 1e3 * v_m  # mm, mm/s
+    if method == "lsoda":
+        y, z = _spencer_lsoda(x, v, dt, p)
+    elif method == "rk4":
+        y, z = _spencer_rk4(x, v, dt, p, int(substeps))
+    else:
+        raise ValueError(f"invalid method = {method!r}: expected 'rk4' or 'lsoda'")
+    ydot = (p.alpha * z + p.k0 * (x - y) + p.c0 * v) / (p.c0 + p.c1)
+    return p.c1 * ydot + p.k1 * (x - p.x0)
+
+
+def _spencer_rk4(x: np.ndarray, v: np.ndarray, dt: float, p: SpencerParameters,
+                 substeps: int) -> tuple[np.ndarray, np.ndarray]:
+    if substeps < 1:
+        raise ValueError(f"invalid substeps = {substeps!r}: must be >= 1")
+    n, h = x.size, 1.0 / substeps
+    ys, zs = np.empty(n), np.empty(n)
+    y, z = float(x[0]), 0.0
+    ys[0], zs[0] = y, z
+    xl, vl = x.tolist(), v.tolist()
+    rates = _spencer_rates
+    for k in range(n - 1):
+        x0, dx, v0, dv = xl[k], xl[k + 1] - xl[k], vl[k], vl[k + 1] - vl[k]
+        for j in range(substeps):
+            w0, wm, w1 = j * h, (j + 0.5) * h, (j + 1) * h
+            a1, b1 = rates(p, x0 + w0 * dx, v0 + w0 * dv, y, z)
+            a2, b2 = rates(p, x0 + wm * dx, v0 + wm * dv, y + 0.5 * h * dt * a1, z + 0.5 * h * dt * b1)
+            a3, b3 = rates(p, x0 + wm * dx, v0 + wm * dv, y + 0.5 * h * dt * a2, z + 0.5 * h * dt * b2)
+            a4, b4 = rates(p, x0 + w1 * dx, v0 + w1 * dv, y + h * dt * a3, z + h * dt * b3)
+            y += h * dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+            z += h * dt / 6.0 * (b1 + 2.0 * b2 + 2.0 * b3 + b4)
+        ys[k + 1], zs[k + 1] = y, z
+    return ys, zs
+
+
+def _spencer_lsoda(x: np.ndarray, v: np.ndarray, dt: float, p: SpencerParameters) -> tuple[np.ndarray, np.ndarray]:
     n = x.size
-    c01 = p.c0 + p.c1
 
     def rhs(t: float, s: np.ndarray) -> list[float]:
         k = min(int(t / dt), n - 2)
         w = t / dt - k
-        xt = x[k] + w * (x[k + 1] - x[k])
-        vt = v[k] + w * (v[k + 1] - v[k])
-        y, z = s
-        ydot = (p.alpha * z + p.k0 * (xt - y) + p.c0 * vt) / c01
-        r = vt - ydot
-        az = abs(z)
-        zdot = -p.gamma * abs(r) * az ** (p.n - 1.0) * z - p.beta * r * az**p.n + p.A * r
-        return [ydot, zdot]
+        return list(_spencer_rates(p, x[k] + w * (x[k + 1] - x[k]), v[k] + w * (v[k + 1] - v[k]), s[0], s[1]))
 
     t = np.arange(n) * dt
     sol = integrate.solve_ivp(rhs, (0.0, t[-1]), [x[0], 0.0], method="LSODA", t_eval=t, rtol=1e-6,
                               atol=[1e-6, 1e-6], max_step=dt)
     if not sol.success:
         raise RuntimeError(f"the Bouc-Wen baseline failed at t = {sol.t[-1]:.4g} s: {sol.message}")
-    y, z = sol.y
-    ydot = (p.alpha * z + p.k0 * (x - y) + p.c0 * v) / c01
-    return p.c1 * ydot + p.k1 * (x - p.x0)
+    return sol.y[0], sol.y[1]
 
 
 def thesis_mr_force(displacement: ArrayLike, dt: float, current: float) -> np.ndarray:

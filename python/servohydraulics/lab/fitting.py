@@ -135,7 +135,7 @@ def records_peak_velocity(records: list[Response]) -> float:
     return max(record_scales(r)["v_pk"] for r in records)
 
 
-def fixed_rk4(rig: Rig, records: list[Response], mode: str, margin: float = 2.0):
+def fixed_rk4(rig: Rig, records: list[Response], mode: str, margin: float = 1.5):
     """RK4 options with the substep count fixed at ``margin`` times the automatic count
     of the start; CVODE when that count would exceed ``MAX_RK4_SUBSTEPS``.  The
     automatic count bounds a hysteretic specimen's rate with the sliding speed

@@ -34,7 +34,7 @@ from ..rig import Rig
 LOOP_KEYS = {"displacement": ("G_p", "f_v", "zeta_v"), "force": ("G_p", "f_v", "zeta_v")}
 
 SPECIMEN_KEYS = {
-    "linear": ("k", "c", "m"),
+    "linear": ("k", "c"),
     "bouc_wen": ("bw_k", "bw_beta", "bw_gamma", "c", "m"),
     "mr_damper": ("mr_alpha_a", "mr_c0_a", "mr_c1_a", "mr_k1", "mr_beta", "mr_gamma", "m"),
 }
@@ -153,7 +153,7 @@ class Coordinates:
 
     def values_at(self, i: int, z: float) -> float:
         if self.log[i]:
-            return float(self.start[i] * math.exp(z))
+            return float(self.start[i]) * math.exp(min(max(z, -745.0), 709.0))  # a huge sd: 0 or inf
         return float(self.start[i] + z * self.scale[i])
 
 
