@@ -1,9 +1,13 @@
 """The UTFSM records (../shared/real-data/utfsm-mts-mrdamper, never copied here):
 the thesis' baselines as its README reports them, our H1 against the README's
-table, and a rig identified from the 0 A chirp predicting the 0 A sweep at
-least as well as the thesis' G(s)."""
+table, a loop identified from the 0 A chirp predicting the 0 A sweep at least as
+well as the thesis' G(s), and the rigs benchmarks/utfsm_eval.py identified
+(MR damper) against the thesis' models on every held-out record and channel."""
 
 from __future__ import annotations
+
+import functools
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -57,15 +61,55 @@ def test_thesis_bouc_wen_follows_the_measured_force_at_1A():
     assert np.min(F) == pytest.approx(np.min(rec.force), rel=0.15)
 
 
-def test_identified_from_chirp_predicts_sweep_no_worse_than_thesis():
-    """Identify (generic start, linear damper) from the 0 A chirp; predict the 0 A sweep
-    from its command: displacement NRMSE <= the thesis' G(s) on the same record, both
-    with the issue's definition and with the error's mean removed."""
+def test_loop_identified_from_chirp_predicts_sweep_no_worse_than_thesis():
+    """Identify the loop alone (generic start, displacement channel) from the 0 A chirp;
+    predict the 0 A sweep from its command: displacement NRMSE <= the thesis' G(s) on the
+    same record, with the issue's definition and with the error's mean removed."""
     chirp, sweep = record("chirp20Hz_0A"), record("sweep15Hz_0A")
-    ident = sh.identify([chirp], mode="displacement", progress=False)
+    ident = sh.identify([chirp], mode="displacement", fit=["G_p", "f_v", "zeta_v"], channels=["displacement"],
+                        progress=False)
     pred = lab.compare(sweep, ident.rig, "displacement", options=fixed_rk4(ident.rig, [sweep], "displacement"))
     x = b.thesis_displacement(sweep.time, sweep.command)
     assert pred.nrmse("displacement") <= lab.nrmse_pct(x, sweep.displacement)
     assert pred.channels["displacement"]["nrmse_demeaned_pct"] <= lab.nrmse_demeaned_pct(x, sweep.displacement)
     assert ident.after[0].nrmse("displacement") <= lab.nrmse_pct(b.thesis_displacement(chirp.time, chirp.command),
                                                                  chirp.displacement)
+
+
+#: (identified from, held out) at the same current; the rigs are those benchmarks/utfsm_eval.py
+#: identified (generic start, --specimen mr_damper) and committed in benchmarks/utfsm_rigs/
+HELD_OUT = (("chirp20Hz_0A", "sweep15Hz_0A"), ("sweep15Hz_0A", "chirp20Hz_0A"),
+            ("chirp20Hz_1A", "sweep15Hz_1A"), ("sweep15Hz_1A", "chirp20Hz_1A"))
+RIGS = Path(__file__).resolve().parents[2] / "benchmarks" / "utfsm_rigs"
+CURRENT = {"0A": 0.0, "1A": 1.0}
+#: held-out cases where ours still loses (docs/lab-records.md says why); strict: a win fails
+#: the test until this table is updated
+KNOWN_LOSSES = {("chirp20Hz_0A", "sweep15Hz_0A", "force"):
+                "the June 0 A damper forces are 1.5 x the May ones (best gain 0.66)",
+                ("chirp20Hz_1A", "sweep15Hz_1A", "force"):
+                "the chirp-fitted hysteresis lags the May sweep's by 1-6 ms"}
+
+
+@functools.lru_cache(maxsize=None)
+def held_out(train: str, test: str) -> tuple[dict, dict]:
+    """(ours, thesis) NRMSE [%] per channel on the held-out record."""
+    rec = record(test)
+    rig = sh.load_rig(RIGS / f"identified_from_{train}.toml")
+    sim = lab.simulate_record(rig, rec, "displacement", options=fixed_rk4(rig, [rec], "displacement"))
+    ours = {ch: lab.nrmse_pct(sim[ch], rec.channels[ch]) for ch in ("displacement", "force")}
+    thesis = {"displacement": lab.nrmse_pct(b.thesis_displacement(rec.time, rec.command), rec.displacement),
+              "force": lab.nrmse_pct(b.thesis_mr_force(rec.displacement, rec.dt, CURRENT[test.split("_")[1]]),
+                                     rec.force)}
+    return ours, thesis
+
+
+@pytest.mark.parametrize("channel", ["displacement", "force"])
+@pytest.mark.parametrize("train, test", HELD_OUT)
+def test_held_out_no_worse_than_thesis(train, test, channel, request):
+    """Ours (the committed rig identified from `train`, driven by the held-out record's
+    command alone) <= the thesis' model (G(s) from the command for displacement; its
+    Bouc-Wen driven by the MEASURED displacement for force) on the held-out record."""
+    if (train, test, channel) in KNOWN_LOSSES:
+        request.applymarker(pytest.mark.xfail(strict=True, reason=KNOWN_LOSSES[(train, test, channel)]))
+    ours, thesis = held_out(train, test)
+    assert ours[channel] <= thesis[channel], (ours, thesis)

@@ -32,7 +32,8 @@ def register(sub) -> None:
     p.add_argument("--rig", default=None, help="start rig TOML (default: a generic rig scaled from the record)")
     p.add_argument("--fit", default=None, help="comma-separated rig keys to fit (default: loop + specimen keys)")
     p.add_argument("--specimen", default="linear", choices=["linear", "bouc_wen", "mr_damper"],
-                   help="specimen model whose keys are fitted (bouc_wen, mr_damper: need issue 12's elements)")
+                   help="specimen model whose keys are fitted: linear (k, c), bouc_wen (bouc_wen_hysteresis), "
+                        "mr_damper (Spencer's MR damper); default linear")
     p.add_argument("--dt", type=float, default=None, help="controller sample time [s] (default: the record's)")
     p.add_argument("--max-nfev", type=int, default=60, help="time-domain evaluations budget (default: 60)")
     p.add_argument("--out", required=True, help="output directory")

@@ -205,7 +205,8 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         rig: the start (a Rig or a rig TOML path); None: the generic rig scaled from the first record.
         fit: keys to fit; default ``LOOP_KEYS[mode]`` + ``SPECIMEN_KEYS[specimen]``.
         mode: the records' control mode, ``"displacement"`` or ``"force"``.
-        specimen: ``"linear"``, ``"bouc_wen"`` or ``"mr_damper"`` (the last two need issue 12's elements).
+        specimen: ``"linear"``, ``"bouc_wen"`` or ``"mr_damper"`` (``keys.SPECIMEN_KEYS``; a generic start
+            scales the specimen from the record, ``generic.specimen_start``).
         channels: the channels fitted (default: those the records carry, displacement and force).
         dt: controller sample time [s] (default: the records' own).
         frequency_stage: run stage 1 (the H1 fit of the linearised model) before the time domain.

@@ -3,22 +3,23 @@
 One table per concern, easy to edit when the core gains fields:
 
 * ``LOOP_KEYS``: the actuator loop's keys fitted by default in each control mode.
-* ``SPECIMEN_KEYS``: the specimen's keys per ``--specimen`` kind.  ``linear``
-  is today's structure (stiffness k, damping c).  ``bouc_wen`` and
-  ``mr_damper`` name the fields the specimen elements of issue 12 are expected
-  to add to ``Rig`` (Spencer et al. 1997's modified Bouc-Wen with the paper's
-  symbols, prefixed ``mr_`` because ``A`` is the piston area; a plain
-  Bouc-Wen hysteresis prefixed ``bw_``).  Until ``Rig`` has them, asking for
-  those specimens is a clear error (:func:`specimen_keys`).  For the MR damper
-  at one constant current the current-dependent pairs (alpha_a + alpha_b u ...)
-  cannot be separated, so the ``_a`` terms are fitted; ``mr_A`` and ``mr_n``
-  are held (z is scaled by A: only alpha A is identifiable with beta, gamma).
+* ``SPECIMEN_KEYS``: the specimen's keys per ``--specimen`` kind: ``linear``
+  (the structure's k, c), ``bouc_wen`` (issue 12's ``bouc_wen_hysteresis``:
+  bw_k, bw_beta, bw_gamma with bw_A = 1 and bw_n held, since z scales with A,
+  plus the viscous c and the mass m the load cell carries) and ``mr_damper``
+  (issue 12's Spencer element: at one constant current the current-dependent
+  pairs alpha_a + alpha_b u ... cannot be separated, so the ``_a`` terms are
+  fitted with the ``_b`` ones and the voltage at 0; mr_A and mr_n are held for
+  the same scaling reason; k0 and x0 are held at 0: x0 only offsets the force,
+  k0 is below what the records resolve).
+* ``FORCE_KEYS``: keys that act on the measured force (fitted on the force
+  channel in displacement control, the others on the displacement).
 * ``SPECIMEN_EFFECT``: the ``[effects]`` switch that turns the specimen on, if
   the rig has one.
 * ``SIGNED_KEYS``: keys that may be negative (fitted linearly, not in log space).
 
-Every other numeric field of ``Rig`` may be named in ``fit=[...]`` too (delays
-of issue 12 included, e.g. ``command_delay``, ``loop_delay``, once they exist).
+Every other numeric field of ``Rig`` may be named in ``fit=[...]`` too (the
+delays included: ``command_delay``, ``measurement_delay_force``, ``loop_delay``).
 """
 
 from __future__ import annotations
