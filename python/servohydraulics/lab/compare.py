@@ -12,13 +12,14 @@ set of frequencies.  ``Comparison.write(out)`` writes ``comparison.json``,
 from __future__ import annotations
 
 import json
-import os
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ..atomic import write_text, write_with
 from ..response import Response
 from ..rig import Rig
 from .frf import FrequencyResponse, command_band, gain_phase, h1
@@ -81,16 +82,26 @@ class Comparison:
         figs = self.figures()
         write_json(out / "comparison.json", self.to_dict())
         for name, fig in figs.items():
-            fig.savefig(out / f"{name}.png", dpi=110)
+            write_with(out / f"{name}.png", lambda p, fig=fig: fig.savefig(p, dpi=110, format="png"))
         return out / "comparison.json"
 
 
+def finite_or_none(obj):
+    """``obj`` with every non-finite float replaced by None (JSON null: not determined,
+    e.g. the interval of a key the records do not constrain)."""
+    if isinstance(obj, dict):
+        return {k: finite_or_none(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [finite_or_none(v) for v in obj]
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
 def write_json(path: Path, data: dict) -> Path:
-    """Writes JSON through a temporary file and a rename (never a half-written file)."""
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(json.dumps(data, indent=2, allow_nan=False) + "\n")
-    os.replace(tmp, path)
-    return path
+    """Writes JSON atomically (``atomic.write_text``: never a half-written file); non-finite
+    numbers become null."""
+    return write_text(path, json.dumps(finite_or_none(data), indent=2, allow_nan=False) + "\n")
 
 
 def frf_points(measured: FrequencyResponse, simulated: FrequencyResponse, frequencies: np.ndarray) -> dict:

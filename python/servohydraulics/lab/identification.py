@@ -28,6 +28,7 @@ import numpy as np
 from scipy.stats import norm
 
 from ..identify import ar1_coefficient, ar1_effective_n
+from ..atomic import write_text, write_with
 from ..records import read_record
 from ..response import Response
 from ..rig import Rig, load_rig, save_rig
@@ -95,10 +96,10 @@ class Identification:
             for name, fig in a.figures().items():
                 figs[f"{name}_{a.name}.png"] = fig
         for name, fig in figs.items():
-            fig.savefig(out / name, dpi=110)
+            write_with(out / name, lambda p, fig=fig: fig.savefig(p, dpi=110, format="png"))
         save_rig(self.rig, out / "rig_identified.toml")
         write_json(out / "identification.json", self.to_dict())
-        (out / "report.md").write_text(self.markdown())
+        write_text(out / "report.md", self.markdown())
         return out / "report.md"
 
 
