@@ -262,3 +262,23 @@ def test_cli_bouc_wen_from_the_generic_start(tmp_path):
     rec = data["records"][0]
     for ch in ("displacement", "force"):
         assert rec["after"][ch] < rec["before"][ch]
+
+
+@pytest.mark.parametrize("current", [0.0, 1.0])
+def test_thesis_parameters_in_si_drive_the_core_like_the_baseline(current):
+    """The thesis' Spencer parameters (N, mm, s) converted by ``spencer_rig_keys`` into the
+    core's MR element: its specimen force in a displacement-controlled run equals the
+    independent NumPy baseline driven by the same displacement, within 1 % of the force's std."""
+    from servohydraulics.lab import baselines as b
+
+    r = truth_rig()
+    r.k, r.c = 1.0, 0.0
+    r.effects.mr_damper = True
+    for k, v in b.spencer_rig_keys(b.thesis_mr_parameters(current)).items():
+        setattr(r, k, v)
+    t = np.arange(3001) * DT
+    u = 2e-3 * np.sin(2 * np.pi * 3.0 * t) * np.minimum(t / 0.3, 1.0)
+    sim = sh.simulate(r, "displacement", command=u, dt=DT, options=sh.solver_options(rtol=1e-8))
+    ref = b.spencer_force(sim.displacement, DT, b.thesis_mr_parameters(current), cutoff_hz=400.0)
+    F = np.asarray(sim.specimen_force)
+    assert np.max(np.abs(F - ref)[100:]) < 0.01 * np.std(ref)

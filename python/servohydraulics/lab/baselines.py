@@ -73,6 +73,16 @@ def thesis_mr_parameters(current: float) -> SpencerParameters:
                              beta=bg, gamma=bg, n=2.0)
 
 
+def spencer_rig_keys(p: SpencerParameters) -> dict[str, float]:
+    """The parameters as the core's ``[specimen]`` keys in SI units (N, m, s): N/mm -> N/m,
+    N s/mm -> N s/m, mm -> m, mm^-n -> m^-n (z in m), the current folded into the
+    ``_a`` terms (``_b`` = 0, ``mr_voltage`` = 0)."""
+    return {"mr_alpha_a": 1e3 * p.alpha, "mr_alpha_b": 0.0, "mr_c0_a": 1e3 * p.c0, "mr_c0_b": 0.0,
+            "mr_c1_a": 1e3 * p.c1, "mr_c1_b": 0.0, "mr_k0": 1e3 * p.k0, "mr_k1": 1e3 * p.k1, "mr_x0": 1e-3 * p.x0,
+            "mr_A": p.A, "mr_beta": p.beta * 1e3**p.n, "mr_gamma": p.gamma * 1e3**p.n, "mr_n": p.n,
+            "mr_voltage": 0.0}
+
+
 def smoothed_motion(displacement: ArrayLike, dt: float, cutoff_hz: float = 200.0) -> tuple[np.ndarray, np.ndarray]:
     """(x, dx/dt) [m, m/s] from a measured displacement: the thesis' 4th-order
     Butterworth low-pass at 200 Hz (applied forward and backward, no phase
@@ -159,5 +169,5 @@ def thesis_mr_force(displacement: ArrayLike, dt: float, current: float) -> np.nd
     return spencer_force(displacement, dt, thesis_mr_parameters(current))
 
 
-__all__ = ["THESIS_ACTUATOR", "SpencerParameters", "smoothed_motion", "spencer_force", "thesis_actuator_tf",
+__all__ = ["THESIS_ACTUATOR", "SpencerParameters", "smoothed_motion", "spencer_rig_keys", "spencer_force", "thesis_actuator_tf",
            "thesis_displacement", "thesis_mr_force", "thesis_mr_parameters"]
