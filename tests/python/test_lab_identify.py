@@ -196,7 +196,7 @@ def test_recovers_an_mr_damper():
     specimen keys start 30-50 % off: the fit brings the force NRMSE to the noise's
     level and the main keys (alpha, c0) within 5 % or their 95 % intervals."""
     truth = mr_truth()
-    t, u = chirp(duration=8.0, f1=8.0)
+    t, u = chirp(duration=6.0, f1=8.0)
     sim = sh.simulate(truth, "displacement", command=u, dt=DT, options=sh.solver_options(rtol=1e-8))
     rng = np.random.default_rng(5)
     sf = 0.01 * np.std(sim.force)
