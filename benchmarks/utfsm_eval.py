@@ -53,7 +53,7 @@ def baselines(records: dict) -> dict:
 def identify_and_predict(records: dict, out: Path) -> tuple[list, dict]:
     import servohydraulics as sh
     from servohydraulics.lab import compare, simulate_record
-    from servohydraulics.lab.fitting import fixed_rk4
+    from servohydraulics.lab.fitting import fit_options
 
     rows, times = [], {}
     for train, test in PAIRS:
@@ -66,7 +66,7 @@ def identify_and_predict(records: dict, out: Path) -> tuple[list, dict]:
         fit = ident.after[0]
         roles = [("fit", fit)]
         if test is not None:
-            opts = fixed_rk4(ident.rig, [records[test]], "displacement")
+            opts = fit_options(ident.rig, [records[test]], "displacement")
             pred = compare(records[test], ident.rig, "displacement",
                            simulated=simulate_record(ident.rig, records[test], "displacement", options=opts))
             pred.write(out / f"{test}_from_{train}")

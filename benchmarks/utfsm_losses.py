@@ -38,7 +38,7 @@ def main() -> int:
     sys.path.insert(0, str(ROOT / "python"))
     import servohydraulics as sh
     from servohydraulics import lab
-    from servohydraulics.lab.fitting import fixed_rk4
+    from servohydraulics.lab.fitting import fit_options
 
     if not DATA.is_dir():
         print(f"UTFSM records not found in {DATA}", file=sys.stderr)
@@ -46,7 +46,7 @@ def main() -> int:
     for train, test in PAIRS:
         rec = sh.read_record(DATA / f"{test}.csv")
         rig = sh.load_rig(ROOT / "benchmarks" / "utfsm_rigs" / f"identified_from_{train}.toml")
-        sim = lab.simulate_record(rig, rec, "displacement", options=fixed_rk4(rig, [rec], "displacement"))["force"]
+        sim = lab.simulate_record(rig, rec, "displacement", options=fit_options(rig, [rec], "displacement"))["force"]
         meas = np.asarray(rec.force, dtype=float)
         g = float(sim @ meas / (sim @ sim))
         stretches = np.array_split(np.arange(2000, meas.size - 2000), 6)
@@ -54,11 +54,11 @@ def main() -> int:
         print(f"{train} -> {test}: force NRMSE {lab.nrmse_pct(sim, meas):.2f} %, best gain {g:.3f} "
               f"(NRMSE {lab.nrmse_pct(g * sim, meas):.2f} %), best shift per sixth of the record [ms]: {shifts}")
     if "--extra-keys" in sys.argv[1:]:
-        extra_keys(sh, lab, fixed_rk4)
+        extra_keys(sh, lab, fit_options)
     return 0
 
 
-def extra_keys(sh, lab, fixed_rk4) -> None:
+def extra_keys(sh, lab, fit_options) -> None:
     from servohydraulics.lab import generic, keys
 
     from servohydraulics.lab import baselines
@@ -75,7 +75,7 @@ def extra_keys(sh, lab, fixed_rk4) -> None:
         for k, v in start.items():
             setattr(rig, k, v)
         ident = sh.identify([train], rig=rig, fit=fit, mode="displacement", specimen="mr_damper", progress=False)
-        pred = lab.compare(test, ident.rig, "displacement", options=fixed_rk4(ident.rig, [test], "displacement"))
+        pred = lab.compare(test, ident.rig, "displacement", options=fit_options(ident.rig, [test], "displacement"))
         print(f"chirp20Hz_1A, {label}: " + ", ".join(f"{k} = {ident.values[k]:.4g}" for k in fit[3:])
               + f"; fit force {ident.after[0].nrmse('force'):.2f} %, held-out sweep15Hz_1A force "
               f"{pred.nrmse('force'):.2f} %, displacement {pred.nrmse('displacement'):.2f} %")

@@ -16,7 +16,7 @@ from shared_data import shared_path
 import servohydraulics as sh
 from servohydraulics import lab
 from servohydraulics.lab import baselines as b
-from servohydraulics.lab.fitting import fixed_rk4
+from servohydraulics.lab.fitting import fit_options
 
 FOLDER = "real-data/utfsm-mts-mrdamper"
 
@@ -68,7 +68,7 @@ def test_loop_identified_from_chirp_predicts_sweep_no_worse_than_thesis():
     chirp, sweep = record("chirp20Hz_0A"), record("sweep15Hz_0A")
     ident = sh.identify([chirp], mode="displacement", fit=["G_p", "f_v", "zeta_v"], channels=["displacement"],
                         progress=False)
-    pred = lab.compare(sweep, ident.rig, "displacement", options=fixed_rk4(ident.rig, [sweep], "displacement"))
+    pred = lab.compare(sweep, ident.rig, "displacement", options=fit_options(ident.rig, [sweep], "displacement"))
     x = b.thesis_displacement(sweep.time, sweep.command)
     assert pred.nrmse("displacement") <= lab.nrmse_pct(x, sweep.displacement)
     assert pred.channels["displacement"]["nrmse_demeaned_pct"] <= lab.nrmse_demeaned_pct(x, sweep.displacement)
@@ -95,7 +95,7 @@ def held_out(train: str, test: str) -> tuple[dict, dict]:
     """(ours, thesis) NRMSE [%] per channel on the held-out record."""
     rec = record(test)
     rig = sh.load_rig(RIGS / f"identified_from_{train}.toml")
-    sim = lab.simulate_record(rig, rec, "displacement", options=fixed_rk4(rig, [rec], "displacement"))
+    sim = lab.simulate_record(rig, rec, "displacement", options=fit_options(rig, [rec], "displacement"))
     ours = {ch: lab.nrmse_pct(sim[ch], rec.channels[ch]) for ch in ("displacement", "force")}
     thesis = {"displacement": lab.nrmse_pct(b.thesis_displacement(rec.time, rec.command), rec.displacement),
               "force": lab.nrmse_pct(b.thesis_mr_force(rec.displacement, rec.dt, CURRENT[test.split("_")[1]]),

@@ -7,15 +7,13 @@
   weighted by the coherence.  Keys that do not change the linear model
   (friction, hysteresis) are left for stage 2.
 * :func:`fit_time` (stage 2): the records' commands simulated through the
-  nonlinear model (the fast integrator, RK4 with the substep count fixed at
-  the start so the residual is a smooth function of the keys; CVODE if the
-  start is too stiff for it), the residual (sim - measured) / std(measured) of
-  every channel, weighted by the inverse of that channel's rms residual at the
-  start (channels fitted as well as the model allows weigh in equally: a
-  linear spring-dashpot standing in for an MR damper leaves a 40 % force
-  residual that would otherwise pull the loop's keys), minimised by
-  ``scipy.optimize.least_squares`` (trust region reflective, Jacobian by
-  forward differences of 0.1 % steps in the fitting coordinates).
+  nonlinear model (the fast integrator, :func:`fit_options`), the residual
+  (sim - measured) / std(measured) of every channel (optionally weighted per
+  channel), minimised by ``scipy.optimize.least_squares`` (trust region
+  reflective, Jacobian by forward differences of 0.1 % steps in the fitting
+  coordinates, its columns on two threads) over the active keys.
+  ``identification.py`` runs it block by block (loop keys on the
+  displacement, force keys on the force) in displacement control.
 
 Both work in :class:`~servohydraulics.lab.keys.Coordinates` (log space for
 positive keys).
@@ -135,12 +133,21 @@ def records_peak_velocity(records: list[Response]) -> float:
     return max(record_scales(r)["v_pk"] for r in records)
 
 
-def fixed_rk4(rig: Rig, records: list[Response], mode: str, margin: float = 1.5):
-    """RK4 options with the substep count fixed at ``margin`` times the automatic count
-    of the start; CVODE when that count would exceed ``MAX_RK4_SUBSTEPS``.  The
-    automatic count bounds a hysteretic specimen's rate with the sliding speed
-    ``V_REF_MARGIN`` times the records' peak velocity (not the actuator's no-load
-    speed: a record shows how fast the rig moved)."""
+#: relative tolerance of the time stage's Dormand-Prince runs
+FIT_RTOL = 1e-6
+
+
+def fit_options(rig: Rig, records: list[Response], mode: str, method: str = "dopri5", margin: float = 1.5):
+    """The time stage's integrator.  ``"dopri5"``: Dormand-Prince 5(4) (the core's default,
+    CVODE for a stiff sample) at rtol ``FIT_RTOL``.  ``"rk4"``: RK4 with the substep count
+    fixed at ``margin`` times the automatic count of the start (a hysteretic specimen's
+    rate bounded with ``V_REF_MARGIN`` times the records' peak velocity; a fixed count keeps
+    the residual a smooth function of the keys), CVODE when that count would exceed
+    ``MAX_RK4_SUBSTEPS``."""
+    if method == "dopri5":
+        return solver_options(method="dopri5", rtol=FIT_RTOL)
+    if method != "rk4":
+        raise ValueError(f"invalid method = {method!r}: expected 'dopri5' or 'rk4'")
     dt = min(r.dt for r in records)
     v_ref = V_REF_MARGIN * max(records_peak_velocity(records), 1e-4)
     try:
@@ -275,5 +282,5 @@ def jacobian_at(records: list[Response], rig: Rig, coords: Coordinates, z: np.nd
 
 
 __all__ = ["DIFF_STEP", "MAX_RK4_SUBSTEPS", "MIN_COHERENCE", "StageResult", "channel_weights", "default_workers",
-           "fit_frequency", "fit_time", "fixed_rk4", "forward_jacobian", "frequency_targets", "jacobian_at",
+           "fit_frequency", "fit_options", "fit_time", "forward_jacobian", "frequency_targets", "jacobian_at",
            "linear_response", "records_peak_velocity", "time_residual"]

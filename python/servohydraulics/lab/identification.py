@@ -33,7 +33,7 @@ from ..records import read_record
 from ..response import Response
 from ..rig import Rig, load_rig, save_rig
 from .compare import Comparison, channels_of, compare, write_json
-from .fitting import StageResult, channel_weights, fit_frequency, fit_time, fixed_rk4, jacobian_at
+from .fitting import StageResult, channel_weights, fit_frequency, fit_time, fit_options, jacobian_at
 from .generic import generic_rig, specimen_start
 from .keys import FORCE_KEYS, LOOP_KEYS, Coordinates, check_keys, specimen_keys, use_specimen
 from .run import simulate_record
@@ -237,7 +237,7 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         t0 = time.perf_counter()
         s1, stage1_keys = fit_frequency(recs, start, coords, mode, chans)
         z1, nfev["frequency"], runtime["frequency"] = s1.z, s1.nfev, time.perf_counter() - t0
-    options = fixed_rk4(coords.apply(start, z1), recs, mode)
+    options = fit_options(coords.apply(start, z1), recs, mode)
     t0 = time.perf_counter()
     from tqdm.auto import tqdm
 
