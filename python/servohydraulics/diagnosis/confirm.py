@@ -92,9 +92,9 @@ def fit_space(space, z0: np.ndarray, cases: list[Case], x0s, stats: dict, base_t
     neff = neff_ref if neff_ref is not None else engine.n_eff(st_c)
     worse = (sum(s["ssr"] for s in st_c.values()) > sum(s["ssr"] for s in stats.values())
              or engine.bic(st_c, 0, neff) > engine.bic(stats, 0, neff))
-    if worse:  # the fit wandered off: the candidate at "absent" is the current model
+    if worse:  # the fit wandered off: the candidate at "absent", i.e. the current model itself
         z, x0 = absent, np.asarray(x0s, float)
-        rig_c, tau_c = space.rig_and_tau(z, tau)
+        rig_c, tau_c = space.ctx.rig, tau
         sims_c = engine.simulate_all(rig_c, cases, tau_c, x0)
         st_c = engine.channel_stats(sims_c, cases)
         res = dataclasses.replace(res, z=z, x0=x0)

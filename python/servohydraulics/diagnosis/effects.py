@@ -383,8 +383,12 @@ FLOW_KNEE_MIN_OPENING = 0.15  #: peak spool opening above which the knee x_k is 
 
 
 def _spool_absent(ctx: Context) -> np.ndarray:
+    # a limit at the sampled peak opening would clip the peaks between samples: "absent" is 1 % above it
     lim = ctx.rig.x_v_max if ctx.rig.effects.spool_saturation else math.inf
-    return _a(min(lim, ctx.peak_spool))
+    return _a(min(lim, SPOOL_ABSENT_MARGIN * ctx.peak_spool))
+
+
+SPOOL_ABSENT_MARGIN = 1.01  #: "absent" spool limit over the simulated peak opening [-]
 
 
 def _piston_absent(ctx: Context) -> np.ndarray:
@@ -634,7 +638,7 @@ CANDIDATES: tuple[Candidate, ...] = (
         "spool_saturation", (Param("x_v_max", "-", "servovalve.x_v_max (effects.spool_saturation on)"),),
         "spool travel limited to +-x_v_max (end stops)",
         absent=_spool_absent,
-        bounds=lambda ctx: (_a(max(0.01 * ctx.peak_spool, 1e-4)), _a(max(ctx.peak_spool, 2e-4))),
+        bounds=lambda ctx: (_a(max(0.01 * ctx.peak_spool, 1e-4)), _a(max(SPOOL_ABSENT_MARGIN * ctx.peak_spool, 2e-4))),
         probe=lambda ctx: _a(0.7 * ctx.peak_spool),
         apply=_apply_spool, modes=("displacement", "force"), exercised=_spool_exercised,
         scan=lambda ctx: _spool_absent(ctx)[0] * np.array([0.4, 0.5, 0.6, 0.7, 0.8, 0.9]),
