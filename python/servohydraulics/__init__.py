@@ -130,6 +130,7 @@ __all__ = [
     "copy_rig",
     "diagnose",
     "export_fmu",
+    "identify",
     "linearize",
     "load_rig",
     "make_plant",

@@ -15,12 +15,19 @@
 * :func:`frequency_response` and :func:`fourier_ratio`: frequency responses of
   sweep records as ratios of whole-record DFTs (one implementation, ``_dft_ratio``).
 
+The module is callable: ``sh.identify(records, rig=start, fit=[keys], mode=...)``
+is :func:`servohydraulics.lab.identify` (a rig identified from lab records,
+docs/lab-records.md), while ``from servohydraulics.identify import ...`` and
+``sh.identify.identify_first_order`` keep working.
+
 SI units: m, s, N, N s/m.
 """
 
 from __future__ import annotations
 
 import math
+import sys
+import types
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -316,3 +323,16 @@ def identify_free_vibration(x: ArrayLike, dt: float, start: int = 0, duration: f
 __all__ = ["FirstOrderEstimate", "FreeVibration", "FrictionEstimate", "ar1_coefficient", "ar1_effective_n",
            "fourier_ratio", "frequency_response", "identify_damping_friction", "identify_first_order",
            "identify_free_vibration", "lag1_autocorrelation", "linear_chirp", "simulate_structure"]
+
+
+class _CallableModule(types.ModuleType):
+    """``servohydraulics.identify(...)`` calls :func:`servohydraulics.lab.identify`."""
+
+    def __call__(self, records, **kwargs):
+        from .lab import identify
+
+        return identify(records, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule
+

@@ -8,6 +8,11 @@ channel of a run (``channel_units("record")``: ``velocity`` [m/s],
 ``flags``...).  Time must be uniform and increasing.  The old column name
 ``ground_accel`` is read as ``ground_acceleration`` for one release.
 
+Lab files that name their columns with the unit appended (``time_s``,
+``command_m``, ``command_N``, ``displacement_m``, ``force_N``: the UTFSM
+records of docs/lab-records.md) are read under the project's names
+(``UNIT_SUFFIXED_COLUMNS``); the suffix must be the channel's SI unit.
+
 A record is a :class:`~servohydraulics.response.Response` of kind ``"record"``;
 ``write_record(path, r)`` is ``r.to_csv(path)``.
 """
@@ -27,8 +32,13 @@ from .response import DEPRECATED_COLUMNS, REQUIRED, Response, channel_units, uni
 Record = Response
 
 
+#: Unit-suffixed column names read as the project's channel names (SI units only).
+UNIT_SUFFIXED_COLUMNS = {"time_s": "time", "command_m": "command", "command_N": "command",
+                         "displacement_m": "displacement", "force_N": "force"}
+
+
 def _columns(path: Path, header: str) -> list[str]:
-    names = [h.strip() for h in header.split(",")]
+    names = [UNIT_SUFFIXED_COLUMNS.get(h.strip(), h.strip()) for h in header.split(",")]
     seen: set[str] = set()
     for i, n in enumerate(names):
         if n in seen:
@@ -94,4 +104,4 @@ def write_record(path: str | Path, record: Response | Mapping[str, ArrayLike]) -
     return record.to_csv(path)
 
 
-__all__ = ["Record", "read_record", "write_record"]
+__all__ = ["UNIT_SUFFIXED_COLUMNS", "Record", "read_record", "write_record"]

@@ -1,0 +1,40 @@
+"""``servohydraulics identify REC.csv [REC2.csv ...] --mode ... --out DIR``: a rig
+identified from lab records (docs/lab-records.md)."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def _run(args: argparse.Namespace) -> int:
+    from ..lab import identify
+
+    fit = [k.strip() for k in args.fit.split(",") if k.strip()] if args.fit else None
+    ident = identify(args.records, rig=args.rig, fit=fit, mode=args.mode, specimen=args.specimen, dt=args.dt,
+                     max_nfev=args.max_nfev, progress=not args.quiet)
+    report = ident.write(args.out)
+    for k in ident.keys:
+        lo, hi = ident.intervals[k]
+        print(f"  {k} = {ident.values[k]:.5g} [{lo:.5g}, {hi:.5g}] (95 %)")
+    for f in ident.flags:
+        print(f"  note: {f}")
+    for b, a in zip(ident.before, ident.after):
+        print(f"  {a.name}: " + ", ".join(f"{c} NRMSE {b.nrmse(c):.2f} % -> {a.nrmse(c):.2f} %" for c in a.channels))
+    print(f"wrote {args.out}/rig_identified.toml, identification.json, {report.name} "
+          f"({ident.runtime_s['total']:.1f} s)")
+    return 0
+
+
+def register(sub) -> None:
+    p = sub.add_parser("identify", help="identify a rig from its own lab records (two-stage fit, intervals, plots)")
+    p.add_argument("records", nargs="+", help="record CSV file(s) of the same rig")
+    p.add_argument("--mode", required=True, choices=["displacement", "force"], help="control mode of the records")
+    p.add_argument("--rig", default=None, help="start rig TOML (default: a generic rig scaled from the record)")
+    p.add_argument("--fit", default=None, help="comma-separated rig keys to fit (default: loop + specimen keys)")
+    p.add_argument("--specimen", default="linear", choices=["linear", "bouc_wen", "mr_damper"],
+                   help="specimen model whose keys are fitted (bouc_wen, mr_damper: need issue 12's elements)")
+    p.add_argument("--dt", type=float, default=None, help="controller sample time [s] (default: the record's)")
+    p.add_argument("--max-nfev", type=int, default=60, help="time-domain evaluations budget (default: 60)")
+    p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_run)

@@ -1,0 +1,141 @@
+"""Compare a rig with a lab record: the record's command simulated through the
+rig, from the record's initial state, against what was measured.
+
+Per channel: ``nrmse_pct`` = 100 rms(sim - measured) / std(measured) (the
+issue's definition), ``nrmse_demeaned_pct`` (the same with the error's mean
+removed, the UTFSM README's figure), and the gain and phase of the measured
+and simulated frequency responses channel/command (H1, with coherence) at a
+set of frequencies.  ``Comparison.write(out)`` writes ``comparison.json``,
+``overlay.png`` and ``frf.png``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..response import Response
+from ..rig import Rig
+from .frf import FrequencyResponse, command_band, gain_phase, h1
+from .run import CHANNELS, nrmse_demeaned_pct, nrmse_pct, simulate_record
+
+#: default frequencies of the reported FRF points [Hz] (those above the command's band are dropped)
+FREQUENCIES = (0.5, 1.0, 2.0, 5.0, 8.0, 10.0, 12.0, 15.0, 18.0, 20.0, 30.0, 50.0, 100.0)
+
+
+def record_name(record: Response) -> str:
+    return record.path.stem if record.path is not None else "record"
+
+
+def channels_of(record: Response, mode: str) -> tuple[str, ...]:
+    """The channels of ``CHANNELS`` the record carries with some variation."""
+    out = tuple(c for c in CHANNELS if c in record.channels and np.std(record.channels[c]) > 0)
+    if not out:
+        raise ValueError(f"{record_name(record)}: no measured channel among {list(CHANNELS)} varies")
+    return out
+
+
+@dataclass(eq=False)
+class Comparison:
+    """A rig against a record (SI units); see the module docstring."""
+
+    name: str
+    mode: str
+    time: np.ndarray = field(repr=False)
+    measured: dict = field(repr=False)
+    simulated: dict = field(repr=False)
+    frf_measured: dict = field(repr=False)
+    frf_simulated: dict = field(repr=False)
+    frequencies: np.ndarray = field(repr=False)
+    f_max: float = 0.0
+    channels: dict = field(default_factory=dict)  #: channel -> metrics (the JSON's "channels")
+
+    def nrmse(self, channel: str) -> float:
+        return self.channels[channel]["nrmse_pct"]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"record": self.name, "mode": self.mode, "samples": int(self.time.size),
+                "dt_s": float(self.time[1] - self.time[0]), "command_band_hz": self.f_max,
+                "definition": "nrmse_pct = 100 rms(sim - measured) / std(measured); nrmse_demeaned_pct: the "
+                              "error's mean removed; frf: H1 = S_uy/S_uu (Welch, Hann, nperseg) of channel/command",
+                "channels": self.channels}
+
+    def figures(self) -> dict:
+        from .figures import frf_figure, overlay_figure
+
+        unit = "N" if self.mode == "force" else "m"
+        return {"overlay": overlay_figure(self.time, self.measured, self.simulated, f"{self.name}: measured "
+                                          "and simulated"),
+                "frf": frf_figure(self.frf_measured, self.frf_simulated, 1.2 * self.f_max,
+                                  f"{self.name}: frequency response (H1)", unit)}
+
+    def write(self, out: str | Path) -> Path:
+        """Writes ``comparison.json``, ``overlay.png`` and ``frf.png`` into ``out``."""
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        figs = self.figures()
+        write_json(out / "comparison.json", self.to_dict())
+        for name, fig in figs.items():
+            fig.savefig(out / f"{name}.png", dpi=110)
+        return out / "comparison.json"
+
+
+def write_json(path: Path, data: dict) -> Path:
+    """Writes JSON through a temporary file and a rename (never a half-written file)."""
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp.write_text(json.dumps(data, indent=2, allow_nan=False) + "\n")
+    os.replace(tmp, path)
+    return path
+
+
+def frf_points(measured: FrequencyResponse, simulated: FrequencyResponse, frequencies: np.ndarray) -> dict:
+    """Gain [-] and phase [deg] of measured and simulated at the frequencies, with coherence."""
+    hm, cm = measured.at(frequencies)
+    hs, cs = simulated.at(frequencies)
+    gm, pm = gain_phase(hm)
+    gs, ps = gain_phase(hs)
+    r = lambda a: [round(float(v), 6) for v in a]  # noqa: E731
+    return {"frequency_hz": r(frequencies), "measured_gain": r(gm), "measured_phase_deg": r(pm),
+            "simulated_gain": r(gs), "simulated_phase_deg": r(ps), "measured_coherence": r(cm),
+            "simulated_coherence": r(cs), "gain_ratio": r(gs / gm), "phase_difference_deg": r(ps - pm)}
+
+
+def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, options=None,
+            frequencies=None, simulated: dict | None = None) -> Comparison:
+    """Simulates the record's command through the rig and compares (see the module docstring).
+
+    Args:
+        record: a record (``read_record``) with time, command, displacement, force.
+        rig: the rig; mode: its control mode (``"displacement"`` or ``"force"``).
+        dt: controller sample time [s] (default: the record's).
+        options: solver options (default: CVODE BDF).
+        frequencies: FRF points [Hz] (default ``FREQUENCIES`` up to the command's band).
+        simulated: channels already simulated on the record's time axis (skips the run).
+    """
+    if mode not in ("displacement", "force"):
+        raise ValueError(f"invalid mode = {mode!r}: a record compares in 'displacement' or 'force' control")
+    chans = channels_of(record, mode)
+    sim = simulated if simulated is not None else simulate_record(rig, record, mode, dt=dt, options=options)
+    u = np.asarray(record.command, dtype=float)
+    f_max = command_band(u, record.dt)
+    freq = np.asarray(frequencies if frequencies is not None else [f for f in FREQUENCIES if f <= 1.05 * f_max],
+                      dtype=float)
+    out = Comparison(name=record_name(record), mode=mode, time=np.asarray(record.time), measured={}, simulated={},
+                     frf_measured={}, frf_simulated={}, frequencies=freq, f_max=f_max)
+    for ch in chans:
+        m, s = np.asarray(record.channels[ch], dtype=float), np.asarray(sim[ch], dtype=float)
+        out.measured[ch], out.simulated[ch] = m, s
+        out.frf_measured[ch], out.frf_simulated[ch] = h1(u, m, record.dt), h1(u, s, record.dt)
+        out.channels[ch] = {"nrmse_pct": nrmse_pct(s, m), "nrmse_demeaned_pct": nrmse_demeaned_pct(s, m),
+                            "rms_error": float(np.sqrt(np.mean((s - m) ** 2))), "std_measured": float(np.std(m)),
+                            "unit": {"displacement": "m", "force": "N"}[ch],
+                            "frf": frf_points(out.frf_measured[ch], out.frf_simulated[ch], freq)}
+    return out
+
+
+__all__ = ["FREQUENCIES", "Comparison", "channels_of", "compare", "frf_points", "record_name", "write_json"]

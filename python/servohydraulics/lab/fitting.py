@@ -1,0 +1,279 @@
+"""The two stages of identification: the frequency response, then the time domain.
+
+* :func:`fit_frequency` (stage 1): the H1 estimates channel/command of every
+  record (coherence >= 0.9, inside the command's band) fitted by the
+  linearised model (``sh.analysis.linearize``, i.e. ``_core.linearize_dynamics``
+  about the record's initial displacement) in relative complex least squares
+  weighted by the coherence.  Keys that do not change the linear model
+  (friction, hysteresis) are left for stage 2.
+* :func:`fit_time` (stage 2): the records' commands simulated through the
+  nonlinear model (the fast integrator, RK4 with the substep count fixed at
+  the start so the residual is a smooth function of the keys; CVODE if the
+  start is too stiff for it), the residual (sim - measured) / std(measured) of
+  every channel, weighted by the inverse of that channel's rms residual at the
+  start (channels fitted as well as the model allows weigh in equally: a
+  linear spring-dashpot standing in for an MR damper leaves a 40 % force
+  residual that would otherwise pull the loop's keys), minimised by
+  ``scipy.optimize.least_squares`` (trust region reflective, Jacobian by
+  forward differences of 0.1 % steps in the fitting coordinates).
+
+Both work in :class:`~servohydraulics.lab.keys.Coordinates` (log space for
+positive keys).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from ..response import Response, SimulationError
+from ..rig import Error, Rig
+from ..simulate import make_plant, solver_options
+from .frf import FrequencyResponse, command_band, h1
+from .keys import Coordinates
+from .run import initial_displacement, simulate_record
+
+MIN_COHERENCE = 0.9
+MAX_POINTS = 80  #: frequency points per channel in stage 1 (log-spaced thinning)
+FAILED = 10.0  #: normalised residual of a failed simulation
+
+
+@dataclass(frozen=True, eq=False)
+class StageResult:
+    z: np.ndarray
+    cost: float
+    nfev: int
+    fun: np.ndarray
+    jac: np.ndarray | None = None
+
+
+def _thin(mask: np.ndarray, f: np.ndarray) -> np.ndarray:
+    idx = np.flatnonzero(mask)
+    if idx.size <= MAX_POINTS:
+        return idx
+    grid = np.geomspace(f[idx[0]], f[idx[-1]], MAX_POINTS)
+    return np.unique(idx[np.clip(np.searchsorted(f[idx], grid), 0, idx.size - 1)])
+
+
+def frequency_targets(records: list[Response], channels: tuple[str, ...]) -> list[tuple]:
+    """(record, channel, f [Hz], H, coherence) of every record and channel, in the fitted band."""
+    out = []
+    for rec in records:
+        u = np.asarray(rec.command, dtype=float)
+        f_hi = command_band(u, rec.dt)
+        for ch in channels:
+            est: FrequencyResponse = h1(u, np.asarray(rec.channels[ch], dtype=float), rec.dt)
+            f_lo = 2.0 / (est.nperseg * rec.dt)
+            idx = _thin(est.band(MIN_COHERENCE, f_lo, f_hi), est.frequency)
+            if idx.size >= 3:
+                out.append((rec, ch, est.frequency[idx], est.response[idx], est.coherence[idx]))
+    if not out:
+        raise ValueError("no frequency with coherence >= 0.9 inside the commands' band: the records carry no "
+                         "usable frequency response")
+    return out
+
+
+def linear_response(rig: Rig, mode: str, x0: float, channels: tuple[str, ...], f: np.ndarray) -> np.ndarray:
+    """Frequency response of the linearised model, rows = channels, columns = f [Hz]."""
+    from ..analysis import linearize
+
+    sys = linearize(rig, mode, x0=x0, outputs=channels)
+    A, B, C, D = (np.asarray(m, dtype=float) for m in (sys.A, sys.B, sys.C, sys.D))
+    s = 2j * np.pi * f
+    X = np.linalg.solve(s[:, None, None] * np.eye(A.shape[0]) - A, np.broadcast_to(B, (f.size,) + B.shape))
+    return (C @ X)[..., 0].T + D
+
+
+def fit_frequency(records: list[Response], rig: Rig, coords: Coordinates, mode: str,
+                  channels: tuple[str, ...]) -> tuple[StageResult, list[str]]:
+    """Stage 1; returns the result and the keys it fitted (those the linear model sees)."""
+    targets = frequency_targets(records, channels)
+    x0s = {id(r): initial_displacement(r) for r in records}
+
+    def residual(z: np.ndarray, active: np.ndarray) -> np.ndarray:
+        zz = np.zeros(len(coords.keys))
+        zz[active] = z
+        out = []
+        for rec, ch, f, H, coh in targets:
+            try:  # an invalid rig (ValueError naming the key) or a singular model: a failed point
+                Hm = linear_response(coords.apply(rig, zz), mode, x0s[id(rec)], (ch,), f)[0]
+            except (ValueError, np.linalg.LinAlgError):
+                return np.full(sum(2 * t[2].size for t in targets), FAILED)
+            e = np.sqrt(coh) * (Hm - H) / np.abs(H)
+            out.append(np.concatenate([e.real, e.imag]) / np.sqrt(f.size))
+        return np.concatenate(out)
+
+    everything = np.ones(len(coords.keys), dtype=bool)
+    base = residual(np.zeros(len(coords.keys)), everything)
+    sees = np.array([np.max(np.abs(residual(np.eye(len(coords.keys))[i] * 0.05, everything) - base)) > 1e-9
+                     for i in range(len(coords.keys))])
+    fitted = [k for k, s in zip(coords.keys, sees) if s]
+    if not fitted:
+        return StageResult(np.zeros(len(coords.keys)), float(base @ base) / 2, 1, base), []
+    lo, hi = coords.bounds()
+    sol = least_squares(lambda z: residual(z, sees), np.zeros(int(sees.sum())), bounds=(lo[sees], hi[sees]),
+                        method="trf", x_scale=1.0, max_nfev=200)
+    z = np.zeros(len(coords.keys))
+    z[sees] = sol.x
+    return StageResult(z, float(sol.cost), int(sol.nfev), sol.fun), fitted
+
+
+MAX_RK4_SUBSTEPS = 200
+
+
+#: the hysteretic specimens' rate bound uses this multiple of the records' peak velocity
+V_REF_MARGIN = 2.0
+
+
+def records_peak_velocity(records: list[Response]) -> float:
+    """The largest 99.9th percentile of |velocity| [m/s] over the records (displacement
+    low-passed at 200 Hz and differenced)."""
+    from .generic import record_scales
+
+    return max(record_scales(r)["v_pk"] for r in records)
+
+
+def fixed_rk4(rig: Rig, records: list[Response], mode: str, margin: float = 2.0):
+    """RK4 options with the substep count fixed at ``margin`` times the automatic count
+    of the start; CVODE when that count would exceed ``MAX_RK4_SUBSTEPS``.  The
+    automatic count bounds a hysteretic specimen's rate with the sliding speed
+    ``V_REF_MARGIN`` times the records' peak velocity (not the actuator's no-load
+    speed: a record shows how fast the rig moved)."""
+    dt = min(r.dt for r in records)
+    v_ref = V_REF_MARGIN * max(records_peak_velocity(records), 1e-4)
+    try:
+        n = make_plant(rig, mode, dt, solver_options(method="rk4", rk4_v_ref=v_ref),
+                       initial_displacement(records[0])).rk4_substeps
+    except Error:
+        n = MAX_RK4_SUBSTEPS + 1
+    if margin * n > MAX_RK4_SUBSTEPS:
+        return solver_options(method="cvode")
+    return solver_options(method="rk4", rk4_substeps=max(1, int(np.ceil(margin * n))))
+
+
+def time_residual(rig: Rig, records: list[Response], mode: str, channels: tuple[str, ...], options,
+                  dt: float | None = None, weights: dict | None = None) -> np.ndarray:
+    """w_ch (sim - measured) / std(measured) of every record and channel, concatenated
+    (w_ch = 1 unless ``weights`` gives it)."""
+    out = []
+    for rec in records:
+        try:
+            sim = simulate_record(rig, rec, mode, dt=dt, options=options)
+        except (SimulationError, ValueError):
+            sim = None
+        for ch in channels:
+            m = np.asarray(rec.channels[ch], dtype=float)
+            s = sim[ch] if sim is not None and np.all(np.isfinite(sim[ch])) else None
+            w = 1.0 if weights is None else weights[ch]
+            out.append(np.full(m.size, FAILED) if s is None else w * (s - m) / np.std(m))
+    return np.concatenate(out)
+
+
+def channel_weights(rig: Rig, records: list[Response], mode: str, channels: tuple[str, ...], options,
+                    dt: float | None = None) -> dict[str, float]:
+    """1 / (rms normalised residual) of each channel over all records at ``rig`` (floored at 1e-3)."""
+    e = time_residual(rig, records, mode, channels, options, dt)
+    sizes = [rec.time.size for rec in records for _ in channels]
+    parts = np.split(e, np.cumsum(sizes)[:-1])
+    names = [ch for _ in records for ch in channels]
+    return {ch: 1.0 / max(float(np.sqrt(np.mean(np.concatenate([p for p, n in zip(parts, names) if n == ch])
+                                                    ** 2))), 1e-3) for ch in channels}
+
+
+#: least_squares' stopping tolerances: a relative cost change below 1e-4 is far below
+#: what separates the models compared here (NRMSE differences of 0.1 %)
+FTOL, XTOL = 1e-4, 1e-6
+
+#: relative forward-difference step of the time-domain Jacobian (in the fitting coordinates)
+DIFF_STEP = 1e-3
+
+
+def default_workers() -> int:
+    """Threads for the Jacobian's columns: the core releases the GIL while it simulates."""
+    import os
+
+    return max(1, min(2, os.cpu_count() or 1))
+
+
+def forward_jacobian(fun, z: np.ndarray, f0: np.ndarray, hi: np.ndarray, workers: int) -> np.ndarray:
+    """Forward differences of ``fun`` at z (steps DIFF_STEP max(1, |z_i|), backwards at an
+    upper bound), the columns evaluated on ``workers`` threads."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    h = DIFF_STEP * np.maximum(1.0, np.abs(z))
+    h = np.where(z + h > hi, -h, h)
+
+    def column(i: int) -> np.ndarray:
+        zi = z.copy()
+        zi[i] += h[i]
+        return (fun(zi) - f0) / h[i]
+
+    if workers <= 1:
+        cols = [column(i) for i in range(z.size)]
+    else:
+        with ThreadPoolExecutor(max_workers=workers) as pool:
+            cols = list(pool.map(column, range(z.size)))
+    return np.column_stack(cols)
+
+
+def fit_time(records: list[Response], rig: Rig, coords: Coordinates, z0: np.ndarray, mode: str,
+             channels: tuple[str, ...], options, dt: float | None = None, max_nfev: int = 60,
+             progress=None, weights: dict | None = None, active: np.ndarray | None = None,
+             workers: int | None = None) -> StageResult:
+    """Stage 2 from z0 (see the module docstring): the ``active`` keys (default all)
+    move, the others stay at z0; the Jacobian's columns run on ``workers`` threads.
+    The result's z covers every key; its ``jac`` the active ones."""
+    n = sum(rec.time.size for rec in records) * len(channels)
+    act = np.ones(z0.size, dtype=bool) if active is None else np.asarray(active, dtype=bool)
+    workers = default_workers() if workers is None else int(workers)
+    cache: dict = {}
+
+    def full(za: np.ndarray) -> np.ndarray:
+        z = np.array(z0, dtype=float)
+        z[act] = za
+        return z
+
+    def residual(za: np.ndarray) -> np.ndarray:
+        if progress is not None:
+            progress.update(1)
+        try:
+            r = coords.apply(rig, full(za))
+        except ValueError:  # the step left the rig's valid range: a failed point
+            return np.full(n, FAILED)
+        return time_residual(r, records, mode, channels, options, dt, weights)
+
+    def fun(za: np.ndarray) -> np.ndarray:
+        cache["z"], cache["f"] = za.copy(), residual(za)
+        return cache["f"]
+
+    lo, hi = (b[act] for b in coords.bounds())
+
+    def jac(za: np.ndarray) -> np.ndarray:
+        f0 = cache["f"] if "z" in cache and np.array_equal(cache["z"], za) else residual(za)
+        return forward_jacobian(residual, za, f0, hi, workers)
+
+    sol = least_squares(fun, np.clip(np.asarray(z0, dtype=float)[act], lo, hi), bounds=(lo, hi), method="trf",
+                        jac=jac, x_scale=1.0, xtol=XTOL, ftol=FTOL, max_nfev=max_nfev)
+    return StageResult(full(sol.x), float(sol.cost), int(sol.nfev), sol.fun, sol.jac)
+
+
+def jacobian_at(records: list[Response], rig: Rig, coords: Coordinates, z: np.ndarray, mode: str,
+                channels: tuple[str, ...], options, dt: float | None = None, weights: dict | None = None,
+                workers: int | None = None, progress=None) -> StageResult:
+    """The residual and its Jacobian over every key at z (for the uncertainty after a block-wise fit)."""
+    def residual(zz: np.ndarray) -> np.ndarray:
+        if progress is not None:
+            progress.update(1)
+        return time_residual(coords.apply(rig, zz), records, mode, channels, options, dt, weights)
+
+    f0 = residual(np.asarray(z, dtype=float))
+    J = forward_jacobian(residual, np.asarray(z, dtype=float), f0, coords.bounds()[1],
+                         default_workers() if workers is None else int(workers))
+    return StageResult(np.asarray(z, dtype=float), float(f0 @ f0) / 2, 1 + z.size, f0, J)
+
+
+__all__ = ["DIFF_STEP", "MAX_RK4_SUBSTEPS", "MIN_COHERENCE", "StageResult", "channel_weights", "default_workers",
+           "fit_frequency", "fit_time", "fixed_rk4", "forward_jacobian", "frequency_targets", "jacobian_at",
+           "linear_response", "records_peak_velocity", "time_residual"]

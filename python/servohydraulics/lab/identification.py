@@ -1,0 +1,270 @@
+"""``sh.identify``: a rig identified from its own lab records.
+
+``identify(records, rig=start, fit=[keys], mode=...)`` fits the chosen rig keys
+to one or more records in two stages (``fitting.py``: the frequency response
+on the linearised model, then the time domain on the nonlinear simulation)
+and returns an :class:`Identification`: the identified rig, each key's value,
+95 % interval and the correlation matrix (from the Jacobian at the optimum and
+the residual variance, inflated for autocorrelated residuals by the AR(1)
+effective sample size, as ``identify.identify_damping_friction`` does), the
+pairs the data cannot separate, and the comparison of every record before and
+after.  ``Identification.write(out)`` writes ``rig_identified.toml``,
+``identification.json``, ``report.md`` and per-record overlay and FRF plots.
+
+Without a start rig, :func:`~servohydraulics.lab.generic.generic_rig` scales
+one from the first record.
+"""
+
+from __future__ import annotations
+
+import copy
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from scipy.stats import norm
+
+from ..identify import ar1_coefficient, ar1_effective_n
+from ..records import read_record
+from ..response import Response
+from ..rig import Rig, load_rig, save_rig
+from .compare import Comparison, channels_of, compare, write_json
+from .fitting import StageResult, channel_weights, fit_frequency, fit_time, fixed_rk4, jacobian_at
+from .generic import generic_rig, specimen_start
+from .keys import FORCE_KEYS, LOOP_KEYS, Coordinates, check_keys, specimen_keys, use_specimen
+from .run import simulate_record
+
+LEVEL = 0.95
+MAX_CORRELATION = 0.95  #: |corr| above which two keys are reported as not separable
+
+
+@dataclass(eq=False)
+class Identification:
+    """The outcome of :func:`identify` (SI units)."""
+
+    rig: Rig  #: the identified rig
+    start: Rig  #: the start (given or generic)
+    mode: str
+    keys: tuple[str, ...]
+    values: dict  #: key -> identified value
+    start_values: dict  #: key -> start value
+    stage1_values: dict  #: key -> value after the frequency-domain stage (None: not fitted there)
+    intervals: dict  #: key -> (low, high), 95 %
+    std: dict  #: key -> standard error (linearised)
+    correlation: np.ndarray = field(repr=False)
+    flags: list = field(default_factory=list)  #: what the data cannot separate or determine
+    before: list = field(default_factory=list, repr=False)  #: Comparison per record, start rig
+    after: list = field(default_factory=list, repr=False)  #: Comparison per record, identified rig
+    generic_start: bool = False
+    n_eff: float = 0.0
+    rho1: float = 0.0
+    nfev: dict = field(default_factory=dict)
+    runtime_s: dict = field(default_factory=dict)
+    weights: dict = field(default_factory=dict)  #: channel -> weight of its normalised residual
+    integrator: str = "rk4"
+
+    def to_dict(self) -> dict[str, Any]:
+        units = _units()
+        return {
+            "mode": self.mode, "generic_start": self.generic_start, "level": LEVEL,
+            "parameters": {k: {"value": self.values[k], "unit": units.get(k, "?"), "start": self.start_values[k],
+                               "stage1": self.stage1_values[k], "std": self.std[k],
+                               "interval": list(self.intervals[k])} for k in self.keys},
+            "correlation": {"keys": list(self.keys), "matrix": np.round(self.correlation, 4).tolist()},
+            "derived": derived(self.rig, self.mode), "flags": self.flags, "channel_weights": self.weights, "integrator": self.integrator, "n_eff": self.n_eff, "rho1": self.rho1, "nfev": self.nfev,
+            "runtime_s": self.runtime_s,
+            "records": [{"record": b.name, "before": {c: b.channels[c]["nrmse_pct"] for c in b.channels},
+                         "after": {c: a.channels[c]["nrmse_pct"] for c in a.channels}}
+                        for b, a in zip(self.before, self.after)],
+        }
+
+    def markdown(self) -> str:
+        from .report import identification_markdown
+
+        return identification_markdown(self)
+
+    def write(self, out: str | Path) -> Path:
+        """Writes the rig, the JSON and markdown report and the plots into ``out``."""
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        figs = {}
+        for a in self.after:
+            for name, fig in a.figures().items():
+                figs[f"{name}_{a.name}.png"] = fig
+        for name, fig in figs.items():
+            fig.savefig(out / name, dpi=110)
+        save_rig(self.rig, out / "rig_identified.toml")
+        write_json(out / "identification.json", self.to_dict())
+        (out / "report.md").write_text(self.markdown())
+        return out / "report.md"
+
+
+def derived(rig: Rig, mode: str) -> dict[str, float]:
+    """What the records determine even where the keys trade off: the loop gain
+    G_p C_F K_s K_v / A [1/s] in displacement control (the closed-loop corner of
+    the integrating loop; a generic start's G_p alone depends on its scaling)."""
+    if mode != "displacement":
+        return {}
+    return {"loop_gain_1_per_s": float(rig.G_p * rig.C_F_disp * rig.K_s * rig.K_v / rig.A),
+            "valve_lag_s": float(2.0 * rig.zeta_v / (2.0 * np.pi * rig.f_v))}
+
+
+def _units() -> dict[str, str]:
+    from ..rig import PARAMETERS
+
+    return {p.key: p.unit for p in PARAMETERS}
+
+
+def as_records(records) -> list[Response]:
+    """Responses from Responses or record paths (a single one is accepted)."""
+    if isinstance(records, (str, Path, Response)):
+        records = [records]
+    out = [r if isinstance(r, Response) else read_record(r) for r in records]
+    if not out:
+        raise ValueError("invalid records = []: give at least one record")
+    return out
+
+
+def _start_rig(rig, records: list[Response]) -> tuple[Rig, bool]:
+    if rig is None:
+        return generic_rig(records[0]), True
+    if isinstance(rig, (str, Path)):
+        return load_rig(rig), False
+    return copy.copy(rig), False
+
+
+def uncertainty(stage: StageResult, coords: Coordinates) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """(covariance of z, correlation, n_eff, rho1) from the Jacobian at the optimum."""
+    r, J = stage.fun, stage.jac
+    n, p = r.size, J.shape[1]
+    s2 = float(r @ r) / max(n - p, 1)
+    rho = ar1_coefficient(r)
+    n_eff = ar1_effective_n(n, rho)
+    cov = s2 * (n - p) / max(n_eff - p, 1.0) * np.linalg.pinv(J.T @ J)
+    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        corr = np.where(np.outer(sd, sd) > 0, cov / np.outer(sd, sd), 0.0)
+    return cov, corr, n_eff, rho
+
+
+def separability_flags(keys, values: dict, intervals: dict, corr: np.ndarray) -> list[str]:
+    """Pairs with |corr| > 0.95 and keys whose 95 % interval is wider than the value."""
+    flags = []
+    for i, a in enumerate(keys):
+        for j in range(i + 1, len(keys)):
+            if abs(corr[i, j]) > MAX_CORRELATION:
+                flags.append(f"{a} and {keys[j]} cannot be separated by these records (correlation "
+                             f"{corr[i, j]:+.3f})")
+    for k in keys:
+        lo, hi = intervals[k]
+        if hi - lo > abs(values[k]):
+            flags.append(f"{k} is poorly determined: its 95 % interval [{lo:.4g}, {hi:.4g}] is wider than its "
+                         f"value {values[k]:.4g}")
+    return flags
+
+
+def time_blocks(keys: tuple[str, ...], channels: tuple[str, ...], mode: str) -> list[tuple[np.ndarray, tuple]]:
+    """The time-domain stage's blocks (active keys, channels fitted), in order.  In
+    displacement control with both channels: the loop's keys (every key that is not a
+    force key, ``FORCE_KEYS``) on the displacement, then the force keys on the force (the
+    specimen sees the displacement the loop makes; the records show a tracking that does
+    not depend on the load).  Otherwise one block: every key on every channel."""
+    force = np.array([k in FORCE_KEYS for k in keys])
+    if mode == "displacement" and set(channels) >= {"displacement", "force"} and force.any() and not force.all():
+        return [(~force, ("displacement",)), (force, ("force",))]
+    return [(np.ones(len(keys), dtype=bool), channels)]
+
+
+def _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar, workers):
+    """Stage 2 block by block (:func:`time_blocks`), then the residual and Jacobian of every
+    key on every channel at the result (weights 1 / rms of each channel's residual there)."""
+    z = np.array(z1, dtype=float)
+    nfev = 0
+    blocks = time_blocks(coords.keys, chans, mode)
+    for active, block_chans in blocks:
+        w = channel_weights(coords.apply(start, z), recs, mode, block_chans, options, dt) \
+            if len(blocks) == 1 else None
+        s = fit_time(recs, start, coords, z, mode, block_chans, options, dt, max_nfev, bar, w, active, workers)
+        z, nfev = s.z, nfev + s.nfev
+    weights = channel_weights(coords.apply(start, z), recs, mode, chans, options, dt)
+    final = jacobian_at(recs, start, coords, z, mode, chans, options, dt, weights, workers, bar)
+    return StageResult(z, final.cost, nfev, final.fun, final.jac), weights
+
+
+def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | None = None,
+             mode: str = "displacement", specimen: str = "linear", channels: Sequence[str] | None = None,
+             dt: float | None = None, frequency_stage: bool = True, max_nfev: int = 60,
+             progress: bool = True, workers: int | None = None) -> Identification:
+    """Identifies rig keys from lab records (see the module docstring).
+
+    Args:
+        records: record paths or Responses (time, command, displacement, force).
+        rig: the start (a Rig or a rig TOML path); None: the generic rig scaled from the first record.
+        fit: keys to fit; default ``LOOP_KEYS[mode]`` + ``SPECIMEN_KEYS[specimen]``.
+        mode: the records' control mode, ``"displacement"`` or ``"force"``.
+        specimen: ``"linear"``, ``"bouc_wen"`` or ``"mr_damper"`` (the last two need issue 12's elements).
+        channels: the channels fitted (default: those the records carry, displacement and force).
+        dt: controller sample time [s] (default: the records' own).
+        frequency_stage: run stage 1 (the H1 fit of the linearised model) before the time domain.
+        max_nfev: the time-domain stage's budget of residual evaluations (Jacobians not counted).
+        progress: a tqdm bar over the simulations.
+        workers: threads for the Jacobian's columns (default: up to 2).
+    """
+    if mode not in LOOP_KEYS:
+        raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(LOOP_KEYS)}")
+    t_start = time.perf_counter()
+    recs = as_records(records)
+    spec = specimen_keys(specimen)
+    start, generic = _start_rig(rig, recs)
+    if generic:
+        specimen_start(start, recs[0], specimen)
+    use_specimen(start, specimen)
+    keys = check_keys(start, fit if fit is not None else LOOP_KEYS[mode] + spec)
+    chans = tuple(channels) if channels is not None else channels_of(recs[0], mode)
+    for r in recs:
+        missing = [c for c in chans if c not in channels_of(r, mode)]
+        if missing:
+            raise ValueError(f"record {r.path or '?'}: channel(s) {missing} absent or constant")
+    coords = Coordinates.about(start, keys)
+    runtime: dict[str, float] = {}
+    z1, stage1_keys, nfev = np.zeros(len(keys)), [], {}
+    if frequency_stage:
+        t0 = time.perf_counter()
+        s1, stage1_keys = fit_frequency(recs, start, coords, mode, chans)
+        z1, nfev["frequency"], runtime["frequency"] = s1.z, s1.nfev, time.perf_counter() - t0
+    options = fixed_rk4(coords.apply(start, z1), recs, mode)
+    t0 = time.perf_counter()
+    from tqdm.auto import tqdm
+
+    with tqdm(desc="identify (simulations)", unit="sim", disable=not progress, leave=False) as bar:
+        s2, weights = _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar, workers)
+    nfev["time"], runtime["time"] = s2.nfev, time.perf_counter() - t0
+    cov, corr, n_eff, rho = uncertainty(s2, coords)
+    zq = float(norm.ppf(0.5 + LEVEL / 2))
+    sd_z = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    vals = coords.values(s2.z)
+    values = {k: float(v) for k, v in zip(keys, vals)}
+    intervals = {k: coords.interval(s2.z[i], sd_z[i], i, zq) for i, k in enumerate(keys)}
+    std = {k: float(sd_z[i] * (abs(vals[i]) if coords.log[i] else coords.scale[i])) for i, k in enumerate(keys)}
+    s1_vals = coords.values(z1)
+    out_rig = coords.apply(start, s2.z)
+    t0 = time.perf_counter()
+    before = [compare(r, start, mode, simulated=simulate_record(start, r, mode, dt=dt, options=options))
+              for r in recs]
+    after = [compare(r, out_rig, mode, simulated=simulate_record(out_rig, r, mode, dt=dt, options=options))
+             for r in recs]
+    runtime["compare"] = time.perf_counter() - t0
+    runtime["total"] = time.perf_counter() - t_start
+    return Identification(
+        rig=out_rig, start=start, mode=mode, keys=keys, values=values,
+        start_values={k: float(v) for k, v in zip(keys, coords.start)},
+        stage1_values={k: (float(s1_vals[i]) if k in stage1_keys else None) for i, k in enumerate(keys)},
+        intervals=intervals, std=std, correlation=corr,
+        flags=separability_flags(keys, values, intervals, corr), before=before, after=after,
+        generic_start=generic, weights=weights, integrator=options.method.name.lower(), n_eff=float(n_eff), rho1=float(rho), nfev=nfev, runtime_s=runtime)
+
+
+__all__ = ["Comparison", "Identification", "as_records", "identify", "separability_flags", "uncertainty"]

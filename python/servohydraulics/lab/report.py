@@ -1,0 +1,42 @@
+"""The markdown report of an identification."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def _v(x) -> str:
+    return "-" if x is None else f"{x:.5g}"
+
+
+def identification_markdown(ident) -> str:
+    d = ident.to_dict()
+    start = "the generic rig scaled from the first record (docs/lab-records.md)" if ident.generic_start \
+        else "the given rig"
+    lines = [f"# Identified rig ({ident.mode} control)", "",
+             f"Start: {start}. Stage 1 (frequency response, linearised model) then stage 2 (time domain, "
+             f"nonlinear simulation).  Intervals: {int(100 * d['level'])} %, from the Jacobian at the optimum "
+             f"and the residual variance, inflated for autocorrelated residuals (lag-1 rho = {ident.rho1:.3f}, "
+             f"effective samples {ident.n_eff:.0f}).", "",
+             "| key | unit | start | stage 1 | identified | 95 % interval |", "|---|---|---|---|---|---|"]
+    for k, p in d["parameters"].items():
+        lo, hi = p["interval"]
+        lines.append(f"| `{k}` | {p['unit']} | {_v(p['start'])} | {_v(p['stage1'])} | {_v(p['value'])} | "
+                     f"[{lo:.5g}, {hi:.5g}] |")
+    for k, v in d["derived"].items():
+        lines.append(f"\nDerived: `{k}` = {v:.5g}")
+    lines += ["", "## Correlations", "", "| | " + " | ".join(ident.keys) + " |",
+              "|---" * (len(ident.keys) + 1) + "|"]
+    for i, k in enumerate(ident.keys):
+        lines.append(f"| `{k}` | " + " | ".join(f"{c:+.2f}" for c in np.asarray(ident.correlation)[i]) + " |")
+    lines += ["", "## What the data cannot separate", ""]
+    lines += [f"- {f}" for f in ident.flags] or ["- nothing: every key is determined and no pair has |corr| > 0.95"]
+    lines += ["", "## Records (NRMSE = 100 rms(sim - measured) / std(measured), %)", "",
+              "| record | channel | start | identified | plots |", "|---|---|---|---|---|"]
+    for b, a in zip(ident.before, ident.after):
+        for c in a.channels:
+            lines.append(f"| {a.name} | {c} | {b.nrmse(c):.2f} | {a.nrmse(c):.2f} | "
+                         f"[overlay](overlay_{a.name}.png), [FRF](frf_{a.name}.png) |")
+    rt = ", ".join(f"{k} {v:.1f} s" for k, v in ident.runtime_s.items())
+    lines += ["", f"Run time: {rt}; evaluations: {ident.nfev}.", ""]
+    return "\n".join(lines)

@@ -1,0 +1,33 @@
+"""The thesis' Spencer (modified Bouc-Wen) baseline against a closed form."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from servohydraulics.lab import baselines as b
+
+
+def test_spencer_without_hysteresis_is_its_linear_closed_form():
+    """With A = 0 the evolutionary variable z stays 0 and the model is linear:
+    F/X = c1 s (k0 + c0 s)/((c0 + c1) s + k0) + k1 (N, mm).  Steady-state sine response."""
+    p = dataclasses.replace(b.thesis_mr_parameters(0.5), A=0.0, k0=50.0, c0=2.0, c1=10.0, x0=0.0)
+    dt, f, X = 1e-3, 2.0, 3.0  # mm
+    t = np.arange(6000) * dt
+    x_m = 1e-3 * X * np.sin(2 * np.pi * f * t)
+    F = b.spencer_force(x_m, dt, p)
+    s = 2j * np.pi * f
+    H = p.c1 * s * (p.k0 + p.c0 * s) / ((p.c0 + p.c1) * s + p.k0) + p.k1
+    expected = X * np.abs(H) * np.sin(2 * np.pi * f * t + np.angle(H))
+    tail = t > 3.0  # (c0 + c1)/k0 = 0.24 s: the start has decayed
+    assert np.max(np.abs(F[tail] - expected[tail])) < 2e-3 * X * np.abs(H)
+
+
+def test_thesis_parameters_follow_the_readme():
+    p0, p1 = b.thesis_mr_parameters(0.0), b.thesis_mr_parameters(1.0)
+    assert p0.alpha == pytest.approx(15.221) and p1.alpha == pytest.approx(-38.152 + 41.508 + 15.221)
+    assert p1.c1 == pytest.approx(78.337 + 9.8671) and p1.beta == pytest.approx(1.8941 * np.exp(-3.6561))
+    with pytest.raises(ValueError, match="invalid current"):
+        b.thesis_mr_parameters(2.0)
