@@ -30,7 +30,10 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(os.environ.get("SH_SHARED_DIR", ROOT.parent / "shared")) / "real-data" / "utfsm-mts-mrdamper"
-START, END = "<!-- utfsm-diagnose:start -->", "<!-- utfsm-diagnose:end -->"
+
+
+def markers(label: str) -> tuple[str, str]:
+    return f"<!-- utfsm-diagnose:{label}:start -->", f"<!-- utfsm-diagnose:{label}:end -->"
 
 
 def _record(name: str, end: float | None):
@@ -68,8 +71,9 @@ def _fmt(v: float | None, unit: str) -> str:
     return f"{v:.4g} {unit}"
 
 
-def section(js: dict, how: str, record: str, end: float | None, cmd: str, t_ident: float) -> str:
+def section(js: dict, how: str, record: str, end: float | None, cmd: str, t_ident: float, label: str) -> str:
     """The Markdown section for the doc."""
+    START, END = markers(label)
     L = [START, "", f"Made by: `{cmd}`", "",
          f"Nominal rig: {how}" + (f" ({t_ident:.0f} s)" if t_ident else "") + ".",
          f"Record: `{record}`" + (f", its first {end:g} s" if end else "") + f"; diagnosis run time {js['runtime_s']:.0f} s.",
@@ -112,10 +116,24 @@ def main() -> None:
     p.add_argument("--out", default="build/utfsm_diagnose")
     p.add_argument("--doc", default="docs/utfsm_diagnose.md")
     p.add_argument("--no-doc", action="store_true")
+    p.add_argument("--effect-off", action="append", default=[],
+                   help="switch this effect of the nominal rig off first (repeatable), e.g. load_pressure")
+    p.add_argument("--label", default="main", help="which section of the doc to write (its markers)")
+    p.add_argument("--render", action="store_true", help="only re-write the doc section from OUT/utfsm_diagnose.json")
     a = p.parse_args()
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
+    if a.render:
+        saved = json.loads((out / "utfsm_diagnose.json").read_text())
+        write_section(Path(a.doc), a.label, section(saved["diagnosis"], saved["nominal"], saved["record"],
+                                                      saved["end"], saved["command"], saved["identify_s"], a.label))
+        return
     rig, how, t_ident = _rig_0a(a.rig, out)
+    for eff in a.effect_off:
+        if not hasattr(rig.effects, eff):
+            raise SystemExit(f"invalid --effect-off {eff!r}: not an effect switch")
+        setattr(rig.effects, eff, False)
+        how += f", with `effects.{eff}` switched off"
     end = a.end or None
     rec = _record(a.record, end)
     d = sh.diagnose(rec, rig, mode="displacement", max_effects=a.max_effects, progress=True)
@@ -128,16 +146,26 @@ def main() -> None:
         print(f"  gap {c}: {100 * js['gap_before'][c]:.2f} % -> {100 * js['gap_after'][c]:.2f} % "
               f"(noise floor {100 * js['noise_floor'][c]:.2f} %)")
     args = " ".join(f"--{k} {v}" for k, v in (("rig", a.rig), ("record", a.record), ("end", a.end),
-                                              ("max-effects", a.max_effects), ("out", a.out)) if v)
+                                              ("max-effects", a.max_effects), ("out", a.out), ("label", a.label))
+                    if v)
+    args += "".join(f" --effect-off {e}" for e in a.effect_off)
     cmd = f"PYTHONPATH=python python benchmarks/utfsm_diagnose.py {args}"
     (out / "utfsm_diagnose.json").write_text(json.dumps({"command": cmd, "nominal": how, "identify_s": t_ident,
-                                                         "diagnosis": js}, indent=1, default=str))
+                                                         "record": a.record, "end": end, "diagnosis": js},
+                                                        indent=1, default=str))
     if not a.no_doc:
-        doc = Path(a.doc)
-        text = doc.read_text() if doc.exists() else f"# Diagnose on real data\n\n{START}\n{END}\n"
-        i, j = text.index(START), text.index(END) + len(END)
-        doc.write_text(text[:i] + section(js, how, a.record, end, cmd, t_ident) + text[j:])
-        print(f"wrote {doc}")
+        write_section(Path(a.doc), a.label, section(js, how, a.record, end, cmd, t_ident, a.label))
+
+
+def write_section(doc: Path, label: str, text_section: str) -> None:
+    """Replaces the section between the label's markers in ``doc`` (appends the markers if absent)."""
+    START, END = markers(label)
+    text = doc.read_text() if doc.exists() else "# Diagnose on real data\n"
+    if START not in text:
+        text += f"\n{START}\n{END}\n"
+    i, j = text.index(START), text.index(END) + len(END)
+    doc.write_text(text[:i] + text_section + text[j:])
+    print(f"wrote {doc}")
 
 
 if __name__ == "__main__":
