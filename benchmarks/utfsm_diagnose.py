@@ -76,9 +76,11 @@ def section(js: dict, how: str, record: str, end: float | None, cmd: str, t_iden
     START, END = markers(label)
     L = [START, "", f"Made by: `{cmd}`", "",
          f"Nominal rig: {how}" + (f" ({t_ident:.0f} s)" if t_ident else "") + ".",
-         f"Record: `{record}`" + (f", its first {end:g} s" if end else "") + f"; diagnosis run time {js['runtime_s']:.0f} s.",
+         f"Record: `{record}`" + (f", its first {end:g} s" if end else "")
+         + f"; diagnosis run time {js['runtime_s']:.0f} s.",
          "", f"Verdict: **{js['verdict']}**: {js['summary']}", "",
-         "| effect | parameter | fitted | 95 % interval | absent (0 A model) | BIC change | gap after (displacement / force) |",
+         "| effect | parameter | fitted | 95 % interval | absent (0 A model) | BIC change | "
+         "gap after (displacement / force) |",
          "|---|---|---|---|---|---|---|"]
     for e in js["effects"]:
         for i, (k, p) in enumerate(e["parameters"].items()):
@@ -89,7 +91,8 @@ def section(js: dict, how: str, record: str, end: float | None, cmd: str, t_iden
                         f"{100 * e['gap_after'].get('force', float('nan')):.2f} % |" if i == 0 else " | |"))
     if not js["effects"]:
         L.append("| (none) | | | | | | |")
-    L += ["", "| channel | gap before (0 A model) | gap after | noise floor | share of the gap above the floor closed |",
+    L += ["", "| channel | gap before (0 A model) | gap after | noise floor | "
+          "share of the gap above the floor closed |",
           "|---|---|---|---|---|"]
     for c in js["gap_before"]:
         closed = js["gap_closed"].get(c)
@@ -141,7 +144,8 @@ def main() -> None:
     js = d.to_dict()
     print(f"{js['verdict']}: {js['summary']}")
     for e in js["effects"]:
-        print(f"  + {e['name']}: " + ", ".join(f"{k} = {_fmt(v['value'], v['unit'])}" for k, v in e["parameters"].items()))
+        pars = ", ".join(f"{k} = {_fmt(v['value'], v['unit'])}" for k, v in e["parameters"].items())
+        print(f"  + {e['name']}: {pars}")
     for c in js["gap_before"]:
         print(f"  gap {c}: {100 * js['gap_before'][c]:.2f} % -> {100 * js['gap_after'][c]:.2f} % "
               f"(noise floor {100 * js['noise_floor'][c]:.2f} %)")

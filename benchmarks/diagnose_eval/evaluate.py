@@ -310,7 +310,8 @@ def write_doc(m: dict, per: list[dict], key: list[dict], doc: Path, cmd: str, wa
                     v = _fitted(r["parameters"][i], pk, a)["value"]
                     what = a.get("alt_label", "second truth")
                     par[-1] += f" [{what}: {pk} {v:.4g} ({tv:.4g})]" if v is not None else f" [{what} {tv:.4g}]"
-        L.append(f"| {r['id']} | {k.get('rig', 'paper')} {k['mode']} | {k['snr']} | {'; '.join(k['forms']) or 'none'} | {r['verdict']} | "
+        L.append(f"| {r['id']} | {k.get('rig', 'paper')} {k['mode']} | {k['snr']} | "
+                 f"{'; '.join(k['forms']) or 'none'} | {r['verdict']} | "
                  f"{', '.join(r['named']) or ('/'.join(r['ambiguous']) if r['ambiguous'] else '-')} | "
                  f"{'; '.join(par) or '-'} | {_p(r['gap_closed_main'])} |")
     doc.write_text("\n".join(L) + "\n")

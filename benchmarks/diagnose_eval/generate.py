@@ -1,6 +1,7 @@
 """Seeded generator of records with hidden effects for the diagnose evaluation.
 
-    python benchmarks/diagnose_eval/generate.py --out build/diagnose_eval [--size default|quick] [--seed 2003] [--jobs 2]
+    python benchmarks/diagnose_eval/generate.py --out build/diagnose_eval [--size default|quick] [--seed 2003]
+        [--jobs 2] [--cases all|new|old]
 
 Writes OUT/records/*.csv (time, command, displacement, force), OUT/nominal_*.toml
 (the models the diagnosis is told to believe), OUT/manifest.json (record, mode,
@@ -272,7 +273,8 @@ def plan(size: str, cases: str = "all") -> list[dict]:
 
 
 IN_LIBRARY = {"coulomb", "viscous", "spring", "load_pressure", "flow", "delay", "valve", "leakage", "piston",
-              "spool", "bouc_wen", "bouc_wen_soft"}  #: forms the library has exactly (the others are out-of-library forms)
+              "spool", "bouc_wen", "bouc_wen_soft"}
+#: (IN_LIBRARY: forms the library has exactly; the others are out-of-library forms)
 
 
 def make_record(args: tuple) -> tuple[dict, dict, dict]:
@@ -319,7 +321,8 @@ def make_record(args: tuple) -> tuple[dict, dict, dict]:
         noise = rms * 10 ** (-it["snr"] / 20) if rms > 0 and not (c == "force" and mode == "free") else 0.0
         rec[c] = y + rng.normal(0.0, noise, y.size) if noise > 0 else y.copy()
     key = {"id": rid, "kind": it["kind"], "mode": mode, "snr": it["snr"], "answers": answers,
-           "forms": forms, "duration": dur, "rig": rig, "set": it.get("set", "earlier"), "runtime_check": it.get("runtime_check", False),
+           "forms": forms, "duration": dur, "rig": rig, "set": it.get("set", "earlier"),
+           "runtime_check": it.get("runtime_check", False),
            "peak_spool": float(np.max(np.abs(ch["spool"]))), "friction_energy_equivalent": f_eq,
            "truth": {k: v for k, v in asdict(tr).items() if not isinstance(v, list)}}
     return rec, {"id": rid, "mode": mode, "rig": nominal_file(mode, rig)}, key

@@ -137,7 +137,8 @@ def simulate(tr: Truth, mode: str, u: np.ndarray, dt: float, x0: float = 0.0, su
         else:
             zd = 0.0
         if tr.bouc_wen:
-            zbd = tr.bw_A * v - tr.bw_beta * abs(v) * abs(zb) ** (tr.bw_n - 1) * zb - tr.bw_gamma * v * abs(zb) ** tr.bw_n
+            zbd = (tr.bw_A * v - tr.bw_beta * abs(v) * abs(zb) ** (tr.bw_n - 1) * zb
+                   - tr.bw_gamma * v * abs(zb) ** tr.bw_n)
         else:
             zbd = 0.0
         applied = p * tr.A if actuator else ucmd
