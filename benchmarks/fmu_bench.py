@@ -2,7 +2,7 @@
 
     PYTHONPATH=python SERVOHYDRAULICS_CORE_DIR=build/dev python benchmarks/fmu_bench.py [--steps 4000] [--write]
 
-The plant of the calibrated Zhao (2003) rig in displacement control, CVODE, a
+The plant of the calibrated Zhao (2003) rig in displacement control, the default integrator (dopri5), a
 2 Hz, 10 mm sine command at the 0.5 ms controller sample.  Per sample, in the
 same run (models built outside the timed region):
 

@@ -82,8 +82,11 @@ void expose_plant(py::module_& m) {
 
   py::class_<SolverOptions> so(m, "SolverOptions");
   py::enum_<SolverOptions::Method>(so, "Method")
+      .value("Dopri5", SolverOptions::Method::Dopri5)
       .value("CvodeBdf", SolverOptions::Method::CvodeBdf)
-      .value("Rk4", SolverOptions::Method::Rk4);
+      .value("Rk4", SolverOptions::Method::Rk4)
+      .value("ArkodeErk", SolverOptions::Method::ArkodeErk)
+      .value("ArkodeDirk", SolverOptions::Method::ArkodeDirk);
   py::enum_<SolverOptions::Restart>(so, "Restart")
       .value("OnInputChange", SolverOptions::Restart::OnInputChange)
       .value("Never", SolverOptions::Restart::Never);
@@ -91,16 +94,22 @@ void expose_plant(py::module_& m) {
       .def_readwrite("method", &SolverOptions::method)
       .def_readwrite("restart", &SolverOptions::restart)
       .def_readwrite("rtol", &SolverOptions::rtol)
-      .def_readwrite("atol_scale", &SolverOptions::atol_scale)
+      .def_readwrite("atol_fraction", &SolverOptions::atol_fraction)
       .def_readwrite("max_order", &SolverOptions::max_order)
       .def_readwrite("max_steps_per_sample", &SolverOptions::max_steps_per_sample)
       .def_readwrite("max_internal_step", &SolverOptions::max_internal_step)
       .def_readwrite("rk4_substeps", &SolverOptions::rk4_substeps)
       .def_readwrite("rk4_h_rho", &SolverOptions::rk4_h_rho)
       .def_readwrite("rk4_v_ref", &SolverOptions::rk4_v_ref)
+      .def_readwrite("stiff_steps", &SolverOptions::stiff_steps)
+      .def_readwrite("stiff_fallback", &SolverOptions::stiff_fallback)
+      .def_readwrite("rk4_flag_rtol", &SolverOptions::rk4_flag_rtol)
+      .def_readwrite("rk4_max_refinements", &SolverOptions::rk4_max_refinements)
+      .def_readonly_static("MAX_SUBSTEPS", &SolverOptions::kMaxSubsteps)
       .def("validate", &SolverOptions::validate);
-  bindings::add_protocol(so, {"method", "restart", "rtol", "atol_scale", "max_order", "max_steps_per_sample",
-                              "max_internal_step", "rk4_substeps", "rk4_h_rho", "rk4_v_ref"});
+  bindings::add_protocol(so, {"method", "restart", "rtol", "atol_fraction", "max_order", "max_steps_per_sample",
+                              "max_internal_step", "stiff_steps", "stiff_fallback", "rk4_substeps", "rk4_h_rho",
+                              "rk4_v_ref", "rk4_flag_rtol", "rk4_max_refinements"});
 
   py::class_<Status> st(m, "Status");
   py::enum_<Status::Code>(st, "Code")
@@ -108,13 +117,17 @@ void expose_plant(py::module_& m) {
       .value("SolverFailure", Status::SolverFailure)
       .value("TooMuchWork", Status::TooMuchWork)
       .value("NonFinite", Status::NonFinite)
-      .value("NotReady", Status::NotReady);
+      .value("NotReady", Status::NotReady)
+      .value("Stiff", Status::Stiff);
   st.def_readonly("code", &Status::code)
       .def_readonly("cvode_flag", &Status::cvode_flag)
       .def_readonly("t", &Status::t)
       .def_readonly("internal_steps", &Status::internal_steps)
       .def_readonly("rhs_evals", &Status::rhs_evals)
       .def_readonly("restarted", &Status::restarted)
+      .def_readonly("stiff", &Status::stiff)
+      .def_readonly("inaccurate", &Status::inaccurate)
+      .def_readonly("error_estimate", &Status::error_estimate)
       .def("ok", &Status::ok)
       .def_property_readonly("message", &Status::message);
 
@@ -193,11 +206,21 @@ void expose_plant(py::module_& m) {
       .def_property_readonly("moving_mass", &Dynamics::moving_mass)
       .def_property_readonly("mode", &Dynamics::mode);
 
+  m.def("state_scale", &state_scale, py::arg("dynamics"), py::arg("i"),
+        "The magnitude of state i of this rig, the unit of its absolute tolerance (solver_options.hpp)");
+  m.def("absolute_tolerances",
+        [](const Dynamics& d, const SolverOptions& o) {
+          py::array_t<double> a(d.num_states());
+          absolute_tolerances(d, o, a.mutable_data());
+          return a;
+        },
+        py::arg("dynamics"), py::arg("options") = SolverOptions{},
+        "Absolute tolerance of each state [its unit]: rtol * atol_fraction * state_scale (one home, C++)");
   m.def("rk4_automatic_substeps", &rk4_automatic_substeps, py::arg("dynamics"), py::arg("dt"),
         py::arg("options") = SolverOptions{},
         "RK4 substeps per sample of dt [s] that SolverOptions(rk4_substeps=0) would choose (the C++ rule)");
 
-  py::class_<Plant>(m, "Plant", "The plant stepped at the controller rate (CVODE between samples)")
+  py::class_<Plant>(m, "Plant", "The plant stepped at the controller rate (the ODE integrator of SolverOptions between samples)")
       .def(py::init<const Rig&, ControlMode, double, const SolverOptions&>(), py::arg("rig"), py::arg("mode"),
            py::arg("dt"), py::arg("options") = SolverOptions{})
       .def("reset", bindings::guarded(&Plant::reset, "Plant.reset"), py::arg("x0") = 0.0, py::arg("t0") = 0.0)

@@ -18,7 +18,9 @@ void expose_record(py::module_& m) {
       .def_readonly("max_internal_steps", &RunSummary::max_internal_steps)
       .def_readonly("flags_any", &RunSummary::flags_any)
       .def_readonly("peak_force", &RunSummary::peak_force)
-      .def_readonly("first_capacity_time", &RunSummary::first_capacity_time);
+      .def_readonly("first_capacity_time", &RunSummary::first_capacity_time)
+      .def_readonly("stiff_samples", &RunSummary::stiff_samples)
+      .def_readonly("inaccurate_samples", &RunSummary::inaccurate_samples);
 
   m.def(
       "run_record",

@@ -230,12 +230,12 @@ void add_plant(std::vector<Variable>& out, ControlMode mode) {
   // The names of SolverOptions::Method, in the enum's order (those of simulate.py's METHODS); a new
   // method needs its name here, else exporting with it is a ValueError naming solver.method.
   out.push_back(enumeration<SolverOptions::Method>(
-      "solver.method", "SolverMethod", {"cvode", "rk4"}, "the plant's ODE integrator (solver_options.hpp)",
+      "solver.method", "SolverMethod", {"dopri5", "cvode", "rk4", "arkode_erk", "arkode_dirk"}, "the plant's ODE integrator (solver_options.hpp)",
       [](Values& v) -> SolverOptions::Method& { return v.settings.solver.method; }));
   out.push_back(enumeration<SolverOptions::Restart>(
       "solver.restart", "SolverRestart", {"on_input_change", "never"}, "CVODE restart on a command jump",
       [](Values& v) -> SolverOptions::Restart& { return v.settings.solver.restart; }));
-  out.push_back(parameter("solver.rtol", "", "CVODE relative tolerance",
+  out.push_back(parameter("solver.rtol", "", "relative tolerance (dopri5, CVODE, ARKODE)",
                           [](Values& v) -> double& { return v.settings.solver.rtol; }));
   out.push_back(integer<int>("solver.rk4_substeps", "RK4 substeps per sample (0 = automatic)",
                              [](Values& v) -> int& { return v.settings.solver.rk4_substeps; }));

@@ -50,11 +50,7 @@ RunSummary run_rows(const Plant& p, std::size_t n, StepRow&& step_row, PlantRow&
     const Status st = step_row(k);
     account(sum, plant_row(k), F_cap);
     sum.rows = k + 1;
-    if (st.internal_steps > sum.max_internal_steps) sum.max_internal_steps = st.internal_steps;
-    if (!st.ok()) {
-      sum.status = st;
-      break;
-    }
+    if (!sum.count(st)) break;
   }
   sum.internal_steps = p.total_internal_steps() - ns0;
   sum.rhs_evals = p.total_rhs_evals() - nf0;

@@ -1,6 +1,7 @@
 // The plant stepped at the controller rate: the zero-order hold of the command,
-// the divergence guard and the lifecycle, over one of two integrators
-// (detail/cvode_integrator, detail/rk4_integrator) held in a std::variant.
+// the divergence guard and the lifecycle, over one of the integrators
+// (detail/dopri5_integrator, cvode_integrator, rk4_integrator, arkode_integrator)
+// held in a std::variant.
 #include "servohydraulics/plant.hpp"
 
 #include <algorithm>
@@ -10,7 +11,9 @@
 #include <utility>
 #include <variant>
 
+#include "detail/arkode_integrator.hpp"
 #include "detail/cvode_integrator.hpp"
+#include "detail/dopri5_integrator.hpp"
 #include "detail/rk4_integrator.hpp"
 
 namespace servohydraulics {
@@ -20,7 +23,8 @@ namespace {
 constexpr double kMaxDisplacement = 100.0;  // [m]
 constexpr double kMaxPressureRatio = 100.0; // [p_s]
 
-using Integrator = std::variant<detail::CvodeIntegrator, detail::Rk4Integrator>;
+using Integrator = std::variant<detail::Dopri5Integrator, detail::CvodeIntegrator, detail::Rk4Integrator,
+                                detail::ArkodeIntegrator>;
 
 SolverOptions checked(const SolverOptions& o, double dt) {
   require(std::isfinite(dt) && dt > 0.0, "dt", dt, "controller sample time must be finite and > 0 [s]");
@@ -62,11 +66,19 @@ struct History {
   }
 };
 
-// Built in place (CvodeIntegrator is pinned: CVODE holds its address).
+// Built in place (the SUNDIALS integrators are pinned: SUNDIALS holds their address).
 Integrator make_integrator(const Dynamics& dyn, double dt, const SolverOptions& opt) {
-  if (opt.method == SolverOptions::Method::CvodeBdf)
-    return Integrator(std::in_place_type<detail::CvodeIntegrator>, dyn, dt, opt, dyn.equilibrium(0.0));
-  return Integrator(std::in_place_type<detail::Rk4Integrator>, dyn, dt, opt);
+  using M = SolverOptions::Method;
+  const State y0 = dyn.equilibrium(0.0);
+  switch (opt.method) {
+    case M::CvodeBdf: return Integrator(std::in_place_type<detail::CvodeIntegrator>, dyn, dt, opt, y0);
+    case M::Rk4: return Integrator(std::in_place_type<detail::Rk4Integrator>, dyn, dt, opt);
+    case M::ArkodeErk:
+    case M::ArkodeDirk:
+      return Integrator(std::in_place_type<detail::ArkodeIntegrator>, dyn, dt, opt, y0, opt.method == M::ArkodeDirk);
+    case M::Dopri5: break;
+  }
+  return Integrator(std::in_place_type<detail::Dopri5Integrator>, dyn, dt, opt, y0);
 }
 }  // namespace
 
@@ -179,6 +191,9 @@ Status Plant::Impl::advance_delayed(double t_next) noexcept {
   st.internal_steps += first.internal_steps;
   st.rhs_evals += first.rhs_evals;
   st.restarted = st.restarted || first.restarted;
+  st.stiff = st.stiff || first.stiff;
+  st.inaccurate = st.inaccurate || first.inaccurate;
+  st.error_estimate = std::max(st.error_estimate, first.error_estimate);
   return st;
 }
 

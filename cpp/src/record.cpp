@@ -12,6 +12,14 @@ void put(T* dst, std::size_t k, T v) noexcept {
 }
 }  // namespace
 
+bool RunSummary::count(const Status& st) noexcept {
+  if (st.internal_steps > max_internal_steps) max_internal_steps = st.internal_steps;
+  stiff_samples += st.stiff ? 1 : 0;
+  inaccurate_samples += st.inaccurate ? 1 : 0;
+  if (!st.ok()) status = st;
+  return st.ok();
+}
+
 RunSummary run_record(Plant& plant, const double* command, std::size_t n, const Channels& out) noexcept {
   RunSummary sum;
   const long ns0 = plant.total_internal_steps(), nf0 = plant.total_rhs_evals(), nr0 = plant.total_restarts();
@@ -29,11 +37,7 @@ RunSummary run_record(Plant& plant, const double* command, std::size_t n, const 
     const Status st = plant.step(command[k], o);
     put(out.internal_steps, k, st.internal_steps);
     put(out.rhs_evals, k, st.rhs_evals);
-    if (st.internal_steps > sum.max_internal_steps) sum.max_internal_steps = st.internal_steps;
-    if (!st.ok()) {
-      sum.status = st;
-      break;
-    }
+    if (!sum.count(st)) break;
   }
   sum.internal_steps = plant.total_internal_steps() - ns0;
   sum.rhs_evals = plant.total_rhs_evals() - nf0;

@@ -5,10 +5,11 @@ namespace servohydraulics {
 const char* Status::message() const noexcept {
   switch (code) {
     case Ok: return "ok";
-    case SolverFailure: return "CVODE failed (see cvode_flag)";
-    case TooMuchWork: return "overrun: more CVODE internal steps than max_steps_per_sample in one sample";
+    case SolverFailure: return "the SUNDIALS integrator failed (see cvode_flag)";
+    case TooMuchWork: return "overrun: more internal steps than max_steps_per_sample in one sample";
     case NonFinite: return "the state became NaN or infinite (the run diverged)";
     case NotReady: return "step() called after a failure without reset()";
+    case Stiff: return "the sample is stiff for the explicit Dormand-Prince pair (stiff_fallback off): use CVODE";
   }
   return "?";
 }

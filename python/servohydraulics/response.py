@@ -116,6 +116,20 @@ def _first_time(time: np.ndarray, flags: np.ndarray, bit: int) -> float:
     return float(time[np.argmax((flags & bit) > 0)])
 
 
+def solver_warnings(work: Any) -> list[str]:
+    """Notes on how the integrator coped: samples the real-time option (RK4) flagged as
+    inaccurate by its error estimate, samples the default pair found stiff (CVODE took them)."""
+    out = []
+    n_bad = getattr(work, "inaccurate_samples", 0) if work is not None else 0
+    if n_bad:
+        out.append(f"{n_bad} sample(s) flagged inaccurate by the RK4 error estimate: use the default "
+                   "method (dopri5), more rk4_substeps or rk4_max_refinements")
+    n_stiff = getattr(work, "stiff_samples", 0) if work is not None else 0
+    if n_stiff:
+        out.append(f"{n_stiff} sample(s) were stiff for the explicit pair and integrated by CVODE")
+    return out
+
+
 def limit_warnings(flags: np.ndarray, time: np.ndarray, peak_force: float, rig: Rig | None = None) -> list[str]:
     """Notes on the physical limits a run hit, from its per-row OutputFlag bits
     (``rig`` adds the limit values)."""
@@ -272,6 +286,7 @@ class Response:
         rig = self.rig if rig is None else rig
         peak = self.work.peak_force if self.work is not None else float(np.max(np.abs(self.force), initial=0.0))
         out = limit_warnings(self.flags, self.time, peak, rig)
+        out += solver_warnings(self.work)
         if not self.success:
             out.append(self.message)
         return out
@@ -353,4 +368,5 @@ def finish(res: Response, raise_on_failure: bool) -> Response:
     return res
 
 
-__all__ = ["Channels", "Response", "Work", "SimulationError", "channel_units", "limit_warnings", "uniform_dt"]
+__all__ = ["Channels", "Response", "Work", "SimulationError", "channel_units", "limit_warnings", "solver_warnings",
+           "uniform_dt"]

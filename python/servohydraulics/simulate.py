@@ -20,16 +20,32 @@ MODES = {
     "force": _core.ControlMode.Force,
     "free": _core.ControlMode.Free,
 }
-METHODS = {"cvode": _core.SolverOptions.Method.CvodeBdf, "rk4": _core.SolverOptions.Method.Rk4}
+METHODS = {
+    "dopri5": _core.SolverOptions.Method.Dopri5,  # the default: error-controlled, fast, CVODE for stiff samples
+    "rk4": _core.SolverOptions.Method.Rk4,  # the real-time option: fixed cost, flagged by its error estimate
+    "cvode": _core.SolverOptions.Method.CvodeBdf,  # the reference
+    "arkode_erk": _core.SolverOptions.Method.ArkodeErk,
+    "arkode_dirk": _core.SolverOptions.Method.ArkodeDirk,
+}
 RESTARTS = {"on_input_change": _core.SolverOptions.Restart.OnInputChange, "never": _core.SolverOptions.Restart.Never}
 
 
-def solver_options(method: str = "cvode", rtol: float = 1e-6, restart: str = "on_input_change",
+def solver_options(method: str = "dopri5", rtol: float | None = None, restart: str = "on_input_change",
                    rk4_substeps: int = 0, max_steps_per_sample: int = 2000,
                    max_order: int = 5, rk4_h_rho: float | None = None,
-                   rk4_v_ref: float | None = None) -> _core.SolverOptions:
-    """Builds solver options; see ``SolverOptions`` in solver_options.hpp
-    (``rk4_h_rho``, ``rk4_v_ref``: None keeps the core's default)."""
+                   rk4_v_ref: float | None = None, atol_fraction: float | None = None,
+                   stiff_fallback: bool = True, stiff_steps: int | None = None,
+                   rk4_flag_rtol: float | None = None, rk4_max_refinements: int = 0) -> _core.SolverOptions:
+    """Builds solver options; see ``SolverOptions`` in solver_options.hpp.
+
+    ``method``: ``"dopri5"`` (default: Dormand-Prince 5(4) with error control at ``rtol``, a sample
+    where it turns stiff is redone by CVODE, or reported as status ``stiff`` if ``stiff_fallback`` is
+    False), ``"rk4"`` (the real-time option: fixed cost, ``rk4_substeps`` per sample or automatic,
+    samples flagged by its error estimate at ``rk4_flag_rtol``, redone with doubled substeps up to
+    ``rk4_max_refinements`` times), ``"cvode"`` (BDF, the reference), ``"arkode_erk"``,
+    ``"arkode_dirk"`` (SUNDIALS ARKODE references).  Absolute tolerances scale with the rig:
+    ``rtol * atol_fraction * state_scale`` (``_core.absolute_tolerances``).  A keyword left at None
+    keeps the core's default."""
     if method not in METHODS:
         raise ValueError(f"invalid method = {method!r}: expected one of {sorted(METHODS)}")
     if restart not in RESTARTS:
@@ -38,7 +54,9 @@ def solver_options(method: str = "cvode", rtol: float = 1e-6, restart: str = "on
     o.method = METHODS[method]
     o.restart = RESTARTS[restart]
     _assign(o, rtol=rtol, rk4_substeps=rk4_substeps, max_steps_per_sample=max_steps_per_sample,
-            max_order=max_order, rk4_h_rho=rk4_h_rho, rk4_v_ref=rk4_v_ref)
+            max_order=max_order, rk4_h_rho=rk4_h_rho, rk4_v_ref=rk4_v_ref, atol_fraction=atol_fraction,
+            stiff_fallback=bool(stiff_fallback), stiff_steps=stiff_steps, rk4_flag_rtol=rk4_flag_rtol,
+            rk4_max_refinements=rk4_max_refinements)
     o.validate()
     return o
 
@@ -95,7 +113,7 @@ def make_plant(rig: Rig, mode: str, dt: float = 5e-4, options: _core.SolverOptio
     if not math.isfinite(x0) or abs(x0) > MAX_X0:
         raise ValueError(f"invalid x0 = {x0!r}: must be finite and within +-{MAX_X0:g} m (the plant's "
                          "divergence guard)")
-    plant = _core.Plant(rig, MODES[mode], _check_dt(dt), options or _core.SolverOptions())
+    plant = _core.Plant(rig, MODES[mode], _check_dt(dt), options or solver_options())
     plant.reset(float(x0))
     return plant
 
@@ -114,13 +132,16 @@ def simulate(rig: Rig, mode: str = "displacement", command: ArrayLike | None = N
         dt: controller sample time [s] (the paper's DSP ran at 2 kHz).
         duration: run length [s] when ``command`` is None (checked against it otherwise).
         x0: initial displacement [m]; the run starts from static equilibrium there.
-        options: solver options (``solver_options(...)``); CVODE BDF by default.
+        options: solver options (``solver_options(...)``); by default the error-controlled
+            Dormand-Prince pair (``"dopri5"``, CVODE for stiff samples).
         raise_on_failure: raise SimulationError (carrying the partial Response) on a
             solver failure or divergence; otherwise return the rows computed so far.
 
     Returns:
         A :class:`~servohydraulics.response.Response` of kind ``"plant"``: the
-        plant's channels, ``command``, ``flags``, ``internal_steps``, ``rhs_evals``.
+        plant's channels, ``command``, ``flags``, ``internal_steps``, ``rhs_evals``;
+        ``work.stiff_samples`` and ``work.inaccurate_samples`` count the samples CVODE took
+        over and the RK4 samples its error estimate flagged (also in ``warnings()``).
     """
     dt = _check_dt(dt)
     u = _command_array(command, duration, dt)

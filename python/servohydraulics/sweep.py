@@ -56,7 +56,7 @@ __all__ = ["summary_run", "sweep", "grid_points", "monte_carlo_points"]
 
 def summary_run(rig: Rig, mode: str = "displacement", command: ArrayLike | None = None,
                 amplitude: float = 0.01, frequency: float = 1.0, duration: float = 2.0, dt: float = 5e-4,
-                method: str = "cvode", rtol: float = 1e-6, rk4_substeps: int = 0,
+                method: str = "dopri5", rtol: float | None = None, rk4_substeps: int = 0,
                 keep_record: bool = False) -> dict[str, Any]:
     """The default run of a sweep: simulates the rig and returns summary metrics.
 
@@ -76,7 +76,7 @@ def summary_run(rig: Rig, mode: str = "displacement", command: ArrayLike | None 
         ``rms_tracking_error`` and ``peak_tracking_error`` (command minus the
         fed-back channel: displacement [m] or load-cell force [N]),
         ``capacity_exceeded``, ``supply_limited``, ``spool_saturated``,
-        ``internal_steps`` (CVODE, whole run) and ``wall_time`` [s].
+        ``internal_steps`` (the integrator's, whole run) and ``wall_time`` [s].
     """
     if command is None:
         command = sine(amplitude, frequency, duration, dt)

@@ -1,6 +1,8 @@
 // The real-time promise: Plant::step, reset, observe and run_record allocate
-// nothing, in every control mode, with CVODE (restarting at every input change
-// or never) and with RK4, on success and on the failure paths.  Allocations are
+// nothing, in every control mode, with the default Dormand-Prince pair (and its
+// CVODE fallback on a stiff rig), CVODE (restarting at every input change or
+// never), RK4 (with refinement), ARKODE ERK and DIRK, on success and on the
+// failure paths.  Allocations are
 // counted by interposing malloc & co. and operator new (alloc_counter.hpp), so
 // C allocations inside SUNDIALS count too; the first block of main checks that
 // the counter really sees both kinds.
@@ -31,12 +33,18 @@ double command(ControlMode mode, int k) {
 }
 
 const char* method_name(const SolverOptions& o) {
-  if (o.method == SolverOptions::Method::Rk4) return "rk4";
+  switch (o.method) {
+    case SolverOptions::Method::Rk4: return "rk4";
+    case SolverOptions::Method::Dopri5: return "dopri5";
+    case SolverOptions::Method::ArkodeErk: return "arkode-erk";
+    case SolverOptions::Method::ArkodeDirk: return "arkode-dirk";
+    case SolverOptions::Method::CvodeBdf: break;
+  }
   return o.restart == SolverOptions::Restart::Never ? "cvode/never" : "cvode/on-input-change";
 }
 
-void check_plant(ControlMode mode, const SolverOptions& opt) {
-  Plant plant(zhao2003(), mode, kDt, opt);
+void check_plant(ControlMode mode, const SolverOptions& opt, const Rig& rig = zhao2003()) {
+  Plant plant(rig, mode, kDt, opt);
   const int n = 3000;
   // run_record's destinations are allocated before counting.
   std::vector<double> cmd(n);
@@ -77,8 +85,8 @@ void check_plant(ControlMode mode, const SolverOptions& opt) {
     allocations = counter.count();
     frees = counter.frees();
   }
-  std::printf("%-13s %-22s %5d samples: %ld allocations, %ld frees, %ld restarts\n", to_string(mode), method_name(opt),
-              2 * n + 502, allocations, frees, restarts);
+  std::printf("%-13s %-22s %5d samples: %ld allocations, %ld frees, %ld restarts%s\n", to_string(mode),
+              method_name(opt), 2 * n + 502, allocations, frees, restarts, rig.m < 100.0 ? " (stiff rig)" : "");
   CHECK(failed == 0);
   CHECK(allocations == 0);
   CHECK(frees == 0);
@@ -88,8 +96,9 @@ void check_plant(ControlMode mode, const SolverOptions& opt) {
 
 // An overrun (CVODE's too-much-work return) must not allocate either, e.g. for
 // an error message.
-void check_overrun() {
+void check_overrun(SolverOptions::Method method) {
   SolverOptions opt;
+  opt.method = method;
   opt.max_steps_per_sample = 1;
   Plant plant(zhao2003(), ControlMode::Displacement, kDt, opt);
   Output out;
@@ -129,7 +138,9 @@ int main() {
     { Plant p(zhao2003(), ControlMode::Force, kDt, rk4); }
     rk4_construct = counter.count();
     counter.restart();
-    { Plant p(zhao2003(), ControlMode::Force, kDt); }
+    SolverOptions cv;
+    cv.method = SolverOptions::Method::CvodeBdf;
+    { Plant p(zhao2003(), ControlMode::Force, kDt, cv); }
     cvode_construct = counter.count();
   }
   std::printf("construction: %ld allocations with RK4, %ld with CVODE (SUNDIALS' own mallocs are seen)\n",
@@ -139,13 +150,26 @@ int main() {
     CHECK(cvode_construct >= rk4_construct + 5);
   }
 
+  SolverOptions dopri5;
   SolverOptions cvode;
-  SolverOptions never;
+  cvode.method = SolverOptions::Method::CvodeBdf;
+  SolverOptions never = cvode;
   never.restart = SolverOptions::Restart::Never;
   SolverOptions rk4;
   rk4.method = SolverOptions::Method::Rk4;
+  rk4.rk4_max_refinements = 3;
+  SolverOptions erk, dirk;
+  erk.method = SolverOptions::Method::ArkodeErk;
+  dirk.method = SolverOptions::Method::ArkodeDirk;
   for (ControlMode mode : {ControlMode::Displacement, ControlMode::Force, ControlMode::Free})
-    for (const SolverOptions* o : {&cvode, &never, &rk4}) check_plant(mode, *o);
-  check_overrun();
+    for (const SolverOptions* o : {&dopri5, &cvode, &never, &rk4, &erk, &dirk}) check_plant(mode, *o);
+  // A small installed mass with sharp friction: the pair turns stiff and CVODE takes those samples.
+  Rig light = zhao2003();
+  light.m = 2.0;
+  light.m_p = 1.0;
+  light.v_stick = 1e-6;
+  check_plant(ControlMode::Displacement, dopri5, light);
+  for (auto m : {SolverOptions::Method::CvodeBdf, SolverOptions::Method::Dopri5, SolverOptions::Method::ArkodeErk})
+    check_overrun(m);
   return sh_test::report("test_allocations");
 }

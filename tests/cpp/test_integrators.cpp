@@ -8,11 +8,26 @@
 //    whose RK4 integrator throws (too stiff for the automatic rule).
 // 2. The automatic RK4 rule is one function: the Plant, the Rk4Integrator and
 //    rk4_automatic_substeps agree; rk4_v_ref = 0 is the no-load actuator speed.
+// 3. Every error-controlled method against CVODE at rtol 1e-10 (the tight
+//    reference): the default Dormand-Prince pair, ARKODE ERK and DIRK within
+//    1e-3 of the peak displacement and force; RK4 within 1e-2 or flagged.
+// 4. Stiff configurations, each against the tight reference: a small installed
+//    mass with sharp friction, a run that saturates at the supply pressure, the
+//    LuGre rig.  The default is accurate (CVODE takes the stiff samples) or
+//    returns a non-ok status, never a wrong answer with status ok; without the
+//    fallback it returns Status::Stiff.
+// 5. Absolute tolerances scale with the rig: the issue's piston area of
+//    4.47 m^2, where fixed tolerances gave a peak force 11x the converged one.
+// 6. RK4: the substep cap (no hang at 2^31 - 1), the error estimate flags the
+//    raised-gain force loop at 2 substeps, refinement clears it.
+#include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "alloc_counter.hpp"
 #include "check.hpp"
@@ -20,6 +35,7 @@
 #include "detail/rk4_integrator.hpp"
 #include "servohydraulics/plant.hpp"
 #include "servohydraulics/presets.hpp"
+#include "servohydraulics/record.hpp"
 
 using namespace servohydraulics;
 
@@ -131,11 +147,188 @@ void check_rk4_rule() {
   }
   CHECK(threw);
 }
+
+using M = SolverOptions::Method;
+
+SolverOptions method(M m, double rtol = 0.0) {
+  SolverOptions o;
+  o.method = m;
+  if (rtol > 0.0) o.rtol = rtol;
+  o.max_steps_per_sample = 200000;
+  return o;
+}
+
+// A sine for the first 60 % of the run, then a held step on top: [m] or [N].
+std::vector<double> sine_step(double amp, double freq, double step, int n) {
+  std::vector<double> u(n);
+  for (int k = 0; k < n; ++k)
+    u[k] = amp * std::sin(2.0 * 3.14159265358979323846 * freq * k * kDt) + (k >= 0.6 * n ? step : 0.0);
+  return u;
+}
+
+Trace run(const Rig& rig, ControlMode mode, const std::vector<double>& u, const SolverOptions& opt) {
+  Plant plant(rig, mode, kDt, opt);
+  return simulate(plant, u);
+}
+
+double peak_abs(const std::vector<double>& v, std::size_t n) {
+  double m = 0.0;
+  for (std::size_t i = 0; i < n; ++i) m = std::max(m, std::fabs(v[i]));
+  return m;
+}
+
+// The larger of max |x - x_ref| / max |x_ref| and the same for the load-cell force.
+double rel_error(const Trace& a, const Trace& ref) {
+  const std::size_t n = std::min(a.summary.rows, ref.summary.rows);
+  double e = 0.0;
+  for (Channel c : {Channel::Displacement, Channel::Force}) {
+    double d = 0.0;
+    for (std::size_t i = 0; i < n; ++i) d = std::max(d, std::fabs(a[c][i] - ref[c][i]));
+    e = std::max(e, d / std::max(peak_abs(ref[c], n), 1e-300));
+  }
+  return e;
+}
+
+// Within tol of the reference with status ok, or a non-ok status: never a silent wrong answer.
+bool within_or_status(const Trace& t, const Trace& ref, double tol, const char* what) {
+  const double e = rel_error(t, ref);
+  std::printf("  %-44s status %-3s error %.2e, stiff samples %ld, flagged %ld\n", what,
+              t.summary.status.ok() ? "ok" : "NOK", e, t.summary.stiff_samples, t.summary.inaccurate_samples);
+  return !t.summary.status.ok() || e <= tol;
+}
+
+void check_methods_against_reference() {
+  const Rig rig = zhao2003();
+  for (ControlMode mode : {ControlMode::Displacement, ControlMode::Force}) {
+    const bool disp = mode == ControlMode::Displacement;
+    const std::vector<double> u = sine_step(disp ? 0.02 : 5e4, 2.0, disp ? 0.01 : 2e4, 2000);
+    const Trace ref = run(rig, mode, u, method(M::CvodeBdf, 1e-10));
+    CHECK(ref.summary.status.ok());
+    std::printf("%s, preset:\n", to_string(mode));
+    for (M m : {M::Dopri5, M::ArkodeErk, M::ArkodeDirk, M::CvodeBdf}) {
+      const Trace t = run(rig, mode, u, method(m));
+      CHECK(t.summary.status.ok());
+      CHECK(within_or_status(t, ref, 1e-3, m == M::Dopri5 ? "dopri5 (default)" : "SUNDIALS method"));
+      if (m == M::Dopri5) CHECK(t.summary.stiff_samples == 0);  // not stiff: the explicit pair alone
+    }
+    const Trace rk4 = run(rig, mode, u, method(M::Rk4));
+    CHECK(rel_error(rk4, ref) <= 1e-2 || rk4.summary.inaccurate_samples > 0);
+    // The in-core pair and ARKODE's Dormand-Prince table agree (same tableau, different controllers).
+    CHECK(rel_error(run(rig, mode, u, method(M::Dopri5, 1e-9)), run(rig, mode, u, method(M::ArkodeErk, 1e-9))) < 1e-5);
+  }
+}
+
+void check_stiff_configurations() {
+  // A small installed mass with sharp friction: the friction mode F_c / (v_stick M) ~ 1e7 1/s.
+  Rig light = zhao2003();
+  light.m = 2.0;
+  light.m_p = 1.0;
+  light.v_stick = 1e-6;
+  // Saturating at the supply pressure: a force command of 2 p_s A held (the load pressure reaches 0.99 p_s).
+  const Rig preset = zhao2003();
+  const double psA = preset.p_s * preset.A;
+  Rig lugre = zhao2003();
+  lugre.effects.lugre_friction = true;
+  struct Case {
+    const char* name;
+    Rig rig;
+    ControlMode mode;
+    std::vector<double> u;
+    bool expect_stiff;
+  };
+  const Case cases[] = {
+      {"small mass (3 kg) with friction", light, ControlMode::Displacement, sine_step(0.005, 2.0, 0.002, 2000), true},
+      {"saturating at the supply pressure", preset, ControlMode::Force, std::vector<double>(2000, 2.0 * psA), false},
+      {"LuGre friction", lugre, ControlMode::Displacement, sine_step(0.01, 2.0, 0.005, 2000), false},
+  };
+  for (const Case& c : cases) {
+    std::printf("%s:\n", c.name);
+    const Trace ref = run(c.rig, c.mode, c.u, method(M::CvodeBdf, 1e-10));
+    CHECK(ref.summary.status.ok());
+    if (std::string(c.name).find("supply") != std::string::npos) CHECK(ref.summary.flags_any & kSupplyLimited);
+    const Trace def = run(c.rig, c.mode, c.u, SolverOptions{});
+    CHECK(within_or_status(def, ref, 1e-3, "dopri5 (default)"));
+    CHECK(def.summary.status.ok());
+    if (c.expect_stiff) CHECK(def.summary.stiff_samples > 0);
+    const Trace rk4 = run(c.rig, c.mode, c.u, method(M::Rk4));
+    CHECK(rk4.summary.inaccurate_samples > 0 || !rk4.summary.status.ok() || rel_error(rk4, ref) <= 1e-2);
+    within_or_status(rk4, ref, 1e-2, "rk4 (automatic substeps)");
+    // Without the fallback: a status, not an answer.
+    SolverOptions no_fallback;
+    no_fallback.stiff_fallback = false;
+    const Trace nf = run(c.rig, c.mode, c.u, no_fallback);
+    if (c.expect_stiff) CHECK(nf.summary.status.code == Status::Stiff && nf.summary.status.t > 0.0);
+    CHECK(within_or_status(nf, ref, 1e-3, "dopri5 without the fallback"));
+  }
+}
+
+void check_tolerances_scale_with_the_rig() {
+  // The issue's rig: piston area 4.47 m^2.  With fixed absolute tolerances CVODE at rtol 1e-6 gave a
+  // peak force 11x the converged one (2,361 N vs 213 N in displacement control here).
+  Rig big = zhao2003();
+  big.A = 4.47;
+  const Dynamics d_big(big, ControlMode::Displacement), d_pre(zhao2003(), ControlMode::Displacement);
+  double a_big[kNumStates], a_pre[kNumStates];
+  absolute_tolerances(d_big, SolverOptions{}, a_big);
+  absolute_tolerances(d_pre, SolverOptions{}, a_pre);
+  CHECK(a_big[kP] < a_pre[kP] / 100.0);  // the pressure that makes the force is 500x smaller
+  CHECK(a_big[kV] < a_pre[kV] / 100.0);  // so is the no-load speed
+  CHECK(a_big[kX] == a_pre[kX]);         // the stroke is the same
+  for (int i = 0; i < d_pre.num_states(); ++i) CHECK(a_pre[i] == SolverOptions{}.rtol * 1e-2 * state_scale(d_pre, i));
+  for (ControlMode mode : {ControlMode::Displacement, ControlMode::Force}) {
+    const std::vector<double> u = sine_step(mode == ControlMode::Displacement ? 0.05 : 2e5, 1.0, 0.0, 2001);
+    const double converged = run(big, mode, u, method(M::CvodeBdf, 1e-10)).summary.peak_force;
+    for (M m : {M::CvodeBdf, M::Dopri5}) {
+      const Trace t = run(big, mode, u, method(m, 1e-6));
+      CHECK(t.summary.status.ok());
+      CHECK_NEAR(t.summary.peak_force, converged, 0.02 * converged);
+      std::printf("A = 4.47 m^2, %s, %s rtol 1e-6: peak force %.1f N, converged %.1f N\n", to_string(mode),
+                  m == M::CvodeBdf ? "CVODE" : "dopri5", t.summary.peak_force, converged);
+    }
+  }
+}
+
+void check_rk4_flag_and_cap() {
+  SolverOptions huge = method(M::Rk4);
+  huge.rk4_substeps = INT_MAX;
+  bool threw = false;
+  try {
+    Plant p(zhao2003(), ControlMode::Displacement, kDt, huge);
+  } catch (const Error& e) {
+    threw = std::string(e.what()).find("rk4_substeps") != std::string::npos;
+  }
+  CHECK(threw);
+  // The force loop with K_s and C_F_force raised (issue 16: 2 substeps, 168 % error with status ok).
+  Rig hot = zhao2003();
+  hot.K_s = 1.0;
+  hot.C_F_force = 0.5e-3;
+  const std::vector<double> u = sine_step(5e4, 2.0, 3e4, 2000);
+  const Trace ref = run(hot, ControlMode::Force, u, method(M::CvodeBdf, 1e-10));
+  SolverOptions two = method(M::Rk4);
+  two.rk4_substeps = 2;
+  const Trace t2 = run(hot, ControlMode::Force, u, two);
+  const double e2 = rel_error(t2, ref);
+  CHECK(e2 > 1e-2);                              // off by more than the stated 1 % ...
+  CHECK(t2.summary.inaccurate_samples > 0);      // ... and it says so
+  CHECK(t2.summary.status.ok());                 // flagged, the run goes on
+  two.rk4_max_refinements = 4;
+  const Trace tr = run(hot, ControlMode::Force, u, two);
+  std::printf("raised-gain force loop, RK4 2 substeps: error %.2e, %ld flagged; refined: error %.2e, %ld flagged\n",
+              e2, t2.summary.inaccurate_samples, rel_error(tr, ref), tr.summary.inaccurate_samples);
+  CHECK(rel_error(tr, ref) <= e2);  // refined, no worse ...
+  CHECK(tr.summary.inaccurate_samples > 0);  // ... and still flagged
+  CHECK(tr.summary.rhs_evals > t2.summary.rhs_evals);
+  CHECK(within_or_status(run(hot, ControlMode::Force, u, SolverOptions{}), ref, 1e-3, "dopri5 (default)"));
+}
 }  // namespace
 
 int main() {
   check_no_leak_on_throw();
   check_no_leak_on_success();
   check_rk4_rule();
+  check_methods_against_reference();
+  check_stiff_configurations();
+  check_tolerances_scale_with_the_rig();
+  check_rk4_flag_and_cap();
   return sh_test::report("test_integrators");
 }

@@ -25,7 +25,7 @@ def expect(exc: type[BaseException], f, *args) -> None:
 def main() -> None:
     rig = sh.zhao2003()
     u = 1e-3 * np.sin(np.linspace(0.0, 6.0, 400))
-    for method in ("cvode", "rk4"):
+    for method in ("dopri5", "cvode", "rk4"):
         for mode in ("displacement", "force", "free"):
             cmd = u * (1e5 if mode == "force" else 1.0)
             r = sh.simulate(rig, mode, cmd, options=sh.solver_options(method))

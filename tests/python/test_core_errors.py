@@ -146,7 +146,7 @@ def test_diverging_run_raises_with_time_and_cause(calibrated):
 
 
 def test_solver_overrun_raises_with_time_and_cvode_flag(calibrated):
-    opts = sh.solver_options(max_steps_per_sample=1)
+    opts = sh.solver_options(method="cvode", max_steps_per_sample=1)
     with pytest.raises(sh.SimulationError, match=r"failed at t = [0-9.e-]+ s: overrun.*\(CVODE flag -1\)"):
         sh.simulate(calibrated, mode="displacement", command=np.full(10, 1e-3), options=opts)
 

@@ -74,7 +74,8 @@ def test_restart_policies_agree(calibrated, dt):
 
 
 def test_rk4_automatic_substeps_follow_the_stiffness():
-    """rk4_substeps = 0 picks the fewest substeps with h * rho(J) <= 1 at the equilibrium.
+    """rk4_substeps = 0 picks the fewest substeps with h * rho(J) <= 1 over the operating states
+    (the equilibrium, where friction is steepest, and the pressure and spool envelope).
     The preset (fastest mode: the 70.7 Hz critically damped valve, 444 rad/s; h rho = 0.22)
     needs one.  A piston-only installed mass (54 kg) with the free-structure friction (95.7 N
     over v_stick = 1e-4 m/s) has a friction mode at -8.8e3 rad/s: h lambda = -4.4 at 2 kHz,
@@ -92,9 +93,9 @@ def test_rk4_automatic_substeps_follow_the_stiffness():
         sh.Dynamics(stiff, sh.ControlMode.Displacement).equilibrium(0.0), 0.0))
     rho = np.max(np.abs(np.linalg.eigvals(jac)))
     auto = sh.make_plant(stiff, "displacement", dt, sh.solver_options(method="rk4"))
-    assert auto.rk4_substeps == int(np.ceil(dt * rho))
+    assert auto.rk4_substeps >= int(np.ceil(dt * rho))  # at least the equilibrium's rate
     u = np.full(2000, 0.002)
-    ref = sh.simulate(stiff, "displacement", u, dt, options=sh.solver_options(rtol=1e-9))
+    ref = sh.simulate(stiff, "displacement", u, dt, options=sh.solver_options(method="cvode", rtol=1e-9))
     v_scale = np.max(np.abs(ref.velocity))
     rk = sh.simulate(stiff, "displacement", u, dt, options=sh.solver_options(method="rk4"))
     one = sh.simulate(stiff, "displacement", u, dt, options=sh.solver_options(method="rk4", rk4_substeps=1))

@@ -29,7 +29,7 @@ def _commands(n: int = 2000) -> list[np.ndarray]:
     return [a * np.sin(2 * np.pi * f * t) for a, f in ((2e-3, 1.0), (5e-3, 3.0), (1e-3, 7.0), (8e-3, 0.5))]
 
 
-@pytest.mark.parametrize("method", ["cvode", "rk4"])
+@pytest.mark.parametrize("method", ["dopri5", "cvode", "rk4"])
 def test_simulate_from_four_threads_is_bit_identical_to_serial(method):
     rig, opts = sh.zhao2003(), sh.solver_options(method)
     cmds = _commands()

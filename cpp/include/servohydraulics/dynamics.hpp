@@ -57,8 +57,9 @@ class Dynamics {
   const StateLayout& layout() const noexcept { return layout_; }
   //! Name, unit and meaning of state i < num_states().
   const StateInfo& state_info(int i) const noexcept;
-  //! Absolute scale of state i (CVODE's absolute tolerance is rtol times it): the base
-  //! states take SolverOptions::atol_scale, the appended ones this.
+  //! Absolute scale of an appended state i >= kNumStates (specimen, in-loop delay); the base
+  //! states' scales follow the rig (servohydraulics::state_scale in solver_options.hpp, which
+  //! calls this for the appended ones).
   double state_scale(int i) const noexcept;
   //! Force of the switched-on specimen elements (Bouc-Wen and MR damper) at state y [N]
   //! (0 when both are off); part of the structure's force against the applied one.

@@ -30,12 +30,18 @@ struct Channels {
 
 //! What a run did.
 struct RunSummary {
+  //! Counts one sample's status: the largest work, the stiff and the inaccurate samples, and a
+  //! failure (kept in status).  Returns st.ok().
+  bool count(const Status& st) noexcept;
+
   Status status;                  //!< the first failure, or Ok
   std::size_t rows = 0;           //!< rows written (n on success)
   long internal_steps = 0;        //!< CVODE internal steps in the run
   long rhs_evals = 0;             //!< right-hand-side evaluations in the run
   long restarts = 0;              //!< CVodeReInit calls in the run
   int max_internal_steps = 0;     //!< the largest number in one sample
+  long stiff_samples = 0;         //!< samples the default pair found stiff and CVODE integrated (Status::stiff)
+  long inaccurate_samples = 0;    //!< Rk4 samples whose error estimate exceeded the tolerance (Status::inaccurate)
   std::uint32_t flags_any = 0;    //!< OR of every row's OutputFlag bits
   double peak_force = 0.0;        //!< max |load-cell force| [N]
   double first_capacity_time = -1.0;  //!< first time |force| > F_cap [s], -1 if never

@@ -2,41 +2,78 @@
 // not the structural integration scheme of Eq 15).
 #pragma once
 
-#include <array>
-
 #include "servohydraulics/state.hpp"
 
 namespace servohydraulics {
 
+class Dynamics;
+
 struct SolverOptions {
   enum class Method {
-    CvodeBdf,  //!< CVODE, BDF, Newton with the analytic dense Jacobian (reference, default)
-    Rk4,       //!< classical fixed-step Runge-Kutta, rk4_substeps per sample (real-time option)
+    Dopri5,      //!< Dormand-Prince 5(4) with error control, the sample as maximum step, FSAL; a sample where
+                 //!< it turns stiff is redone by CVODE (stiff_fallback) or reported as Status::Stiff (default)
+    CvodeBdf,    //!< CVODE, BDF, Newton with the analytic dense Jacobian (the reference)
+    Rk4,         //!< classical fixed-step Runge-Kutta, rk4_substeps per sample, with an embedded error
+                 //!< estimate that flags a sample (real-time option: fixed cost)
+    ArkodeErk,   //!< SUNDIALS ARKODE ARKStep, explicit table (Dormand-Prince 5(4)), error-controlled (reference)
+    ArkodeDirk,  //!< SUNDIALS ARKODE ARKStep, implicit DIRK table, Newton with the analytic Jacobian (reference)
   };
   enum class Restart {
     OnInputChange,  //!< CVodeReInit when the held command changes (ZOH jump): safest
     Never,          //!< keep the BDF history across samples (the sample end is a stop time, never straddled)
   };
-  Method method = Method::CvodeBdf;
+  Method method = Method::Dopri5;
   Restart restart = Restart::OnInputChange;
-  double rtol = 1e-6;                 //!< CVODE relative tolerance [-]
-  //! CVODE absolute tolerance = rtol * atol_scale[i]: [m, m/s, Pa, -, 1/s, m]
-  std::array<double, kNumStates> atol_scale{1e-3, 1e-2, 1e5, 1e-2, 1.0, 1e-6};
+  //! Relative tolerance of every error-controlled method [-].  1e-8 keeps the default's error within
+  //! 1e-3 of the peak displacement and force on random rigs (benchmarks/accuracy_random_rigs.py): at
+  //! 1e-6 a fifth of them were off by up to 3e-3, at 1e-7 one in 200 by 2e-3 (stick-slip with a
+  //! large Coulomb force, where the sticking times amplify the local errors).
+  double rtol = 1e-8;
+  //! Absolute tolerance of state i = rtol * atol_fraction * state_scale(dynamics, i): the scales follow
+  //! the rig (stroke, no-load speed, pressure that makes the rig's force, ...; see state_scale).
+  double atol_fraction = 1e-2;
   int max_order = 5;                  //!< BDF maximum order
-  long max_steps_per_sample = 2000;   //!< cap on CVODE internal steps in one step(); then TooMuchWork
-  double max_internal_step = 0.0;     //!< CVODE hmax [s], 0 = no limit
-  //! Rk4: substeps per controller sample; 0 = automatic (rk4_automatic_substeps in
-  //! plant.hpp): the fewest with h * rho(J) <= rk4_h_rho, rho the spectral radius
-  //! of the Jacobian at the equilibrium (where friction is steepest), chosen at
-  //! construction; with LuGre friction also h sigma_0 v_ref / F_c <= rk4_h_rho.
+  long max_steps_per_sample = 2000;   //!< cap on internal steps in one step() (CVODE, ARKODE, Dopri5); then TooMuchWork
+  double max_internal_step = 0.0;     //!< CVODE/ARKODE hmax [s], 0 = no limit
+  //! Dopri5: a sample that needs more than this many steps (accepted + rejected) is stiff for the
+  //! explicit pair: redone by CVODE if stiff_fallback, else Status::Stiff.
+  int stiff_steps = 24;
+  bool stiff_fallback = true;         //!< Dopri5: redo a stiff sample with CVODE (Status::stiff set)
+  //! Rk4: substeps per sample; 0 = automatic (rk4_automatic_substeps in plant.hpp): the fewest with
+  //! h * rho(J) <= rk4_h_rho, rho the largest spectral radius of the Jacobian over the operating
+  //! states the loop can reach (rest, pressure up to 0.9 p_s, spool at its stops, sliding), chosen at
+  //! construction; with LuGre friction also h sigma_0 v_ref / F_c <= rk4_h_rho.  At most kMaxSubsteps.
   int rk4_substeps = 0;
   double rk4_h_rho = 1.0;             //!< Rk4 automatic substeps: bound on h * rho(J) (stability limit ~2.8)
   //! Rk4 automatic substeps with LuGre: the sliding speed v_ref [m/s] that bounds the
   //! bristle rate; 0 = the no-load actuator speed K_v g(x_v_max) / A (1 m/s in free mode).
   double rk4_v_ref = 0.0;
+  //! Rk4: a sample whose embedded error estimate (3rd-order companion of the classical stages, one
+  //! extra RHS evaluation per sample), summed over its substeps in the weighted RMS norm of
+  //! (rk4_flag_rtol, atol), exceeds 1 is flagged (Status::inaccurate).  The estimate is the
+  //! 3rd-order error, far above RK4's own on smooth runs: 5e-5 flags no sample of the preset on
+  //! the benchmark record (3e-5 flags 4 %, 1e-5 half of them) and every random rig beyond 1e-2
+  //! (benchmarks/accuracy_random_rigs.py; 1e-4 missed 2 of 1,200, at 1.1e-2).
+  double rk4_flag_rtol = 5e-5;
+  //! Rk4: a flagged sample is redone with twice the substeps, up to this many times (0 = flag only:
+  //! fixed cost); it stays flagged.  Bounded by kMaxSubsteps substeps per sample.
+  int rk4_max_refinements = 0;
+
+  static constexpr int kMaxSubsteps = 100000;  //!< cap on RK4 substeps per sample (work per call)
 
   //! Throws Error naming the first invalid field.
   void validate() const;
 };
+
+//! The magnitude of state i of this rig, the unit of its absolute tolerance: x: the half-stroke;
+//! v: the no-load actuator speed K_v g(x_v_max) / A (free mode: stroke sqrt(k / m)); p: the pressure
+//! that makes the rig's force scale, min(p_s, k stroke / A) (p_s if k = 0); x_v: x_v_max; x_v_dot:
+//! 2 pi f_v x_v_max; z: F_c / sigma_0 (the presliding deflection).  States past the six of the
+//! servo-hydraulic plant: 1 (the documented default scale of an added state).
+double state_scale(const Dynamics& dynamics, int i) noexcept;
+
+//! atol[i] = options.rtol * options.atol_fraction * state_scale(dynamics, i) for i < num_states():
+//! the one home of the absolute tolerances of every error-controlled integrator.
+void absolute_tolerances(const Dynamics& dynamics, const SolverOptions& options, double* atol) noexcept;
 
 }  // namespace servohydraulics

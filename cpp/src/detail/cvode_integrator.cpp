@@ -11,10 +11,6 @@ namespace servohydraulics::detail {
 
 namespace {
 constexpr const char* kSetup = "CVODE setup";
-// Every setup call through the one checked helper (sundials_check.hpp), named by its function.
-#define SH_FLAG(fn, ...) check_flag(kSetup, #fn, [&] { return fn(__VA_ARGS__); })
-#define SH_PTR(fn, ...) check_ptr(kSetup, #fn, [&] { return fn(__VA_ARGS__); })
-
 // CVODE prints its errors by default; the hot path must stay silent.  The
 // status carries the flag instead.
 void silent_error_handler(int, const char*, const char*, char*, void*) {}
@@ -28,12 +24,11 @@ std::string flag_name(int flag) {
 }  // namespace
 
 CvodeIntegrator::CvodeIntegrator(const Dynamics& dyn, double dt, const SolverOptions& opt, const State& y_prime)
-    : restart_(opt.restart), dyn_(&dyn), n_(dyn.num_states()) {
+    : n_(dyn.num_states()), restart_(opt.restart), dyn_(&dyn) {
   // The vectors and the matrix have the active length (the base states and the switched-on elements').
   y_.reset(SH_PTR(N_VNew_Serial, n_, ctx_));
   atol_.reset(SH_PTR(N_VNew_Serial, n_, ctx_));
-  for (int i = 0; i < n_; ++i)
-    NV_Ith_S(atol_.get(), i) = opt.rtol * (i < kNumStates ? opt.atol_scale[i] : dyn.state_scale(i));
+  absolute_tolerances(dyn, opt, N_VGetArrayPointer(atol_.get()));
   for (int i = 0; i < n_; ++i) NV_Ith_S(y_.get(), i) = 0.0;
   mem_.reset(SH_PTR(CVodeCreate, CV_BDF, ctx_));
   void* cv = mem_.get();
@@ -77,8 +72,6 @@ void CvodeIntegrator::prime(const State& y_prime, double dt) {
     throw Error(s.str());
   }
 }
-#undef SH_FLAG
-#undef SH_PTR
 
 int CvodeIntegrator::rhs(sunrealtype, N_Vector yv, N_Vector ydot, void* user) {
   auto* self = static_cast<CvodeIntegrator*>(user);

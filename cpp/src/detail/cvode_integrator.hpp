@@ -59,6 +59,7 @@ class CvodeIntegrator {
   void prime(const State& y_prime, double dt);
   void accumulate_counters() noexcept;
 
+  int n_;  // active states (Dynamics::num_states): the vectors' and the matrix' length
   // Declared in creation order: destroyed in reverse, the context last.
   sundials::Context ctx_;
   std::unique_ptr<std::remove_pointer_t<N_Vector>, NVectorDeleter> y_;
@@ -70,7 +71,6 @@ class CvodeIntegrator {
   SolverOptions::Restart restart_;
   const Dynamics* dyn_;     // what the callbacks evaluate (set before every CVode call)
   Dynamics::Input in_{};    // the held input of the current sample
-  int n_;                   // active states (Dynamics::num_states)
   bool need_reinit_ = true;
   long steps_done_ = 0, rhs_done_ = 0, restarts_ = 0;  // totals of past CVODE runs (ReInit resets its counters)
 };

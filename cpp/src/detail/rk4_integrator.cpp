@@ -9,19 +9,43 @@
 
 namespace servohydraulics {
 
-// Fewest RK4 substeps that keep h * rho(J) within the bound at the equilibrium,
-// where the regularised friction is steepest (the slope of tanh peaks at v = 0).
+namespace {
+double spectral_radius(const Dynamics& dyn, const State& y) {
+  Jacobian J;
+  dyn.jacobian(y.data(), {}, J);
+  const int n = dyn.num_states();
+  // Sized at run time within a fixed maximum: no heap allocation.
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxStates, kMaxStates> A(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) A(i, j) = J[i][j];
+  const double rho = A.eigenvalues().cwiseAbs().maxCoeff();
+  return std::isfinite(rho) ? rho : 0.0;
+}
+
+// The largest spectral radius over the operating states the loop reaches: the equilibrium at x = 0
+// (where the regularised friction is steepest: the slope of tanh peaks at v = 0), and with the load
+// pressure at 0, +-0.5 p_s and +-0.9 p_s combined with the spool shut, half open and at its stops
+// (the square-root term of Eq 3 and the flow gain change the pressure and loop rates there).
+double loop_spectral_radius(const Dynamics& dyn) {
+  const State y0 = dyn.equilibrium(0.0);
+  double rho = spectral_radius(dyn, y0);
+  if (dyn.mode() == ControlMode::Free) return rho;
+  const Rig& r = dyn.rig();
+  for (double pf : {-0.9, -0.5, 0.0, 0.5, 0.9})
+    for (double sf : {-1.0, -0.5, 0.0, 0.5, 1.0}) {
+      State y = y0;
+      y[kP] = pf * r.p_s;
+      if (r.effects.servovalve_dynamics) y[kXv] = sf * r.x_v_max;
+      rho = std::max(rho, spectral_radius(dyn, y));
+    }
+  return rho;
+}
+}  // namespace
+
 int rk4_automatic_substeps(const Dynamics& dyn, double dt, const SolverOptions& opt) {
   require(std::isfinite(dt) && dt > 0.0, "dt", dt, "controller sample time must be finite and > 0 [s]");
   opt.validate();
-  const State y0 = dyn.equilibrium(0.0);
-  Jacobian J;
-  dyn.jacobian(y0.data(), {}, J);
-  const int ns = dyn.num_states();
-  Eigen::MatrixXd A(ns, ns);
-  for (int i = 0; i < ns; ++i)
-    for (int j = 0; j < ns; ++j) A(i, j) = J[i][j];
-  double rho = A.eigenvalues().cwiseAbs().maxCoeff();
+  double rho = loop_spectral_radius(dyn);
   // LuGre: the bristle rate sigma_0 |v| / g(v) is 0 at rest and grows with the sliding speed.  Bound
   // |v| by v_ref: given, or the no-load actuator speed K_v g(x_v_max) / A (1 m/s in free mode, no actuator).
   if (dyn.lugre()) {
@@ -40,38 +64,69 @@ int rk4_automatic_substeps(const Dynamics& dyn, double dt, const SolverOptions& 
     rho = std::max(rho, dyn.hysteretic_rate_bound(opt.rk4_v_ref > 0.0 ? opt.rk4_v_ref : v_no_load));
   }
   const double n = std::ceil(dt * rho / opt.rk4_h_rho);
-  require(std::isfinite(n) && n <= 100000.0, "rk4_substeps (automatic)", n,
-          "the plant is too stiff for a fixed-step integrator at this dt: use CVODE");
+  require(std::isfinite(n) && n <= SolverOptions::kMaxSubsteps, "rk4_substeps (automatic)", n,
+          "exceeds the cap of 100000 per sample: the plant is too stiff for a fixed-step integrator at this dt; "
+          "use the default (dopri5) or CVODE");
   return std::max(1, static_cast<int>(n));
 }
 
 namespace detail {
 
 Rk4Integrator::Rk4Integrator(const Dynamics& dyn, double dt, const SolverOptions& opt)
-    : substeps_(opt.rk4_substeps > 0 ? opt.rk4_substeps : rk4_automatic_substeps(dyn, dt, opt)) {}
+    : n_(dyn.num_states()),
+      substeps_(opt.rk4_substeps > 0 ? opt.rk4_substeps : rk4_automatic_substeps(dyn, dt, opt)),
+      max_refinements_(opt.rk4_max_refinements),
+      rtol_(opt.rk4_flag_rtol) {
+  SolverOptions flag = opt;
+  flag.rtol = opt.rk4_flag_rtol;
+  absolute_tolerances(dyn, flag, atol_);
+}
+
+double Rk4Integrator::sweep(const Dynamics& dyn, const Dynamics::Input& in, State& y, int n, double h) const
+    noexcept {
+  State k1, k2, k3, k4, tmp, err{};
+  const State y0 = y;
+  const int m = n_;
+  dyn.rhs(y.data(), in, k1.data());
+  for (int s = 0; s < n; ++s) {
+    for (int i = 0; i < m; ++i) tmp[i] = y[i] + 0.5 * h * k1[i];
+    dyn.rhs(tmp.data(), in, k2.data());
+    for (int i = 0; i < m; ++i) tmp[i] = y[i] + 0.5 * h * k2[i];
+    dyn.rhs(tmp.data(), in, k3.data());
+    for (int i = 0; i < m; ++i) tmp[i] = y[i] + h * k3[i];
+    dyn.rhs(tmp.data(), in, k4.data());
+    for (int i = 0; i < m; ++i) y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+    dyn.rhs(y.data(), in, k1.data());  // k5 of this substep, k1 of the next
+    for (int i = 0; i < m; ++i) err[i] += std::fabs(h / 6.0 * (k4[i] - k1[i]));
+  }
+  double sum = 0.0;
+  for (int i = 0; i < m; ++i) {
+    const double q = err[i] / (atol_[i] + rtol_ * std::max(std::fabs(y0[i]), std::fabs(y[i])));
+    sum += q * q;
+  }
+  return std::sqrt(sum / m);  // NaN if the state blew up: flagged, and the plant's guard fails the sample
+}
 
 Status Rk4Integrator::advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t,
                               double t_next, int substeps) noexcept {
   Status st;
-  const int n = substeps > 0 ? substeps : substeps_;
-  const int ns = dyn.num_states();
-  const double h = (t_next - t) / n;
-  double k1[kMaxStates], k2[kMaxStates], k3[kMaxStates], k4[kMaxStates], tmp[kMaxStates] = {};
-  for (int s = 0; s < n; ++s) {
-    dyn.rhs(y.data(), in, k1);
-    for (int i = 0; i < ns; ++i) tmp[i] = y[i] + 0.5 * h * k1[i];
-    dyn.rhs(tmp, in, k2);
-    for (int i = 0; i < ns; ++i) tmp[i] = y[i] + 0.5 * h * k2[i];
-    dyn.rhs(tmp, in, k3);
-    for (int i = 0; i < ns; ++i) tmp[i] = y[i] + h * k3[i];
-    dyn.rhs(tmp, in, k4);
-    for (int i = 0; i < ns; ++i) y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+  const State y0 = y;
+  int n = substeps > 0 ? substeps : substeps_;
+  for (int r = 0;; ++r) {
+    st.error_estimate = sweep(dyn, in, y, n, (t_next - t) / n);
+    st.internal_steps += n;
+    st.rhs_evals += 4 * n + 1;
+    // Flagged if the configured substeps missed the tolerance, refined or not: the local estimate
+    // does not bound the error carried into later samples, so a refined sample still says so.
+    if (r == 0) st.inaccurate = !(st.error_estimate <= 1.0);
+    if (st.error_estimate <= 1.0 || r >= max_refinements_ || 2L * n > SolverOptions::kMaxSubsteps) break;
+    y = y0;
+    n *= 2;
   }
+  if (st.inaccurate) ++flagged_;
   t = t_next;
-  st.internal_steps = n;
-  st.rhs_evals = 4 * n;
-  steps_done_ += n;
-  rhs_done_ += 4 * n;
+  steps_done_ += st.internal_steps;
+  rhs_done_ += st.rhs_evals;
   st.t = t;
   return st;
 }

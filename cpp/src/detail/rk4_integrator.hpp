@@ -1,6 +1,6 @@
 // Internal: the plant's fixed-step classical Runge-Kutta integrator (the
 // real-time option), with its automatic substep rule (rk4_automatic_substeps,
-// declared in plant.hpp).
+// declared in plant.hpp) and an embedded error estimate that flags a sample.
 #pragma once
 
 #include "servohydraulics/dynamics.hpp"
@@ -14,9 +14,15 @@ class Rk4Integrator {
   //! options.rk4_substeps per sample of dt [s], or the automatic rule if 0 (may throw Error).
   Rk4Integrator(const Dynamics& dyn, double dt, const SolverOptions& options);
 
-  void reset(const State&, double) noexcept { steps_done_ = rhs_done_ = 0; }
-  //! RK4 from t to t_next with the input held, in `substeps` equal substeps (0: the configured
-  //! count; the plant passes a share of it for each part of a sample split by a command delay).
+  void reset(const State&, double) noexcept { steps_done_ = rhs_done_ = flagged_ = 0; }
+  //! The classical RK4 over substeps() equal substeps, and the estimate of its error: the classical
+  //! stages with k5 = f(y_next) (the next substep's k1; one extra evaluation per sample) give the
+  //! 3rd-order companion b^ = (1/6, 1/3, 1/3, 0, 1/6), so e = h (k4 - k5) / 6 per substep, summed in
+  //! absolute value over the sample and measured in the weighted RMS norm of (rk4_flag_rtol, atol).
+  //! Above 1: Status::inaccurate, and the sample is redone with twice the substeps up to
+  //! rk4_max_refinements times (the flag stays: a local estimate does not bound the error carried on).
+  //! `substeps` > 0 replaces the configured count (the plant passes a share of it for each part of a
+  //! sample split by a command delay).
   Status advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t, double t_next,
                  int substeps = 0) noexcept;
 
@@ -24,10 +30,18 @@ class Rk4Integrator {
   long total_steps() const noexcept { return steps_done_; }
   long total_rhs_evals() const noexcept { return rhs_done_; }
   long total_restarts() const noexcept { return 0; }
+  long total_flagged() const noexcept { return flagged_; }
 
  private:
+  //! n substeps of size h from y (updated); returns the weighted norm of the error estimate.
+  double sweep(const Dynamics& dyn, const Dynamics::Input& in, State& y, int n, double h) const noexcept;
+
+  int n_;
   int substeps_;
-  long steps_done_ = 0, rhs_done_ = 0;
+  int max_refinements_;
+  double rtol_;
+  double atol_[kMaxStates];
+  long steps_done_ = 0, rhs_done_ = 0, flagged_ = 0;
 };
 
 }  // namespace servohydraulics::detail

@@ -52,3 +52,8 @@ auto check_ptr(const char* what, const char* call, Call&& make) {
 }
 
 }  // namespace servohydraulics::detail
+
+// Every setup call through the checked helpers above, named by its function;
+// the calling file defines `kSetup` (what is being set up, e.g. "CVODE setup").
+#define SH_FLAG(fn, ...) ::servohydraulics::detail::check_flag(kSetup, #fn, [&] { return fn(__VA_ARGS__); })
+#define SH_PTR(fn, ...) ::servohydraulics::detail::check_ptr(kSetup, #fn, [&] { return fn(__VA_ARGS__); })

@@ -16,7 +16,7 @@ from scipy.signal import savgol_filter
 
 from .. import _core
 from ..identify import ar1_coefficient, ar1_effective_n
-from ..rig import Error, Rig
+from ..rig import Rig
 from ..simulate import MODES, SimulationError, simulate, solver_options
 from .effects import INTERACT_SPAN, Candidate, Context, split_delay
 from .types import Case, FitResult, Screening, Sim
@@ -31,8 +31,6 @@ SIM_CHANNELS = tuple(c for c, _ in _core.PLANT_CHANNELS if c not in NOT_COMPARED
 #: channels compared per mode (those present in the record are used)
 CHANNELS = {mode: tuple(c for c in SIM_CHANNELS if not (mode == "free" and c in ACTUATOR_CHANNELS))
             for mode in MODES}
-#: RK4 substeps per sample beyond which a diagnosis simulation uses CVODE instead
-MAX_RK4_SUBSTEPS = 64
 N_SEGMENTS = 6  #: held-out split: contiguous segments, even ones train, odd ones test
 
 
@@ -121,20 +119,6 @@ def refine_x0(rig: Rig, cases: list[Case], tau: float) -> tuple[float, ...]:
 
 # --- simulation ---------------------------------------------------------------------
 
-def rk4_options(rig: Rig, case: Case):
-    """The solver options of a diagnosis simulation: the core's automatic RK4
-    rule (``rk4_substeps = 0``: h times the spectral radius of the Jacobian at
-    rest <= ``rk4_h_rho``; with LuGre friction also h sigma_0 v_ref / F_c, the
-    bristle rate, with v_ref the record's peak velocity), or None (CVODE) if
-    that rule asks for more than ``MAX_RK4_SUBSTEPS`` substeps per sample."""
-    opts = solver_options(method="rk4", rk4_substeps=0, rk4_v_ref=case.v_peak)
-    try:
-        n = _core.rk4_automatic_substeps(_core.Dynamics(rig, MODES[case.mode]), case.dt, opts)
-    except Error:  # too stiff for any fixed step
-        return None
-    return opts if n <= MAX_RK4_SUBSTEPS else None
-
-
 def delayed(u: np.ndarray, dt: float, tau: float) -> np.ndarray:
     """The command delayed by tau [s]: integer + fractional samples by linear
     interpolation, holding the first value before the record starts."""
@@ -147,10 +131,10 @@ def delayed(u: np.ndarray, dt: float, tau: float) -> np.ndarray:
 def simulate_case(rig: Rig, case: Case, tau: float, x0: float) -> Sim:
     """The model's channels for the record's command delayed by ``tau`` [s]
     from the initial displacement ``x0`` [m] (None if the run fails).
-    Fixed-step RK4 (``rk4_options``) for speed; CVODE if RK4 fails."""
+    The default error-controlled pair (dopri5, CVODE for its stiff samples); CVODE alone if
+    that run fails."""
     u = delayed(case.u, case.dt, tau)
-    first = rk4_options(rig, case)
-    for opts in ((first, None) if first is not None else (None,)):
+    for opts in (solver_options(), solver_options(method="cvode")):
         try:
             r = simulate(rig, case.mode, u, case.dt, x0=float(x0), options=opts)
         except (SimulationError, ValueError):

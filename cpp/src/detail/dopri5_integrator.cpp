@@ -1,0 +1,156 @@
+#include "detail/dopri5_integrator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace servohydraulics::detail {
+
+namespace {
+// Dormand & Prince (1980), "A family of embedded Runge-Kutta formulae", J. Comput. Appl. Math. 6:19-26,
+// Table 2 (RK5(4)7M): the nodes, the stage weights, the 5th-order weights (row 7, FSAL) and e = b - b^.
+constexpr double a21 = 1.0 / 5.0;
+constexpr double a31 = 3.0 / 40.0, a32 = 9.0 / 40.0;
+constexpr double a41 = 44.0 / 45.0, a42 = -56.0 / 15.0, a43 = 32.0 / 9.0;
+constexpr double a51 = 19372.0 / 6561.0, a52 = -25360.0 / 2187.0, a53 = 64448.0 / 6561.0, a54 = -212.0 / 729.0;
+constexpr double a61 = 9017.0 / 3168.0, a62 = -355.0 / 33.0, a63 = 46732.0 / 5247.0, a64 = 49.0 / 176.0,
+                 a65 = -5103.0 / 18656.0;
+constexpr double b1 = 35.0 / 384.0, b3 = 500.0 / 1113.0, b4 = 125.0 / 192.0, b5 = -2187.0 / 6784.0,
+                 b6 = 11.0 / 84.0;
+constexpr double e1 = 71.0 / 57600.0, e3 = -71.0 / 16695.0, e4 = 71.0 / 1920.0, e5 = -17253.0 / 339200.0,
+                 e6 = 22.0 / 525.0, e7 = -1.0 / 40.0;
+// Step-size controller: h_new = h * clamp(kSafety err^(-1/5), kShrink, kGrow).
+constexpr double kSafety = 0.9, kShrink = 0.2, kGrow = 5.0;
+}  // namespace
+
+Dopri5Integrator::Dopri5Integrator(const Dynamics& dyn, double dt, const SolverOptions& opt, const State& y_prime)
+    : n_(dyn.num_states()),
+      rtol_(opt.rtol),
+      max_steps_(opt.max_steps_per_sample),
+      stiff_steps_(opt.stiff_steps),
+      dt_(dt),
+      h_(dt) {
+  absolute_tolerances(dyn, opt, atol_);
+  if (opt.stiff_fallback) implicit_ = std::make_unique<CvodeIntegrator>(dyn, dt, opt, y_prime);
+}
+
+void Dopri5Integrator::reset(const State& y, double t) noexcept {
+  steps_done_ = rhs_done_ = restarts_ = stiff_samples_ = 0;
+  fsal_ = false;
+  h_ = dt_;
+  hold_ = 0;
+  if (implicit_) implicit_->reset(y, t);
+}
+
+double Dopri5Integrator::trial_step(const Dynamics& dyn, const Dynamics::Input& in, const State& y, double h,
+                                    State& y5) noexcept {
+  State& k1 = k_[0];
+  State tmp{};
+  const int n = n_;
+  for (int i = 0; i < n; ++i) tmp[i] = y[i] + h * a21 * k1[i];
+  dyn.rhs(tmp.data(), in, k_[1].data());
+  for (int i = 0; i < n; ++i) tmp[i] = y[i] + h * (a31 * k1[i] + a32 * k_[1][i]);
+  dyn.rhs(tmp.data(), in, k_[2].data());
+  for (int i = 0; i < n; ++i) tmp[i] = y[i] + h * (a41 * k1[i] + a42 * k_[1][i] + a43 * k_[2][i]);
+  dyn.rhs(tmp.data(), in, k_[3].data());
+  for (int i = 0; i < n; ++i)
+    tmp[i] = y[i] + h * (a51 * k1[i] + a52 * k_[1][i] + a53 * k_[2][i] + a54 * k_[3][i]);
+  dyn.rhs(tmp.data(), in, k_[4].data());
+  for (int i = 0; i < n; ++i)
+    tmp[i] = y[i] + h * (a61 * k1[i] + a62 * k_[1][i] + a63 * k_[2][i] + a64 * k_[3][i] + a65 * k_[4][i]);
+  dyn.rhs(tmp.data(), in, k_[5].data());
+  for (int i = 0; i < n; ++i)
+    y5[i] = y[i] + h * (b1 * k1[i] + b3 * k_[2][i] + b4 * k_[3][i] + b5 * k_[4][i] + b6 * k_[5][i]);
+  dyn.rhs(y5.data(), in, k_[6].data());
+  double sum = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double e = h * (e1 * k1[i] + e3 * k_[2][i] + e4 * k_[3][i] + e5 * k_[4][i] + e6 * k_[5][i] +
+                          e7 * k_[6][i]);
+    const double sc = atol_[i] + rtol_ * std::max(std::fabs(y[i]), std::fabs(y5[i]));
+    sum += (e / sc) * (e / sc);
+  }
+  return std::sqrt(sum / n);  // NaN if a stage was not finite: rejected by the caller
+}
+
+Dopri5Integrator::Outcome Dopri5Integrator::explicit_sample(const Dynamics& dyn, const Dynamics::Input& in,
+                                                            State& y, double& t, double t_next,
+                                                            Status& st) noexcept {
+  if (!fsal_ || in.u != fsal_in_.u || in.u_rate != fsal_in_.u_rate) {
+    dyn.rhs(y.data(), in, k_[0].data());
+    ++st.rhs_evals;
+  }
+  fsal_ = false;
+  int attempts = 0;
+  bool rejected = false;
+  State y5 = y;  // the entries past n_ (unused states) stay as they are
+  while (t < t_next) {
+    const double remaining = t_next - t;
+    // Equal steps to the sample end: no sliver of a last step.
+    const double n_left = std::ceil(remaining / std::min(h_, remaining) * (1.0 - 1e-12));
+    const double h = remaining / std::max(1.0, n_left);
+    if (++attempts > stiff_steps_ || h < 1e-12 * dt_) return Outcome::Stiff;
+    if (attempts > max_steps_) return Outcome::TooMuchWork;
+    const double err = trial_step(dyn, in, y, h, y5);
+    st.rhs_evals += 6;
+    if (!(err <= 1.0)) {  // rejected (or NaN: a stage blew up)
+      h_ = h * (std::isfinite(err) ? std::max(kShrink, kSafety * std::pow(err, -0.2)) : kShrink);
+      rejected = true;
+      continue;
+    }
+    const double fac = err > 0.0 ? std::min(kGrow, std::max(kShrink, kSafety * std::pow(err, -0.2))) : kGrow;
+    h_ = std::min(dt_, h * (rejected ? std::min(1.0, fac) : fac));
+    rejected = false;
+    y = y5;
+    k_[0] = k_[6];
+    t = n_left <= 1.0 ? t_next : t + h;
+    ++st.internal_steps;
+  }
+  fsal_ = true;
+  fsal_in_ = in;
+  return Outcome::Done;
+}
+
+Status Dopri5Integrator::implicit_sample(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t,
+                                         double t_next) noexcept {
+  implicit_->reset(y, t);
+  Status st = implicit_->advance(dyn, in, y, t, t_next);
+  ++restarts_;
+  fsal_ = false;
+  h_ = dt_;
+  st.stiff = true;
+  ++stiff_samples_;
+  return st;
+}
+
+Status Dopri5Integrator::advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t,
+                                 double t_next) noexcept {
+  Status st;
+  if (hold_ > 0 && implicit_) {
+    --hold_;
+    st = implicit_sample(dyn, in, y, t, t_next);
+  } else {
+    const State y0 = y;
+    const double t0 = t;
+    const Outcome out = explicit_sample(dyn, in, y, t, t_next, st);
+    if (out != Outcome::Done) {
+      y = y0;
+      t = t0;
+      if (out == Outcome::Stiff && implicit_) {
+        const Status tried = st;
+        st = implicit_sample(dyn, in, y, t, t_next);
+        st.internal_steps += tried.internal_steps;  // the explicit attempt's work counts too
+        st.rhs_evals += tried.rhs_evals;
+        hold_ = kImplicitHold;
+      } else {
+        st.code = out == Outcome::Stiff ? Status::Stiff : Status::TooMuchWork;
+        fsal_ = false;
+        h_ = dt_;
+      }
+    }
+  }
+  steps_done_ += st.internal_steps;
+  rhs_done_ += st.rhs_evals;
+  st.t = t;
+  return st;
+}
+
+}  // namespace servohydraulics::detail
