@@ -161,6 +161,8 @@ def _apply_viscous(rig: Rig, th: np.ndarray) -> Rig:
 
 
 def _apply_softening(rig: Rig, th: np.ndarray) -> Rig:
+    if not rig.effects.spring_softening and th[0] == rig.k:
+        return copy.copy(rig)  # "absent" (k_2 = k): the same model with the switch left off, not an equal one
     return _with(rig, "spring_softening", k_2=th[0])
 
 
