@@ -266,8 +266,8 @@ def _bouc_wen_probe_x(ctx: Context) -> float:
 #: smallest yield displacement of the Bouc-Wen candidate [m]: 1 mm.  What separates a hysteretic specimen from
 #: friction is how far it travels before it yields: seal friction's presliding (LuGre's F_c / sigma_0) is microns to
 #: a fraction of a millimetre, a specimen's yield displacement millimetres.  Below 1 mm the two laws trace the same
-#: loops within the noise of mm-scale records (a 0.5 mm LuGre presliding and a 0.4 mm Bouc-Wen yield fit the same
-#: record within 4 in -2 log L), so the library names that range lugre_friction (or coulomb_friction, its limit)
+#: loops within the noise of mm-scale records (with the yield allowed below 1 mm, a 0.5 mm LuGre presliding record
+#: was "ambiguous" between the two), so the library names that range lugre_friction (or coulomb_friction, its limit)
 BOUC_WEN_MIN_YIELD = 1e-3
 
 
