@@ -72,7 +72,8 @@ def metrics(results: list[dict], key: list[dict]) -> dict:
     names = sorted({a["name"] for k in key for a in k["answers"]})
     for label, sel in (("snr>=30", lambda k: k["snr"] >= 30), ("snr=40", lambda k: k["snr"] == 40),
                        ("snr=30", lambda k: k["snr"] == 30), ("snr=20", lambda k: k["snr"] == 20),
-                       ("all", lambda k: True)):
+                       ("all", lambda k: True), ("issue13", lambda k: k.get("set") == "issue13"),
+                       ("issue13 snr>=30", lambda k: k.get("set") == "issue13" and k["snr"] >= 30)):
         rs = [(r, k) for r, k in rows if sel(k) and not k["runtime_check"]]
         singles = [(r, k) for r, k in rs if k["kind"] == "single"]
         nones = [(r, k) for r, k in rs if k["kind"] == "none"]
@@ -172,6 +173,29 @@ def _p(v) -> str:
     return "-" if v is None else f"{100 * v:.0f} %"
 
 
+def _issue13_section(m: dict, per: list[dict], ans: dict) -> list[str]:
+    """The cases added for issue 13 (in-loop and command delays, load pressure + 400 N Coulomb, Bouc-Wen
+    specimens, other rigs in displacement and force control): their own recall, false positives, gap closed."""
+    L = ["", "## The cases added for issue 13", "",
+         "In-loop (true transport) and command delays, load pressure with 400 N of Coulomb friction, Bouc-Wen "
+         "specimens, and two rigs other than the paper's (rigB: 2.5 t, 250 kN/m, 50 cm^2, 40 Hz valve; rigC: "
+         "80 kg, 20 kN/m, 10 cm^2, 120 Hz valve) in displacement and force control "
+         "(`plan_new` in benchmarks/diagnose_eval/generate.py).", "",
+         "| subset | single: right first | right anywhere | false positives | param within 20 % | gap closed "
+         "(median) | pairs: both named |", "|---|---|---|---|---|---|---|"]
+    for lab in ("issue13 snr>=30", "issue13"):
+        s = m[lab]
+        L.append(f"| {lab.replace('issue13', 'issue-13 cases').replace('cases snr', 'cases, SNR')} "
+                 f"({s['n_single']} single, {s['n_none']} none, {s['n_pair']} pairs) | {_p(s['single_right_first'])} | "
+                 f"{_p(s['single_right_any'])} | {_p(s['false_positive_rate'])} | {_p(s['param_within_20pct'])} | "
+                 f"{_p(s['gap_closed_median'])} | {_p(s['pair_both_named'])} |")
+    L += ["", "| name | recall | precision | records with it | times named |", "|---|---|---|---|---|"]
+    for n, v in m["issue13"]["per_name"].items():
+        if v["n_truth"] or v["n_named"]:
+            L.append(f"| {n} | {_p(v['recall'])} | {_p(v['precision'])} | {v['n_truth']} | {v['n_named']} |")
+    return L
+
+
 def write_doc(m: dict, per: list[dict], key: list[dict], doc: Path, cmd: str, wall: float, jobs: int) -> None:
     ans = {k["id"]: k for k in key}
     L = ["# Diagnose: evaluation on hidden effects", "",
@@ -246,6 +270,8 @@ def write_doc(m: dict, per: list[dict], key: list[dict], doc: Path, cmd: str, wa
           "entry), except the table bending from 2 % opening, whose 15 kN sweep opens the spool to about 0.07 "
           "only: its truth is g_peak = g(x_peak) at the record's peak opening (g(1) is outside the record; "
           "shown as the second truth); filter delay -> the Bessel filter's DC group delay."]
+    if m["issue13"]["n_single"] + m["issue13"]["n_none"] + m["issue13"]["n_pair"]:
+        L += _issue13_section(m, per, ans)
     L += ["", "## By noise level", "",
           "| SNR | single: right first | right anywhere | ambiguous | false positives | param within 20 % | "
           "coverage | gap closed (median) | pairs: both named | pairs: one named |",
@@ -284,7 +310,8 @@ def write_doc(m: dict, per: list[dict], key: list[dict], doc: Path, cmd: str, wa
                     v = _fitted(r["parameters"][i], pk, a)["value"]
                     what = a.get("alt_label", "second truth")
                     par[-1] += f" [{what}: {pk} {v:.4g} ({tv:.4g})]" if v is not None else f" [{what} {tv:.4g}]"
-        L.append(f"| {r['id']} | {k['mode']} | {k['snr']} | {'; '.join(k['forms']) or 'none'} | {r['verdict']} | "
+        L.append(f"| {r['id']} | {k.get('rig', 'paper')} {k['mode']} | {k['snr']} | "
+                 f"{'; '.join(k['forms']) or 'none'} | {r['verdict']} | "
                  f"{', '.join(r['named']) or ('/'.join(r['ambiguous']) if r['ambiguous'] else '-')} | "
                  f"{'; '.join(par) or '-'} | {_p(r['gap_closed_main'])} |")
     doc.write_text("\n".join(L) + "\n")
@@ -317,7 +344,10 @@ def main() -> None:
     wall = time.time() - t0
     key = json.loads((data / "answer_key.json").read_text())  # read only now, after every diagnosis
     m = metrics(results, key)
-    cmd = (f"python benchmarks/diagnose_eval/generate.py --out {a.data} --jobs {a.jobs}\n"
+    gen = data / "generate.json"
+    gen_cmd = (json.loads(gen.read_text())["command"] if gen.exists()
+               else f"python benchmarks/diagnose_eval/generate.py --out {a.data}")
+    cmd = (f"{gen_cmd} --jobs {a.jobs}\n"
            f"python benchmarks/diagnose_eval/evaluate.py --data {a.data} --jobs {a.jobs}")
     write_doc(m, results, key, doc, cmd, wall, a.jobs)
     doc.with_suffix(".json").write_text(json.dumps({"metrics": m, "records": results, "command": cmd,

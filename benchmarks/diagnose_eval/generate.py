@@ -1,6 +1,7 @@
 """Seeded generator of records with hidden effects for the diagnose evaluation.
 
-    python benchmarks/diagnose_eval/generate.py --out build/diagnose_eval [--size default|quick] [--seed 2003] [--jobs 2]
+    python benchmarks/diagnose_eval/generate.py --out build/diagnose_eval [--size default|quick] [--seed 2003]
+        [--jobs 2] [--cases all|new|old]
 
 Writes OUT/records/*.csv (time, command, displacement, force), OUT/nominal_*.toml
 (the models the diagnosis is told to believe), OUT/manifest.json (record, mode,
@@ -29,7 +30,21 @@ curves: the full-opening flow ratio g(1) = Q(x_v = 1) / K_v (rational curve:
 sweep that opens the spool to about 7 % only, so its truth is g at the record's
 peak opening (g(1), outside the record, kept as ``alt``); the preset-kind table
 is run with a large sweep (peak opening beyond 0.3) so that g(1) is within reach.
-Filter delay: the Bessel filter's DC group delay.
+Filter delay: the Bessel filter's DC group delay (named command_delay: a filter
+before the loop).  In-loop delay: a true transport delay of the valve drive
+(the library's loop_delay is a Pade approximant of it): its delay.  Bouc-Wen
+specimen (n = 1, beta = gamma, the library's form): its yield displacement
+x_y = A / (beta + gamma) and yield force F_y = bw_k x_y.
+
+Other rigs (``RIGS``): "paper" (Zhao et al. 2003, the default), "rigB" (another
+mass, stiffness, piston area, valve, oil column and loop gain) and "rigC" (a
+light, soft, fast rig: a damper frame).  The nominal rig the workflow is told to
+believe for each is written as OUT/nominal_<rig>_<mode>.toml (the paper's as
+OUT/nominal_<mode>.toml).
+
+``--cases new`` keeps only the cases added for issue 13 (in-loop and command
+delays, load pressure + 400 N Coulomb, Bouc-Wen specimens, the other rigs in
+displacement and force control, their no-effect records).
 """
 
 from __future__ import annotations
@@ -78,23 +93,45 @@ def command(mode: str, kind: str, duration: float, rng: np.random.Generator) -> 
     return ramp * (big * np.sin(2 * np.pi * f0 * t + ph[0]) + 3e3 * chirp), 0.0
 
 
-def base_truth(mode: str) -> ip.Truth:
-    return ip.Truth(c=1.1e3) if mode == "free" else ip.Truth()
+#: rigs other than the paper's: the Truth fields that differ (the same names as the rig keys), and the scale of
+#: their commands against the paper rig's (displacement, force)
+RIGS = {
+    "paper": ({}, 1.0, 1.0),
+    # a lighter, softer structure on a smaller piston, a slower under-damped valve and a higher loop gain
+    "rigB": ({"m": 2500.0, "c": 800.0, "k": 250e3, "k_2": 125e3, "m_p": 30.0, "A": 50e-4, "K_a": 0.8e-12,
+              "C_l": 2e-11, "K_v": 1.0e-2, "f_v": 40.0, "zeta_v": 0.7, "G_p": 1.5, "C_F_force": 0.03e-3},
+             0.8, 0.3),
+    # a light, soft, fast rig (a damper frame): 80 kg, 20 kN/m, 10 cm^2 piston, 120 Hz valve
+    "rigC": ({"m": 80.0, "c": 50.0, "k": 20e3, "k_2": 10e3, "m_p": 5.0, "A": 10e-4, "K_a": 0.2e-12, "C_l": 1e-11,
+              "K_v": 2.5e-3, "f_v": 120.0, "zeta_v": 0.8, "G_p": 1.2, "C_F_force": 0.6e-3}, 0.4, 0.01),
+}
 
 
-def nominal_rig(mode: str):
+def base_truth(mode: str, rig: str = "paper") -> ip.Truth:
+    tr = ip.Truth(c=1.1e3) if mode == "free" else ip.Truth()
+    return replace(tr, **RIGS[rig][0])
+
+
+def nominal_rig(mode: str, rig: str = "paper"):
     """The model the workflow is told to believe: the calibrated preset with the
-    nonlinear effects of the paper's linear analysis switched off."""
+    nonlinear effects of the paper's linear analysis switched off (for another
+    rig: its own values of the keys ``RIGS`` lists)."""
     import servohydraulics as sh
 
     if mode == "free":
-        rig = sh.zhao2003(actuator_attached=False)
-        rig.effects.coulomb_friction = False
-        return rig
-    rig = sh.zhao2003()
-    for e in ("coulomb_friction", "spring_softening", "load_pressure", "flow_nonlinearity"):
-        setattr(rig.effects, e, False)
-    return rig
+        r = sh.zhao2003(actuator_attached=False)
+        r.effects.coulomb_friction = False
+    else:
+        r = sh.zhao2003()
+        for e in ("coulomb_friction", "spring_softening", "load_pressure", "flow_nonlinearity"):
+            setattr(r.effects, e, False)
+    for key, v in RIGS[rig][0].items():
+        setattr(r, key, float(v))
+    return r
+
+
+def nominal_file(mode: str, rig: str = "paper") -> str:
+    return f"nominal_{mode}.toml" if rig == "paper" else f"nominal_{rig}_{mode}.toml"
 
 
 # effect key -> (Truth overrides at a strength value, answer name, answer parameter, modes)
@@ -126,10 +163,19 @@ def hidden(key: str, val: float, peak_spool: float) -> tuple[dict, str, dict, st
         return ({"flow": "table", "table_opening": KNEE_OPENING, "table_flow": KNEE_FLOW},
                 "flow_gain_nonlinearity", {"g_1": KNEE_FLOW[-1]}, "tabulated curve of the preset's kind (knee 10 %)")
     if key == "delay":
-        return {"delay": "pure", "tau": val}, "time_delay", {"tau": val}, "continuous-time delay of the ZOH command"
+        return ({"delay": "pure", "tau": val}, "command_delay", {"command_delay": val},
+                "continuous-time delay of the ZOH command")
     if key == "delay_filter":
-        return ({"delay": "filter", "tau": val}, "time_delay", {"tau": val},
+        return ({"delay": "filter", "tau": val}, "command_delay", {"command_delay": val},
                 "2nd-order Bessel filter of the command (tau: its DC group delay)")
+    if key == "loop_delay":
+        return ({"loop_delay": val}, "loop_delay", {"loop_delay": val},
+                "true transport delay of the valve drive inside the loop")
+    if key in ("bouc_wen", "bouc_wen_soft"):
+        x_y = 3e-3 if key == "bouc_wen" else 6e-3  # yield displacement [m]; val: the yield force F_y [N]
+        return ({"bouc_wen": True, "bw_k": val / x_y, "bw_A": 1.0, "bw_beta": 0.5 / x_y, "bw_gamma": 0.5 / x_y,
+                 "bw_n": 1.0}, "bouc_wen_hysteresis", {"x_y": x_y, "F_y": val},
+                f"Bouc-Wen specimen, yield {1e3 * x_y:g} mm")
     if key == "valve":
         return {"f_v": val}, "servovalve_dynamics", {"f_v": val}, "2nd-order valve"
     if key == "leakage":
@@ -141,7 +187,42 @@ def hidden(key: str, val: float, peak_spool: float) -> tuple[dict, str, dict, st
     raise ValueError(key)
 
 
-def plan(size: str) -> list[dict]:
+def plan_new(snrs) -> list[dict]:
+    """The cases added for issue 13: in-loop and command delays side by side, load pressure with 400 N of
+    Coulomb friction, Bouc-Wen specimens, and rigs other than the paper's in displacement and force control."""
+    singles = [
+        # (key, mode, strengths, rig)
+        ("loop_delay", "displacement", [0.004, 0.008], "paper"),
+        ("delay", "displacement", [0.004], "paper"),
+        ("bouc_wen", "displacement", [2000.0], "paper"),
+        ("bouc_wen_soft", "displacement", [3000.0], "paper"),
+        ("coulomb", "displacement", [300.0], "rigB"),
+        ("loop_delay", "displacement", [0.004], "rigB"),
+        ("viscous", "displacement", [2500.0], "rigB"),
+        ("coulomb", "force", [300.0], "rigB"),
+        # (a 25 or 30 Hz valve makes rigB's force loop unstable: a diverging record, nothing to diagnose)
+        ("valve", "displacement", [20.0], "rigB"),
+        ("viscous", "force", [2500.0], "rigB"),
+        ("coulomb", "displacement", [20.0], "rigC"),
+        ("bouc_wen", "displacement", [60.0], "rigC"),
+        ("coulomb", "force", [20.0], "rigC"),
+    ]
+    nones = [("displacement", "rigB"), ("force", "rigB"), ("displacement", "rigC"), ("force", "rigC")]
+    out = []
+    for snr in snrs:
+        for key, mode, strengths, rig in singles:
+            for v in strengths:
+                out.append({"kind": "single", "effects": [(key, v)], "mode": mode, "cmd": "std", "snr": snr,
+                            "rig": rig, "set": "issue13"})
+        for mode, rig in nones:
+            out.append({"kind": "none", "effects": [], "mode": mode, "cmd": "std", "snr": snr, "rig": rig,
+                        "set": "issue13"})
+        out.append({"kind": "pair", "effects": [("load_pressure", 10e6), ("coulomb", 400.0)],
+                    "mode": "displacement", "cmd": "std", "snr": snr, "set": "issue13"})
+    return out
+
+
+def plan(size: str, cases: str = "all") -> list[dict]:
     """The records: single effects at graded strengths, no effect, two effects."""
     singles = [
         # (key, mode, strengths)
@@ -175,6 +256,8 @@ def plan(size: str) -> list[dict]:
         singles = singles[::3]
         nones = nones[:3]
         pairs = pairs[:1]
+    if cases == "new":
+        return plan_new(snrs)
     out = []
     for snr in snrs:
         for key, mode, strengths in singles:
@@ -186,11 +269,12 @@ def plan(size: str) -> list[dict]:
             out.append({"kind": "none", "effects": [], "mode": mode, "cmd": cmd, "snr": snr})
         for a, b in pairs:
             out.append({"kind": "pair", "effects": [a, b], "mode": "displacement", "cmd": "std", "snr": snr})
-    return out
+    return out + (plan_new(snrs) if cases == "all" else [])
 
 
 IN_LIBRARY = {"coulomb", "viscous", "spring", "load_pressure", "flow", "delay", "valve", "leakage", "piston",
-              "spool"}  #: forms the library has exactly (the others are out-of-library forms)
+              "spool", "bouc_wen", "bouc_wen_soft"}
+#: (IN_LIBRARY: forms the library has exactly; the others are out-of-library forms)
 
 
 def make_record(args: tuple) -> tuple[dict, dict, dict]:
@@ -199,9 +283,11 @@ def make_record(args: tuple) -> tuple[dict, dict, dict]:
     rng = np.random.default_rng([seed, i])
     rid = f"r{i:03d}"
     mode = it["mode"]
+    rig = it.get("rig", "paper")
     dur = it.get("duration", duration)
     u, x0 = command(mode, it["cmd"], dur, rng)
-    tr = base_truth(mode)
+    u = u * RIGS[rig][1 if mode == "displacement" else 2] if mode != "free" else u
+    tr = base_truth(mode, rig)
     peak = float(np.max(np.abs(ip.simulate(tr, mode, u, DT, x0, substeps=2)["spool"]))) \
         if any(k == "spool" for k, _ in it["effects"]) else 0.0
     answers, forms, over = [], [], {}
@@ -235,23 +321,26 @@ def make_record(args: tuple) -> tuple[dict, dict, dict]:
         noise = rms * 10 ** (-it["snr"] / 20) if rms > 0 and not (c == "force" and mode == "free") else 0.0
         rec[c] = y + rng.normal(0.0, noise, y.size) if noise > 0 else y.copy()
     key = {"id": rid, "kind": it["kind"], "mode": mode, "snr": it["snr"], "answers": answers,
-           "forms": forms, "duration": dur, "runtime_check": it.get("runtime_check", False),
+           "forms": forms, "duration": dur, "rig": rig, "set": it.get("set", "earlier"),
+           "runtime_check": it.get("runtime_check", False),
            "peak_spool": float(np.max(np.abs(ch["spool"]))), "friction_energy_equivalent": f_eq,
            "truth": {k: v for k, v in asdict(tr).items() if not isinstance(v, list)}}
-    return rec, {"id": rid, "mode": mode, "rig": f"nominal_{mode}.toml"}, key
+    return rec, {"id": rid, "mode": mode, "rig": nominal_file(mode, rig)}, key
 
 
 SUBSTEPS = 4  #: RK4 substeps a 0.5 ms sample in the generator (125 us: h times the fastest rate < 0.1)
 
 
-def generate(out: Path, size: str = "default", seed: int = 2003, duration: float = 4.0, jobs: int = 2) -> None:
+def generate(out: Path, size: str = "default", seed: int = 2003, duration: float = 4.0, jobs: int = 2,
+             cases: str = "all") -> None:
     import servohydraulics as sh
 
     out.mkdir(parents=True, exist_ok=True)
     (out / "records").mkdir(exist_ok=True)
-    for mode in ("displacement", "force", "free"):
-        sh.save_rig(nominal_rig(mode), out / f"nominal_{mode}.toml")
-    items = plan(size)
+    for rig in RIGS:
+        for mode in (("displacement", "force", "free") if rig == "paper" else ("displacement", "force")):
+            sh.save_rig(nominal_rig(mode, rig), out / nominal_file(mode, rig))
+    items = plan(size, cases)
     # the 10 s, 2 kHz runtime record
     items.append({"kind": "single", "effects": [("coulomb", 300.0)], "mode": "displacement", "cmd": "std",
                   "snr": 30, "duration": 10.0, "runtime_check": True})
@@ -266,6 +355,8 @@ def generate(out: Path, size: str = "default", seed: int = 2003, duration: float
             print(f"{k['id']} {k['mode']:12s} snr {k['snr']} {k['kind']:6s} {', '.join(k['forms']) or 'none'}",
                   flush=True)
     (out / "manifest.json").write_text(json.dumps(manifest, indent=1))
+    args = f"--out {out} --size {size} --seed {seed} --duration {duration:g} --cases {cases}"
+    (out / "generate.json").write_text(json.dumps({"command": f"python benchmarks/diagnose_eval/generate.py {args}"}))
     (out / "answer_key.json").write_text(json.dumps(key, indent=1))
 
 
@@ -276,8 +367,10 @@ def main() -> None:
     p.add_argument("--seed", type=int, default=2003)
     p.add_argument("--duration", type=float, default=4.0, help="record length [s]")
     p.add_argument("--jobs", type=int, default=2, help="worker processes")
+    p.add_argument("--cases", choices=["all", "new", "old"], default="all",
+                   help="all cases, only those added for issue 13, or only the earlier ones")
     a = p.parse_args()
-    generate(Path(a.out), a.size, a.seed, a.duration, a.jobs)
+    generate(Path(a.out), a.size, a.seed, a.duration, a.jobs, a.cases)
 
 
 if __name__ == "__main__":

@@ -3,10 +3,13 @@ evaluation: plain Python, classical RK4 with a fixed substep, no code shared wit
 the C++ core.  It carries effects in forms the diagnose library does not have:
 Stribeck and LuGre friction, a tabulated flow curve, a delay made of a filter
 (2nd-order Bessel low-pass of the command) or a true continuous-time delay of
-the held command.
+the held command, a true transport delay of the valve drive inside the loop
+(method of steps on the stored drive history, not a Pade approximant), and a
+Bouc-Wen hysteretic specimen (Wen 1976) in parallel with the structure.
 
 Units SI.  State: x [m], v [m/s], p [Pa], x_v [-], x_v' [1/s], plus z [m] (LuGre
-bristle deflection) and two filter states when a filter delay is on.
+bristle deflection), two filter states when a filter delay is on, and the
+Bouc-Wen displacement z_b [m].
 """
 
 from __future__ import annotations
@@ -56,6 +59,13 @@ class Truth:
     v_max: float = 10.0
     delay: str = "none"  # none | pure | filter
     tau: float = 0.0  # [s]: pure delay, or DC group delay of the Bessel filter
+    loop_delay: float = 0.0  # [s]: transport delay of the valve drive inside the loop (0: none)
+    bouc_wen: bool = False  # Bouc-Wen specimen F = bw_k z_b in parallel with the structure
+    bw_k: float = 0.0  # [N/m]
+    bw_A: float = 1.0
+    bw_beta: float = 0.0  # [1/m^n]
+    bw_gamma: float = 0.0  # [1/m^n]
+    bw_n: float = 1.0
 
 
 def simulate(tr: Truth, mode: str, u: np.ndarray, dt: float, x0: float = 0.0, substeps: int = 8) -> dict:
@@ -92,8 +102,27 @@ def simulate(tr: Truth, mode: str, u: np.ndarray, dt: float, x0: float = 0.0, su
             return tr.k * x
         return math.copysign(tr.k * tr.x_contact + tr.k_2 * (abs(x) - tr.x_contact), x)
 
-    def rhs(y: list, uc: float) -> list:
-        x, v, p, xv, xvd, z, f1, f2 = y
+    def commanded(y: list, uc: float) -> float:
+        # the command the controller sees: through the Bessel filter (state f1) or as held
+        return y[6] if tr.delay == "filter" else uc
+
+    def drive_of(y: list, uc: float) -> float:
+        # the saturated valve drive of the inner loop, Eq (1); the force feedback F = p A - m_p a, a from the
+        # structure's balance (independent of the drive)
+        x, v, p = y[0], y[1], y[2]
+        a = (p * tr.A - structure(y)) / M
+        F = p * tr.A - mp * a
+        err = (commanded(y, uc) - x) if mode == "displacement" else (commanded(y, uc) - F)
+        return max(-tr.v_max, min(tr.v_max, CF * tr.G_p * err))
+
+    def structure(y: list) -> float:
+        # every force of the structure against the applied one, with the friction law and the Bouc-Wen specimen
+        x, v, z = y[0], y[1], y[5]
+        fr = friction(v, z, 0.0)
+        return fr + tr.c * v + spring(x) + (tr.bw_k * y[8] if tr.bouc_wen else 0.0)
+
+    def rhs(y: list, uc: float, w_del: float | None = None) -> list:
+        x, v, p, xv, xvd, z, f1, f2, zb = y
         # delay filter: 2nd-order Bessel 1/(1 + tau s + tau^2 s^2 / 3), states f1 (output), f2 = f1'
         if tr.delay == "filter":
             w2 = 3.0 / tr.tau ** 2
@@ -107,15 +136,16 @@ def simulate(tr: Truth, mode: str, u: np.ndarray, dt: float, x0: float = 0.0, su
             zd = v - tr.sigma_0 * abs(v) * z / level
         else:
             zd = 0.0
-        fr = friction(v, z, zd)
+        if tr.bouc_wen:
+            zbd = (tr.bw_A * v - tr.bw_beta * abs(v) * abs(zb) ** (tr.bw_n - 1) * zb
+                   - tr.bw_gamma * v * abs(zb) ** tr.bw_n)
+        else:
+            zbd = 0.0
         applied = p * tr.A if actuator else ucmd
-        a = (applied - fr - tr.c * v - spring(x)) / M
+        a = (applied - structure(y)) / M
         if not actuator:
-            return [v, a, 0.0, 0.0, 0.0, zd, f2, f2d]
-        F = p * tr.A - mp * a
-        err = (ucmd - x) if mode == "displacement" else (ucmd - F)
-        drive = CF * tr.G_p * err
-        drive = max(-tr.v_max, min(tr.v_max, drive))
+            return [v, a, 0.0, 0.0, 0.0, zd, f2, f2d, zbd]
+        drive = drive_of(y, uc) if w_del is None else w_del
         xvdd = wv * wv * (tr.K_s * drive - xv) - 2 * tr.zeta_v * wv * xvd
         s = max(-tr.x_v_max, min(tr.x_v_max, xv))
         R = 1.0
@@ -124,13 +154,13 @@ def simulate(tr: Truth, mode: str, u: np.ndarray, dt: float, x0: float = 0.0, su
             R = math.copysign(math.sqrt(abs(r)), r)
         Q = tr.K_v * g(s) * R
         pd = (Q - tr.C_l * p - tr.A * v) / tr.K_a
-        return [v, a, pd, xvd, xvdd, zd, f2, f2d]
+        return [v, a, pd, xvd, xvdd, zd, f2, f2d, zbd]
 
     n = len(u)
     # initial state: static equilibrium at x0 (pressure holds the springs; spool feeds the leakage)
-    y = [x0, 0.0, 0.0, 0.0, 0.0, 0.0, float(u[0]) if tr.delay == "filter" else 0.0, 0.0]
+    y = [x0, 0.0, 0.0, 0.0, 0.0, 0.0, float(u[0]) if tr.delay == "filter" else 0.0, 0.0, 0.0]
     if actuator:
-        p0 = spring(x0) / tr.A
+        p0 = spring(x0) / tr.A  # (the Bouc-Wen specimen starts unstrained: z_b = 0)
         y[2] = p0
         q = tr.C_l * p0 / tr.K_v
         if tr.flow == "rational":
@@ -160,6 +190,24 @@ def simulate(tr: Truth, mode: str, u: np.ndarray, dt: float, x0: float = 0.0, su
         j = int(math.floor(tt / dt + 1e-9))
         return float(u[min(max(j, 0), n - 1)])
 
+    # loop delay: the drive at every substep boundary (times j h), before t = 0 the initial state's steady drive
+    # (the spool holding the leakage: x_v = K_s w); the delayed drive at a stage time is linearly interpolated
+    lag = tr.loop_delay if actuator else 0.0
+    if lag > 0.0 and lag < h:
+        raise ValueError(f"invalid loop_delay = {lag}: must be at least one substep ({h} s)")
+    w_hist = [y[3] / tr.K_s] if lag > 0.0 else []
+
+    def w_delayed(t: float) -> float | None:
+        if lag <= 0.0:
+            return None
+        s_ = (t - lag) / h
+        if s_ <= 0.0:
+            return w_hist[0]
+        j = int(math.floor(s_))
+        f = s_ - j
+        return w_hist[j + 1] if f == 0.0 else w_hist[j + 1] * (1 - f) + w_hist[j + 2] * f if j + 2 < len(w_hist) \
+            else w_hist[-1]
+
     for k in range(n):
         t0 = k * dt
         outputs(k, y, held(t0) if tr.delay == "pure" else float(u[k]))
@@ -169,10 +217,13 @@ def simulate(tr: Truth, mode: str, u: np.ndarray, dt: float, x0: float = 0.0, su
                 u1, u2, u3 = held(t), held(t + 0.5 * h), held(t + h - 1e-12)
             else:
                 u1 = u2 = u3 = float(u[k])
-            k1 = rhs(y, u1)
-            k2 = rhs([a + 0.5 * h * b for a, b in zip(y, k1)], u2)
-            k3 = rhs([a + 0.5 * h * b for a, b in zip(y, k2)], u2)
-            k4 = rhs([a + h * b for a, b in zip(y, k3)], u3)
+            if lag > 0.0 and len(w_hist) == k * substeps + i + 1:
+                w_hist.append(drive_of(y, u1))  # the drive at t (index k substeps + i + 1: index 0 is t < 0)
+            w1, w2, w3 = w_delayed(t), w_delayed(t + 0.5 * h), w_delayed(t + h)
+            k1 = rhs(y, u1, w1)
+            k2 = rhs([a + 0.5 * h * b for a, b in zip(y, k1)], u2, w2)
+            k3 = rhs([a + 0.5 * h * b for a, b in zip(y, k2)], u2, w2)
+            k4 = rhs([a + h * b for a, b in zip(y, k3)], u3, w3)
             y = [a + h / 6 * (b1 + 2 * b2 + 2 * b3 + b4) for a, b1, b2, b3, b4 in zip(y, k1, k2, k3, k4)]
     out["command"] = np.asarray(u, float)
     out["time"] = np.arange(n) * dt

@@ -48,7 +48,8 @@ def _diagnose(args: argparse.Namespace) -> int:
     from .diagnosis import diagnose
     from .rig import load_rig
 
-    d = diagnose(args.records, load_rig(args.rig), mode=args.mode, progress=not args.quiet)
+    names = [c.strip() for c in args.candidates.split(",") if c.strip()] if args.candidates else None
+    d = diagnose(args.records, load_rig(args.rig), mode=args.mode, progress=not args.quiet, candidates=names)
     d.write(args.out)
     print(f"{d.verdict}: {d.summary}")
     for e in d.effects:
@@ -92,6 +93,7 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--mode", required=True, choices=list(MODES),
                    help="control mode of the records")
     g.add_argument("--out", required=True, help="output directory (diagnosis.json, rig_updated.toml, report.md)")
+    g.add_argument("--candidates", help="restrict the library to these candidates (comma-separated names)")
     g.add_argument("--quiet", action="store_true", help="no progress bar")
     g.set_defaults(func=_diagnose)
 

@@ -169,7 +169,7 @@ def test_record_logged_one_sample_late_is_an_alignment_not_an_effect() -> None:
     """A lab whose acquisition logs each response sample one sample later than the
     record convention (row k sampled before command k is sent) makes the response
     lead the command by dt.  Without a negative delay in the library that reads as
-    a valve, piston mass and friction together; it must be named time_delay with
+    a valve, piston mass and friction together; it must be named command_delay with
     tau = -dt and a note about the acquisition's alignment.  The opposite shift is a
     plain +dt delay."""
     base = _displacement_record(snr=40, duration=3.0, seed=4)
@@ -180,8 +180,8 @@ def test_record_logged_one_sample_late_is_an_alignment_not_an_effect() -> None:
             rec[c] = np.concatenate([y[1:], y[-1:]]) if shift == 1 else np.concatenate([y[:1], y[:-1]])
         d = sh.diagnose(Record({k: np.asarray(v) for k, v in rec.items()}), _linear_rig(), mode="displacement",
                         progress=False)
-        assert [e["name"] for e in d.effects] == ["time_delay"]
-        tau = d.effects[0]["parameters"]["tau"]["value"]
+        assert [e["name"] for e in d.effects] == ["command_delay"]
+        tau = d.effects[0]["parameters"]["command_delay"]["value"]
         assert abs(tau - (-DT if shift == 1 else DT)) < 0.05 * DT
         assert ("alignment" in d.effects[0]["note"]) == (shift == 1)
 

@@ -66,21 +66,21 @@ def test_joint_refit_recovers_viscous_damping_and_delay() -> None:
     d = sh.diagnose(_record(), _nominal(), mode="displacement", progress=False)
     names = [e["name"] for e in d.effects]
     assert d.verdict == "effect_found", d.summary
-    assert sorted(names) == ["time_delay", "viscous_damping"], names  # only the two hidden effects
+    assert sorted(names) == ["command_delay", "viscous_damping"], names  # only the two hidden effects
     jr = d.to_dict()["joint_refit"]
     assert jr and jr[-1]["kept"], jr
     last = jr[-1]
-    assert sorted(last["effects"]) == ["time_delay", "viscous_damping"]
+    assert sorted(last["effects"]) == ["command_delay", "viscous_damping"]
     assert last["bic_joint"] <= last["bic_greedy"]
 
     # the greedy fits (one effect at a time) are biased: at least one interval misses its truth
     greedy = last["parameters_greedy"]
-    g_c, g_tau = greedy["viscous_damping"]["c"], greedy["time_delay"]["tau"]
+    g_c, g_tau = greedy["viscous_damping"]["c"], greedy["command_delay"]["command_delay"]
     assert not (_covers(g_c, C_TRUE) and _covers(g_tau, TAU_TRUE)), (g_c, g_tau)
 
     # the joint re-fit: both within a few per cent of truth, both intervals cover it
     c = d.effects[names.index("viscous_damping")]["parameters"]["c"]
-    tau = d.effects[names.index("time_delay")]["parameters"]["tau"]
+    tau = d.effects[names.index("command_delay")]["parameters"]["command_delay"]
     assert abs(c["value"] - C_TRUE) < 0.03 * C_TRUE, c
     assert abs(tau["value"] - TAU_TRUE) < 0.02 * TAU_TRUE, tau
     assert _covers(c, C_TRUE), c
@@ -92,5 +92,6 @@ def test_joint_refit_recovers_viscous_damping_and_delay() -> None:
     # the model carries the joint values, and the gap reported is the joint model's
     assert d.rig.c == c["value"]
     assert d.command_delay == tau["value"]
+    assert d.rig.command_delay == tau["value"]  # a real rig parameter now: rig_updated.toml carries it
     assert d.gap_after["force"] <= last["gap_greedy"]["force"]
     assert d.plots["history"][-1][0] == "joint re-fit"

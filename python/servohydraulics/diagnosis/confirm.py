@@ -50,47 +50,86 @@ def _heldout(space, z_tr: np.ndarray, x0_tr: np.ndarray, cases: list[Case], base
     return held, held_lr
 
 
+def _cost(space, z: np.ndarray, cases: list[Case], x0s, tau: float, which: str) -> float:
+    """Sum of squared normalised residuals of the model at ``z`` (fitting coordinates)."""
+    rig, t = space.rig_and_tau(z, tau)
+    r = engine.residuals(engine.simulate_all(rig, cases, t, x0s), cases, which)
+    return float(r @ r)
+
+
+def _absent_z(space) -> np.ndarray:
+    """The candidate's "absent" value with the interacting parameters at their current values (fitting
+    coordinates): the model of the previous round."""
+    return np.asarray(space.absent, float).copy()
+
+
 def fit_space(space, z0: np.ndarray, cases: list[Case], x0s, stats: dict, base_test: dict, tau: float,
               neff_ref: dict | None = None) -> Fit:
     """Train-segment fit (held-out improvement), then the fit on all data, its BIC
     improvement over the current model (``stats``: its channel statistics) and its
     HAC 95 % intervals.  ``x0s``: the current initial displacements (the fits'
-    start for the co-fitted ones)."""
+    start for the co-fitted ones).
+
+    The invariant: the fit never ends worse than the candidate's "absent" value
+    (which reproduces the current model): the fit on all data starts from the
+    better of the train-segment fit and "absent", and a result whose misfit (the
+    total normalised SSR or the BIC's -2 log L) is above the current model's is
+    replaced by "absent" itself (so that its BIC change is the parameter penalty
+    alone, never a gain, and never a loss beyond it)."""
+    absent = _absent_z(space)
     tr = engine.fit(space, cases, z0, tau, "train", x0s)
-    held, held_lr = _heldout(space, tr.z, tr.x0, cases, base_test, tau)
-    res = engine.fit(space, cases, tr.z, tau, "all", x0s, max_nfev=12)
-    z = res.z
+    z_tr = tr.z if _cost(space, tr.z, cases, tr.x0, tau, "train") <= _cost(space, absent, cases, x0s, tau, "train") \
+        else absent
+    x0_tr = tr.x0 if z_tr is tr.z else np.asarray(x0s, float)
+    held, held_lr = _heldout(space, z_tr, x0_tr, cases, base_test, tau)
+    start = z_tr if _cost(space, z_tr, cases, x0s, tau, "all") <= _cost(space, absent, cases, x0s, tau, "all") \
+        else absent
+    res = engine.fit(space, cases, start, tau, "all", x0s, max_nfev=12)
+    z, x0 = res.z, res.x0
     rig_c, tau_c = space.rig_and_tau(z, tau)
-    sims_c = engine.simulate_all(rig_c, cases, tau_c, res.x0)
+    sims_c = engine.simulate_all(rig_c, cases, tau_c, x0)
     st_c = engine.channel_stats(sims_c, cases)
     neff = neff_ref if neff_ref is not None else engine.n_eff(st_c)
+    worse = (sum(s["ssr"] for s in st_c.values()) > sum(s["ssr"] for s in stats.values())
+             or engine.bic(st_c, 0, neff) > engine.bic(stats, 0, neff))
+    if worse:  # the fit wandered off: the candidate at "absent", i.e. the current model itself
+        z, x0 = absent, np.asarray(x0s, float)
+        rig_c, tau_c = space.ctx.rig, tau
+        sims_c = engine.simulate_all(rig_c, cases, tau_c, x0)
+        st_c = engine.channel_stats(sims_c, cases)
+        res = dataclasses.replace(res, z=z, x0=x0)
     dbic = engine.bic(stats, 0, neff) - engine.bic(st_c, z.size, neff)
     lengths = engine.series_lengths(cases)
     lo, hi = engine.intervals(space, res, lengths)
     nm = space.n_main
     tested = np.concatenate([space.tests_absent[:nm], np.zeros(z.size - nm, bool)])
     joint, pval = engine.joint_excludes_absent(space, res, lengths, tested)
-    return Fit(space=space, z=z, z_tr=tr.z, lo=lo, hi=hi, rig=rig_c, tau=tau_c, x0=res.x0, joint_excludes=joint,
-               joint_p=pval, sims=sims_c, stats=st_c, neff=neff, dbic=dbic, held=held, held_lr=held_lr)
+    if worse:
+        joint, pval, lo, hi = False, 1.0, np.minimum(lo, z), np.maximum(hi, z)
+    return Fit(space=space, z=z, z_tr=z_tr, lo=lo, hi=hi, rig=rig_c, tau=tau_c, x0=x0, joint_excludes=joint,
+               joint_p=pval, sims=sims_c, stats=st_c, neff=neff, dbic=dbic, held=held, held_lr=held_lr,
+               ended_at_absent=bool(worse))
 
 
 def scan_start(space, z0: np.ndarray, cases: list[Case], x0s, tau: float, ctx: Context) -> np.ndarray:
-    """The start of the fit: the better (training-segment error) of the screening
-    estimate (a linear extrapolation of the signature, which can land far off for
-    a strongly nonlinear parameter such as K_a) and the probe value, and for an
-    effect whose error is not smooth in its first parameter (``Candidate.scan``)
-    the values of a coarse scan of it (a least-squares fit started where a hard
-    clip barely engages stops there)."""
-    starts = [np.asarray(z0, float), np.asarray(space.probe[: space.n_main], float)]
+    """The start of the fit (multi-start): the best (training-segment error) of
+    the candidate's "absent" value (the current model), the screening estimate (a
+    linear extrapolation of the signature, which can land far off for a strongly
+    nonlinear parameter such as K_a), the probe value, and for an effect whose
+    error is not smooth in its first parameter (``Candidate.scan``) the values of
+    a coarse scan of it, the other parameters at the screening estimate (or the
+    probe where that is "absent": a scan of a yield displacement at zero force
+    sees nothing).  A least-squares fit started where a hard clip barely engages
+    stops there; one started at "absent" cannot end worse than the current model."""
+    n = space.n_main
+    z0 = np.asarray(z0, float)[:n]
+    other = np.where(z0 == space.absent[:n], space.probe[:n], z0)
+    starts = [np.asarray(space.absent[:n], float), z0, np.asarray(space.probe[:n], float)]
     for v in (np.asarray(space.cand.scan(ctx), float) if space.cand.scan is not None else ()):
-        z = np.asarray(z0, float).copy()
+        z = other.copy()
         z[0] = np.clip(space.to_internal(np.concatenate([[v], space.to_external(z)[1:]]))[0], space.lo[0], space.hi[0])
         starts.append(z)
-    cost = []
-    for z in starts:
-        rig, t = space.rig_and_tau(z, tau)
-        r = engine.residuals(engine.simulate_all(rig, cases, t, x0s), cases, "train")
-        cost.append(float(r @ r))
+    cost = [_cost(space, np.concatenate([z, space.absent[n:]]), cases, x0s, tau, "train") for z in starts]
     return starts[int(np.argmin(cost))]
 
 

@@ -5,9 +5,14 @@ structure's equation of motion (for screening) and the experiment that would
 separate it from look-alikes.
 
 Every candidate acts through rig parameters that exist (``rig.PARAMETERS`` and
-the effect switches of ``rig.EFFECTS``), except ``time_delay``, which delays the
-record's command (integer + fractional samples, linear interpolation) before it
-is simulated.
+the effect switches of ``rig.EFFECTS``).  ``command_delay`` is the core's
+``[delays] command_delay`` for values >= 0; its values below 0 (down to -2
+samples: response rows that lead the command, an acquisition misalignment, not
+physics) shift the record's command instead (``Candidate.delays_command``).
+
+Bounds and probes scale with the rig and the records (``force_scale``), so the
+candidates work on rigs other than the paper's (another mass, area, valve,
+gain, a rig without a spring).
 """
 
 from __future__ import annotations
@@ -46,6 +51,21 @@ class Context:
     peak_x: float  #: largest measured |displacement| [m]
     rms_v: float  #: rms measured velocity [m/s]
     dt: float = 5e-4  #: the records' sample time (the shortest) [s]
+    peak_force: float = 0.0  #: largest measured |force| (the applied force in free mode) [N]
+
+
+def force_scale(ctx: Context) -> float:
+    """The force scale of the rig and records [N]: the largest of the measured
+    peak force, the spring force at the peak displacement and the actuator's
+    force at the simulated peak pressure (so that bounds and probes of force
+    parameters fit a 5 kN damper frame as well as the paper's 100 kN rig)."""
+    return max(ctx.peak_force, ctx.rig.k * ctx.peak_x, ctx.rig.A * ctx.peak_pressure, 1.0)
+
+
+def stiffness_scale(ctx: Context) -> float:
+    """The structure's stiffness, or (a rig without a spring: a damper) the
+    secant stiffness force_scale / peak displacement [N/m]."""
+    return ctx.rig.k if ctx.rig.k > 0 else force_scale(ctx) / max(ctx.peak_x, 1e-4)
 
 
 @dataclass
@@ -73,7 +93,8 @@ class Candidate:
     separate: str = ""
     #: a reason it cannot be seen in these records, or None
     exercised: Callable[[Context], str | None] = field(default=lambda ctx: None)
-    #: True if the parameter is a delay applied to the command
+    #: True for the command delay: its first parameter's part >= 0 is the rig's ``command_delay``, its part
+    #: < 0 shifts the record's command (``split_delay``)
     delays_command: bool = False
     #: which parameters are fitted in this context (default all); the others stay at "absent"
     active: Callable[[Context], tuple[bool, ...]] | None = None
@@ -132,7 +153,7 @@ def _lugre_absent(ctx: Context) -> np.ndarray:
 
 def _lugre_scan(ctx: Context) -> np.ndarray:
     # presliding compliance spans decades: start the fit at bristle stiffnesses of 0.1 to 10 k
-    return ctx.rig.k * np.array([0.1, 0.3, 1.0, 3.0, 10.0])
+    return stiffness_scale(ctx) * np.array([0.1, 0.3, 1.0, 3.0, 10.0])
 
 
 def _apply_viscous(rig: Rig, th: np.ndarray) -> Rig:
@@ -140,6 +161,8 @@ def _apply_viscous(rig: Rig, th: np.ndarray) -> Rig:
 
 
 def _apply_softening(rig: Rig, th: np.ndarray) -> Rig:
+    if not rig.effects.spring_softening and th[0] == rig.k:
+        return copy.copy(rig)  # "absent" (k_2 = k): the same model with the switch left off, not an equal one
     return _with(rig, "spring_softening", k_2=th[0])
 
 
@@ -188,8 +211,87 @@ def _apply_flow(rig: Rig, th: np.ndarray) -> Rig:
     return r
 
 
-def _apply_delay(rig: Rig, th: np.ndarray) -> Rig:
-    return rig  # the delay acts on the command, see Candidate.delays_command
+def split_delay(d: float) -> tuple[float, float]:
+    """A fitted command delay d [s] as (the rig's command_delay >= 0, the shift
+    <= 0 of the record's command: response rows that lead the command)."""
+    return max(float(d), 0.0), min(float(d), 0.0)
+
+
+def _apply_command_delay(rig: Rig, th: np.ndarray) -> Rig:
+    return _with(rig, command_delay=split_delay(th[0])[0])
+
+
+#: loop delay below which the effect is off [s]: 0.1 ms, a twentieth of a 2 kHz sample; a Pade realisation of a
+#: shorter delay only makes the simulation stiff (its poles scale as 1 / loop_delay)
+LOOP_DELAY_MIN = 1e-4
+
+
+def _apply_loop_delay(rig: Rig, th: np.ndarray) -> Rig:
+    if not math.isfinite(th[0]) or th[0] < LOOP_DELAY_MIN:
+        return _with(rig, "loop_delay", False)
+    return _with(rig, "loop_delay", loop_delay=th[0])
+
+
+def _loop_delay_absent(ctx: Context) -> np.ndarray:
+    return _a(ctx.rig.loop_delay if ctx.rig.effects.loop_delay else 0.0)
+
+
+def _max_delay(ctx: Context) -> float:
+    """The longest delay the core takes (64 samples) or 50 ms [s]."""
+    return min(0.05, 63.9 * ctx.dt)
+
+
+def _apply_bouc_wen(rig: Rig, th: np.ndarray) -> Rig:
+    # theta = (x_y [m]: yield displacement z_u, F_y [N]: ultimate (yield) force bw_k z_u); n = 1, A = 1,
+    # beta = gamma = 1 / (2 x_y) (the preset's form): small-amplitude stiffness F_y / x_y, unloading elastic
+    x_y, F_y = max(float(th[0]), 1e-9), max(float(th[1]), 0.0)
+    if F_y <= 0.0:
+        return _with(rig, "bouc_wen_hysteresis", False)
+    return _with(rig, "bouc_wen_hysteresis", bw_k=F_y / x_y, bw_A=1.0, bw_beta=0.5 / x_y, bw_gamma=0.5 / x_y,
+                 bw_n=1.0)
+
+
+def _bouc_wen_absent(ctx: Context) -> np.ndarray:
+    r = ctx.rig
+    if r.effects.bouc_wen_hysteresis and r.bw_beta + r.bw_gamma > 0:
+        z_u = (r.bw_A / (r.bw_beta + r.bw_gamma)) ** (1.0 / r.bw_n)
+        return _a(z_u, r.bw_k * z_u)
+    return _a(_bouc_wen_probe_x(ctx), 0.0)
+
+
+def _bouc_wen_probe_x(ctx: Context) -> float:
+    return max(0.1 * ctx.peak_x, 2.0 * BOUC_WEN_MIN_YIELD)
+
+
+#: smallest yield displacement of the Bouc-Wen candidate [m]: 1 mm.  What separates a hysteretic specimen from
+#: friction is how far it travels before it yields: seal friction's presliding (LuGre's F_c / sigma_0) is microns to
+#: a fraction of a millimetre, a specimen's yield displacement millimetres.  Below 1 mm the two laws trace the same
+#: loops within the noise of mm-scale records (with the yield allowed below 1 mm, a 0.5 mm LuGre presliding record
+#: was "ambiguous" between the two), so the library names that range lugre_friction (or coulomb_friction, its limit)
+BOUC_WEN_MIN_YIELD = 1e-3
+
+
+def _bouc_wen_scan(ctx: Context) -> np.ndarray:
+    # the yield displacement spans decades (a stiff specimen yielding at 0.1 mm to a soft one at the stroke)
+    return np.maximum(max(ctx.peak_x, 1e-3) * np.array([0.05, 0.1, 0.3, 1.0]), BOUC_WEN_MIN_YIELD)
+
+
+def _mr_exercised(ctx: Context) -> str | None:
+    if not ctx.rig.effects.mr_damper:
+        return "not exercised: the model has no MR damper element (bouc_wen_hysteresis is the hysteretic candidate)"
+    return None
+
+
+def _apply_mr(rig: Rig, th: np.ndarray) -> Rig:
+    # theta = (alpha [N/m], c0 [N s/m]) at the rig's voltage: the voltage-dependent parts are moved into the a-terms
+    u = rig.mr_voltage
+    return _with(rig, mr_alpha_a=max(th[0] - rig.mr_alpha_b * u, 0.0),
+                 mr_c0_a=max(th[1] - rig.mr_c0_b * u, 1e-6))
+
+
+def _mr_absent(ctx: Context) -> np.ndarray:
+    r, u = ctx.rig, ctx.rig.mr_voltage
+    return _a(r.mr_alpha_a + r.mr_alpha_b * u, r.mr_c0_a + r.mr_c0_b * u)
 
 
 def _apply_valve(rig: Rig, th: np.ndarray) -> Rig:
@@ -283,8 +385,12 @@ FLOW_KNEE_MIN_OPENING = 0.15  #: peak spool opening above which the knee x_k is 
 
 
 def _spool_absent(ctx: Context) -> np.ndarray:
+    # a limit at the sampled peak opening would clip the peaks between samples: "absent" is 1 % above it
     lim = ctx.rig.x_v_max if ctx.rig.effects.spool_saturation else math.inf
-    return _a(min(lim, ctx.peak_spool))
+    return _a(min(lim, SPOOL_ABSENT_MARGIN * ctx.peak_spool))
+
+
+SPOOL_ABSENT_MARGIN = 1.01  #: "absent" spool limit over the simulated peak opening [-]
 
 
 def _piston_absent(ctx: Context) -> np.ndarray:
@@ -292,10 +398,35 @@ def _piston_absent(ctx: Context) -> np.ndarray:
 
 
 def _softening_exercised(ctx: Context) -> str | None:
+    if ctx.rig.k <= 0.0:
+        return "not exercised: the model has no spring (k = 0)"
     if ctx.peak_x <= ctx.rig.x_contact * 1.02:
         return (f"not exercised: |displacement| never exceeds x_contact = {ctx.rig.x_contact * 1e3:.1f} mm "
                 f"(peak {ctx.peak_x * 1e3:.1f} mm)")
     return None
+
+
+def _spring_exercised(ctx: Context) -> str | None:
+    if ctx.rig.k <= 0.0:
+        return "not exercised: the model has no spring (k = 0)"
+    return None
+
+
+def _friction_max(ctx: Context) -> float:
+    """Upper bound of a friction level [N]: 5 kN, or a fifth of the force scale if larger."""
+    return max(5e3, 0.2 * force_scale(ctx))
+
+
+def _friction_probe(ctx: Context) -> float:
+    """A clearly visible step of a friction force [N]: 0.4 % of the force scale, at least 20 N on a large rig
+    (at least 0.1 % of the force scale on a small one)."""
+    fs = force_scale(ctx)
+    return max(min(20.0, 1e-3 * fs), 0.004 * fs)
+
+
+def _critical_damping(ctx: Context) -> float:
+    """2 sqrt(k m) with the stiffness scale [N s/m]."""
+    return 2.0 * math.sqrt(stiffness_scale(ctx) * ctx.rig.m)
 
 
 def _spool_exercised(ctx: Context) -> str | None:
@@ -337,8 +468,8 @@ CANDIDATES: tuple[Candidate, ...] = (
         "coulomb_friction", (Param("F_c", "N", "structure.F_c"),),
         "Coulomb friction F_c sgn(v) in the structure, Eq (5) (effects.coulomb_friction on)",
         absent=_coulomb_absent,
-        bounds=lambda ctx: (_a(0.0), _a(5e3)),
-        probe=lambda ctx: _coulomb_absent(ctx) + max(20.0, 0.004 * ctx.rig.k * max(ctx.peak_x, 1e-3)),
+        bounds=lambda ctx: (_a(0.0), _a(_friction_max(ctx))),
+        probe=lambda ctx: _coulomb_absent(ctx) + _friction_probe(ctx),
         apply=_apply_coulomb, interacts=(("c", "N s/m"),),
         structural_signature=_sig_coulomb, look_alikes=("viscous_damping", "lugre_friction"),
         separate="repeat the test at two amplitudes (or a free vibration): Coulomb friction's share of the "
@@ -352,20 +483,55 @@ CANDIDATES: tuple[Candidate, ...] = (
         "1995): below the presliding displacement F_c / sigma_0 friction acts as a spring, then as Coulomb "
         "friction (added: seal friction in small-amplitude tests)",
         absent=_lugre_absent,
-        bounds=lambda ctx: (_a(0.02 * ctx.rig.k, 0.0), _a(1e12, 5e3)),
-        probe=lambda ctx: _a(ctx.rig.k, _coulomb_absent(ctx)[0]
-                             + max(20.0, 0.004 * ctx.rig.k * max(ctx.peak_x, 1e-3))),
+        bounds=lambda ctx: (_a(0.02 * stiffness_scale(ctx), 0.0), _a(1e12, _friction_max(ctx))),
+        probe=lambda ctx: _a(stiffness_scale(ctx), _coulomb_absent(ctx)[0] + _friction_probe(ctx)),
         apply=_apply_lugre, interacts=(("c", "N s/m"),), scan=_lugre_scan, nests=("coulomb_friction",),
-        look_alikes=("coulomb_friction", "viscous_damping"),
+        look_alikes=("coulomb_friction", "viscous_damping", "bouc_wen_hysteresis"),
         separate="a small-amplitude test (below the presliding displacement F_c / sigma_0): presliding friction "
                  "stiffens the structure there, Coulomb friction locks it, viscous damping does neither",
+    ),
+    Candidate(
+        "bouc_wen_hysteresis",
+        (Param("x_y", "m", "specimen.bw_beta = bw_gamma = 1 / (2 x_y), bw_A = 1, bw_n = 1 (the yield displacement)",
+               tests_absent=False),
+         Param("F_y", "N", "specimen.bw_k = F_y / x_y (effects.bouc_wen_hysteresis on; the yield force)")),
+        "a hysteretic specimen force in parallel with the structure (Bouc-Wen, n = 1, beta = gamma): elastic "
+        "with stiffness F_y / x_y below the yield displacement x_y, then saturating at the yield force F_y; "
+        "unloading is elastic (Coulomb friction is its limit x_y -> 0)",
+        absent=_bouc_wen_absent,
+        bounds=lambda ctx: (_a(BOUC_WEN_MIN_YIELD, 0.0), _a(max(2.0 * ctx.peak_x, 4 * BOUC_WEN_MIN_YIELD),
+                                                            2.0 * force_scale(ctx))),
+        probe=lambda ctx: _a(_bouc_wen_probe_x(ctx), _bouc_wen_absent(ctx)[1] + _friction_probe(ctx)),
+        apply=_apply_bouc_wen, scan=_bouc_wen_scan,
+        exercised=lambda ctx: (None if ctx.peak_x > 2 * BOUC_WEN_MIN_YIELD else
+                               f"not exercised: |displacement| never exceeds twice the smallest yield displacement "
+                               f"{BOUC_WEN_MIN_YIELD * 1e3:g} mm (peak {ctx.peak_x * 1e3:.2f} mm)"),
+        look_alikes=("lugre_friction", "coulomb_friction", "mr_damper"),
+        separate="a test at two amplitudes, one below the yield displacement x_y: a hysteretic specimen is elastic "
+                 "(stiffness F_y / x_y) below it and its loop's corners are rounded over x_y; Coulomb friction "
+                 "locks at any amplitude, LuGre presliding is a spring over microns and unloads with a falling "
+                 "stiffness where Bouc-Wen unloads elastically over 2 x_y",
+    ),
+    Candidate(
+        "mr_damper",
+        (Param("alpha", "N/m", "specimen.mr_alpha_a (+ mr_alpha_b mr_voltage): the damper's Bouc-Wen force level"),
+         Param("c0", "N s/m", "specimen.mr_c0_a (+ mr_c0_b mr_voltage): the damper's viscous coefficient")),
+        "the MR damper element's field-dependent force (Spencer et al. 1997): its hysteretic level alpha and "
+        "viscous coefficient c0 at the record's current (the rest of the damper as in the model)",
+        absent=_mr_absent,
+        bounds=lambda ctx: (_a(0.0, 1e-3), _a(max(50 * _mr_absent(ctx)[0], 20 * force_scale(ctx) / 0.01),
+                                              max(50 * _mr_absent(ctx)[1], 20 * force_scale(ctx) / 0.1))),
+        probe=lambda ctx: _mr_absent(ctx) * 1.5 + _a(_friction_probe(ctx) / 0.01, _friction_probe(ctx) / 0.1),
+        apply=_apply_mr, exercised=_mr_exercised, look_alikes=("bouc_wen_hysteresis",),
+        separate="tests at two velocities: the damper's viscous part c0 grows with velocity, its yield level alpha "
+                 "does not",
     ),
     Candidate(
         "viscous_damping", (Param("c", "N s/m", "structure.c"),),
         "error in the viscous damping c of Eq (5)",
         absent=lambda ctx: _a(ctx.rig.c),
-        bounds=lambda ctx: (_a(0.0), _a(max(20 * ctx.rig.c, 0.2 * 2 * math.sqrt(ctx.rig.k * ctx.rig.m)))),
-        probe=lambda ctx: _a(ctx.rig.c * 1.5 + 0.005 * 2 * math.sqrt(ctx.rig.k * ctx.rig.m)),
+        bounds=lambda ctx: (_a(0.0), _a(max(20 * ctx.rig.c, 0.2 * _critical_damping(ctx)))),
+        probe=lambda ctx: _a(ctx.rig.c * 1.5 + 0.005 * _critical_damping(ctx)),
         apply=_apply_viscous, interacts=(("F_c", "N"),),
         structural_signature=_sig_viscous, look_alikes=("coulomb_friction", "lugre_friction"),
         separate="repeat at two amplitudes: viscous damping gives the same decay ratio at every amplitude",
@@ -406,17 +572,35 @@ CANDIDATES: tuple[Candidate, ...] = (
                  "load pressure does not",
     ),
     Candidate(
-        "time_delay", (Param("tau", "s", "none: the record's command is delayed by tau (integer + fractional "
-                                           "samples) before simulating"),),
-        "a pure delay of the command (controller, DSP or communication latency); down to -2 samples: a "
-        "record whose response rows lead the command (acquisition alignment, not physics)",
-        absent=lambda ctx: _a(0.0),
-        bounds=lambda ctx: (_a(-2.0 * ctx.dt), _a(0.05)),
-        probe=lambda ctx: _a(0.002),
-        apply=_apply_delay, delays_command=True, modes=("displacement", "force"),
-        look_alikes=("servovalve_dynamics",),
-        separate="a sine sweep to higher frequency: a delay's phase lag grows linearly with frequency without "
-                 "amplitude loss, the servovalve's saturates and costs amplitude",
+        "command_delay", (Param("command_delay", "s", "delays.command_delay (a value < 0 is no rig parameter: the "
+                                                      "record's response rows lead its command)"),),
+        "a pure delay of the command before the loop (controller, DSP or communication latency): the core's "
+        "[delays] command_delay; down to -2 samples: a record whose response rows lead the command (acquisition "
+        "alignment, not physics: the record's command is shifted instead)",
+        absent=lambda ctx: _a(ctx.rig.command_delay),
+        bounds=lambda ctx: (_a(-2.0 * ctx.dt), _a(_max_delay(ctx))),
+        probe=lambda ctx: _a(ctx.rig.command_delay + 0.002),
+        apply=_apply_command_delay, delays_command=True, modes=("displacement", "force"),
+        look_alikes=("loop_delay", "servovalve_dynamics"),
+        separate="a sine sweep: a command delay's phase lag grows as w tau at every frequency, with the closed "
+                 "loop's amplitude unchanged; a delay in the loop (or a slower valve) changes the closed loop "
+                 "itself: little extra lag well below the loop's crossover, an amplitude peak near it",
+    ),
+    Candidate(
+        "loop_delay", (Param("loop_delay", "s", "delays.loop_delay (effects.loop_delay on; Pade order "
+                                                "delays.loop_delay_order)"),),
+        "a transport delay inside the analog loop, on the valve drive (slow valve amplifier, long cable run): "
+        "the core's Pade-approximated effects.loop_delay",
+        absent=_loop_delay_absent,
+        bounds=lambda ctx: (_a(0.0), _a(_max_delay(ctx))),
+        probe=lambda ctx: _loop_delay_absent(ctx) + 0.002,
+        apply=_apply_loop_delay, modes=("displacement", "force"),
+        scan=lambda ctx: _loop_delay_absent(ctx)[0] + np.array([0.001, 0.002, 0.004, 0.008]),
+        look_alikes=("servovalve_dynamics", "command_delay"),
+        separate="a sine sweep through and beyond the loop's crossover: a delay in the loop adds phase w tau "
+                 "without amplitude loss in the open loop (the closed loop peaks), the servovalve's lag "
+                 "saturates at 180 deg and costs amplitude above f_v; a command delay leaves the closed loop's "
+                 "amplitude unchanged",
     ),
     Candidate(
         "servovalve_dynamics",
@@ -426,7 +610,7 @@ CANDIDATES: tuple[Candidate, ...] = (
         else _a(math.inf, ctx.rig.zeta_v),
         bounds=lambda ctx: (_a(3.0, 0.1), _a(1000.0, 5.0)),
         probe=lambda ctx: _a(0.7 * min(ctx.rig.f_v, 1000.0), ctx.rig.zeta_v * 0.6),
-        apply=_apply_valve, modes=("displacement", "force"), look_alikes=("time_delay",),
+        apply=_apply_valve, modes=("displacement", "force"), look_alikes=("loop_delay", "command_delay"),
         separate="a sine sweep to 50-100 Hz: the valve's amplitude roll-off and phase saturation separate it "
                  "from a pure delay",
     ),
@@ -437,6 +621,7 @@ CANDIDATES: tuple[Candidate, ...] = (
         bounds=lambda ctx: (_a(0.0), _a(max(50 * ctx.rig.C_l, 1e-9))),
         probe=lambda ctx: _a(ctx.rig.C_l * 1.5 + 1e-12),
         apply=_apply_leakage, interacts=(("K_a", "m^5/N"),), modes=("displacement", "force"),
+        look_alikes=("servovalve_dynamics",),
         separate="hold a static force: leakage needs a steady spool offset (drive) to hold pressure",
     ),
     Candidate(
@@ -455,7 +640,7 @@ CANDIDATES: tuple[Candidate, ...] = (
         "spool_saturation", (Param("x_v_max", "-", "servovalve.x_v_max (effects.spool_saturation on)"),),
         "spool travel limited to +-x_v_max (end stops)",
         absent=_spool_absent,
-        bounds=lambda ctx: (_a(max(0.01 * ctx.peak_spool, 1e-4)), _a(max(ctx.peak_spool, 2e-4))),
+        bounds=lambda ctx: (_a(max(0.01 * ctx.peak_spool, 1e-4)), _a(max(SPOOL_ABSENT_MARGIN * ctx.peak_spool, 2e-4))),
         probe=lambda ctx: _a(0.7 * ctx.peak_spool),
         apply=_apply_spool, modes=("displacement", "force"), exercised=_spool_exercised,
         scan=lambda ctx: _spool_absent(ctx)[0] * np.array([0.4, 0.5, 0.6, 0.7, 0.8, 0.9]),
@@ -468,7 +653,7 @@ CANDIDATES: tuple[Candidate, ...] = (
         absent=lambda ctx: _a(ctx.rig.k),
         bounds=lambda ctx: (_a(0.3 * ctx.rig.k), _a(3.0 * ctx.rig.k)),
         probe=lambda ctx: _a(1.05 * ctx.rig.k),
-        apply=_apply_stiffness, structural_signature=_sig_stiffness,
+        apply=_apply_stiffness, structural_signature=_sig_stiffness, exercised=_spring_exercised,
         separate="a quasi-static test: the stiffness is the force-displacement slope",
     ),
     Candidate(
@@ -488,6 +673,25 @@ CANDIDATES: tuple[Candidate, ...] = (
 #: the candidate effects by name (the names used in reports)
 LIBRARY: dict[str, Candidate] = {cand.name: cand for cand in CANDIDATES}
 NAMES: tuple[str, ...] = tuple(LIBRARY)
+
+#: old candidate names -> why they went and what to use
+RENAMED: dict[str, str] = {
+    "time_delay": "candidate 'time_delay' was renamed 'command_delay' (the core's [delays] command_delay, a "
+                  "delay of the command before the loop); a delay inside the analog loop is 'loop_delay'",
+}
+
+
+def check_names(names) -> list[str]:
+    """The candidate names, checked: an unknown name raises ``ValueError``
+    naming it (with the new name for a renamed one)."""
+    out = []
+    for nme in names:
+        if nme in RENAMED:
+            raise ValueError(f"invalid candidate {nme!r}: {RENAMED[nme]}")
+        if nme not in LIBRARY:
+            raise ValueError(f"unknown candidate {nme!r}: expected one of {list(LIBRARY)}")
+        out.append(nme)
+    return out
 
 
 def nested(a: str, b: str) -> bool:

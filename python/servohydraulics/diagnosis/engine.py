@@ -18,7 +18,7 @@ from .. import _core
 from ..identify import ar1_coefficient, ar1_effective_n
 from ..rig import Rig
 from ..simulate import MODES, SimulationError, simulate, solver_options
-from .effects import INTERACT_SPAN, Candidate, Context
+from .effects import INTERACT_SPAN, Candidate, Context, split_delay
 from .types import Case, FitResult, Screening, Sim
 
 #: Plant channels the diagnosis does not compare: the abscissa, the valve drive (a function of the
@@ -263,10 +263,9 @@ class Space:
     def rig_and_tau(self, z: np.ndarray, base_tau: float) -> tuple[Rig, float]:
         ext = self.to_external(z)
         main = self.own_parameters(ext)
+        rig, tau = self.cand.apply(self.ctx.rig, main), base_tau
         if self.cand.delays_command:
-            rig, tau = self.ctx.rig, base_tau + float(main[0])
-        else:
-            rig, tau = self.cand.apply(self.ctx.rig, main), base_tau
+            tau += split_delay(main[0])[1]
         if self.interacting:
             rig = copy.copy(rig) if rig is self.ctx.rig else rig
             for (key, _), v in zip(self.interacting, ext[self.n_main:]):
@@ -364,10 +363,9 @@ class JointSpace:
         for i in self.order:
             sp = self.spaces[i]
             main = sp.own_parameters(ext[self.blocks[i]])
+            rig = sp.cand.apply(rig, main)
             if sp.cand.delays_command:
-                tau += float(main[0])
-            else:
-                rig = sp.cand.apply(rig, main)
+                tau += split_delay(main[0])[1]
         if self.interacting:
             rig = copy.copy(rig) if rig is self.base else rig
             for (key, _), v in zip(self.interacting, ext[self.n_main:]):

@@ -29,6 +29,7 @@ import numpy as np
 from ..rig import Rig
 from . import engine
 from .confirm import param_report
+from .effects import split_delay
 from .types import Accepted, Case, FitResult, JointRefit
 
 JOINT_MAX_NFEV = 30  #: most least-squares iterations of the joint re-fit
@@ -69,7 +70,7 @@ def _start(accepted: list[Accepted], js: engine.JointSpace, current: Rig, tau: f
         for j, prm in enumerate(a.space.params):
             if prm.key in moved and not prm.reciprocal and hasattr(current, prm.key):
                 z0[blk.start + j] = float(getattr(current, prm.key))
-    delay = sum(float(a.space.to_external(a.z)[0]) for a in accepted if a.space.cand.delays_command)
+    delay = sum(split_delay(a.space.to_external(a.z)[0])[1] for a in accepted if a.space.cand.delays_command)
     return z0, tau - delay
 
 

@@ -111,6 +111,8 @@ class Fit:
     held: float  #: held-out SSR improvement (fraction)
     held_lr: float  #: held-out -2 log likelihood improvement
     refit: Refit = field(default_factory=Refit)
+    #: the fit ended worse than "absent" and was replaced by it (the invariant of ``confirm.fit_space``)
+    ended_at_absent: bool = False
 
 
 @dataclass(frozen=True, eq=False)

@@ -22,7 +22,7 @@ from ..rig import Rig, rig_to_dict
 from ..simulate import MODES
 from . import engine
 from .confirm import confirm, param_report
-from .effects import LIBRARY, Context, nested, separating_experiment
+from .effects import LIBRARY, Context, check_names, nested, separating_experiment, split_delay
 from .joint import joint_refit
 from .types import Accepted, Case, CandidateLog, Fit, JointRefit, Round, Screening, Sim
 
@@ -43,7 +43,7 @@ class Diagnosis:
 
     verdict: str  #: "effect_found", "no_effect" or "ambiguous"
     #: per effect added, in order: name, doc, parameters (key -> value, unit, interval_95, absent, rig_key),
-    #: delta_bic, heldout_improvement, gap_after, round and (time_delay) note
+    #: delta_bic, heldout_improvement, gap_after, round and (command_delay) note
     effects: list[dict[str, Any]]
     gap_before: dict[str, float]  #: channel -> normalised RMS gap of the nominal model
     gap_after: dict[str, float]  #: channel -> normalised RMS gap of the final model
@@ -58,7 +58,8 @@ class Diagnosis:
     separating_experiment: str = ""
     #: the joint re-fits of the accepted effects (one per round from the second effect on; the last is the final one)
     joint_refit: list[JointRefit] = field(default_factory=list)
-    command_delay: float = 0.0  #: [s]
+    command_delay: float = 0.0  #: the model's command delay (rig command_delay + record shift) [s]
+    record_shift: float = 0.0  #: the part of it < 0: the record's command shifted (response rows lead it) [s]
     summary: str = ""
     runtime_s: float = 0.0
     #: arrays for the report (not in the JSON): cases, sims_before, sims_after, history, signatures
@@ -81,6 +82,7 @@ class Diagnosis:
             "ambiguous_between": self.ambiguous_between,
             "separating_experiment": self.separating_experiment,
             "command_delay_s": self.command_delay,
+            "record_shift_s": self.record_shift,
             "rig_updated": rig_to_dict(self.rig),
             "runtime_s": self.runtime_s,
         }
@@ -238,10 +240,7 @@ def _prepare(records, rig: Rig, mode: str, candidates: Sequence[str] | None, kee
     """Checks the arguments and prepares the records (unique names)."""
     if mode not in MODES:
         raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(MODES)}")
-    names = list(candidates) if candidates is not None else list(LIBRARY)
-    for nme in names:
-        if nme not in LIBRARY:
-            raise ValueError(f"unknown candidate {nme!r}: expected one of {list(LIBRARY)}")
+    names = check_names(candidates) if candidates is not None else list(LIBRARY)
     recs = _as_records(records)
     rig.validate()
     cases: list[Case] = []
@@ -259,7 +258,8 @@ def _context(setup: _Setup, state: _State) -> Context:
                    peak_spool=max(float(np.max(np.abs(s["spool"]))) for s in sims),
                    peak_pressure=max(float(np.max(np.abs(s["pressure"]))) for s in sims),
                    peak_x=max(float(np.max(np.abs(c.meas["displacement"]))) for c in cases),
-                   rms_v=float(np.mean([c.derived["rms_v"] for c in cases])), dt=min(c.dt for c in cases))
+                   rms_v=float(np.mean([c.derived["rms_v"] for c in cases])), dt=min(c.dt for c in cases),
+                   peak_force=max(float(np.max(np.abs(c.derived["force"]))) for c in cases))
 
 
 # --- one round: screen, shortlist, confirm, decide ------------------------------------------
@@ -453,8 +453,8 @@ def _accept(setup: _Setup, state: _State, outcome: Round) -> None:
     eff = {"name": name, "doc": LIBRARY[name].doc, "parameters": row.parameters, "delta_bic": fit.dbic,
            "heldout_improvement": fit.held, "gap_after": g_after, "round": outcome.number}
     if LIBRARY[name].delays_command:
-        eff["note"] = ("time_delay is not a rig parameter: delay the command by tau (integer + fractional "
-                       "samples) before simulating; rig_updated.toml cannot hold it")
+        eff["note"] = ("command_delay is the rig's [delays] command_delay (rig_updated.toml carries it) for a value "
+                       ">= 0")
     state.effects.append(eff)
     state.accepted.append(Accepted(name, fit.space, np.asarray(fit.z, float).copy(),
                                    np.asarray(fit.lo, float).copy(), np.asarray(fit.hi, float).copy()))
@@ -485,11 +485,12 @@ def _polish(setup: _Setup, state: _State, rnd: int) -> None:
 def _alignment_notes(effects: list[dict[str, Any]]) -> None:
     """A fitted command delay < 0 is an acquisition misalignment, not a physical delay."""
     for eff in effects:
-        tv = eff["parameters"].get("tau", {}).get("value") if LIBRARY[eff["name"]].delays_command else None
+        tv = eff["parameters"].get("command_delay", {}).get("value") if LIBRARY[eff["name"]].delays_command else None
         if tv is not None and tv < 0.0:
-            eff["note"] += (f"; tau < 0: the response channels lead the command by {-1e3 * tv:.2f} ms, which no "
+            eff["note"] += (f"; here < 0: the response channels lead the command by {-1e3 * tv:.2f} ms, which no "
                             "physical delay does: check the acquisition's alignment (row k must be sampled before "
-                            "the command of row k is sent)")
+                            "the command of row k is sent); rig_updated.toml cannot hold it (the record's command "
+                            "is shifted instead)")
 
 
 def _gap_closed(before: dict, after: dict, floor: dict) -> dict:
@@ -529,7 +530,8 @@ def _result(setup: _Setup, state: _State, sims0: list, last: Round | None, runti
                   gap_where=gap_where(sims0, cases),
                   ambiguous_between=list(last.ambiguous_between) if ambiguous else [],
                   separating_experiment=last.separating_experiment if ambiguous else "",
-                  joint_refit=state.joint_log, command_delay=state.tau,
+                  joint_refit=state.joint_log, command_delay=state.rig.command_delay + state.tau,
+                  record_shift=state.tau,
                   summary=_summary(verdict, state.effects, last, state.joint_log), runtime_s=runtime)
     d.plots = {"cases": cases, "sims_before": sims0, "sims_after": state.sims, "history": state.history,
                "signatures": state.signatures}
