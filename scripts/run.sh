@@ -2,7 +2,8 @@
 # The README's entry point.  On a fresh Debian machine (root, Python and a C++
 # compiler present) it installs what it needs itself, then:
 #   scripts/run.sh demo    the main job on built-in defaults (plots + summaries in demo_out/)
-#   scripts/run.sh test    all tests: C++ (ctest) and Python (pytest)
+#   scripts/run.sh test    all tests: C++ (ctest) and Python (pytest), but those marked slow
+#   scripts/run.sh test-all  the same with the slow diagnosis tests (minutes each)
 #   scripts/run.sh bench   the step-time benchmarks (docs/benchmarks.md)
 #   scripts/run.sh sanitize  the C++ tests (with the SUNDIALS failure injection) and a short
 #                          Python smoke run under AddressSanitizer, UBSan and LeakSanitizer
@@ -83,8 +84,15 @@ case "${1:-}" in
   test)
     system_deps; python_env
     cxx_tests
-    # Run pytest from the tests directory so that the installed package is the one imported.
-    PATH="$venv/bin:$PATH" "$venv/bin/python" -m pytest "$root/tests/python" -q -p no:cacheprovider
+    # Run pytest from the tests directory so that the installed package is the one imported;
+    # one worker process per core (pytest-xdist): the diagnosis tests dominate and are independent.
+    # Tests marked slow (diagnosis runs of a minute or more each) are left to `test-all`.
+    PATH="$venv/bin:$PATH" "$venv/bin/python" -m pytest "$root/tests/python" -q -p no:cacheprovider -n auto -m "not slow"
+    ;;
+  test-all)
+    system_deps; python_env
+    cxx_tests
+    PATH="$venv/bin:$PATH" "$venv/bin/python" -m pytest "$root/tests/python" -q -p no:cacheprovider -n auto
     ;;
   bench)
     system_deps; python_env

@@ -165,6 +165,7 @@ def test_weak_effect_under_the_noise_floor_is_found_at_20db() -> None:
     assert d.verdict == "no_effect"
 
 
+@pytest.mark.slow  # minutes: excluded from scripts/run.sh test, run by scripts/run.sh test-all
 def test_record_logged_one_sample_late_is_an_alignment_not_an_effect() -> None:
     """A lab whose acquisition logs each response sample one sample later than the
     record convention (row k sampled before command k is sent) makes the response
@@ -228,6 +229,7 @@ def test_csv_errors(tmp_path: Path, capsys) -> None:
         sh.diagnose([ok], _free_rig(), mode="free", candidates=["magic"], progress=False)
 
 
+@pytest.mark.slow  # minutes: excluded from scripts/run.sh test, run by scripts/run.sh test-all
 def test_ambiguous_valve_or_leakage_then_resolved_by_a_sweep() -> None:
     """A slower servovalve (f_v = 50 Hz instead of the nominal 70.7 Hz) seen through one
     4 Hz, 2 mm sine at 20 dB: at a single frequency the valve's extra lag and a larger

@@ -117,6 +117,7 @@ def test_absent_value_of_every_candidate_reproduces_the_current_model() -> None:
         <= set(checked), checked
 
 
+@pytest.mark.slow  # minutes: excluded from scripts/run.sh test, run by scripts/run.sh test-all
 def test_no_fit_ends_worse_than_absent_even_from_a_bad_start(monkeypatch) -> None:
     """Every candidate's fit started far off (at its upper bounds) with a
     least-squares that may not move (max_nfev = 1: a fit that stalls, the way
@@ -152,6 +153,7 @@ def test_load_pressure_and_400_newton_coulomb_are_both_named() -> None:
             assert c.delta_bic > -30.0, (c.name, c.round, c.delta_bic)
 
 
+@pytest.mark.slow  # minutes: excluded from scripts/run.sh test, run by scripts/run.sh test-all
 # --- delays: in the loop, before it, or the valve --------------------------------------------
 
 @pytest.mark.parametrize("hidden, name, key", [
