@@ -66,7 +66,8 @@ def _time(rig, command, options, repeat):
 def step_time_table(steps: int, repeat: int, progress: bool = True) -> str:
     t = np.arange(steps) * DT
     command = 0.01 * np.sin(2 * np.pi * 1.0 * t) + 0.003 * np.sin(2 * np.pi * 7.0 * t)
-    methods = [("CVODE", sh.solver_options()), ("RK4, 4 substeps", sh.solver_options("rk4", rk4_substeps=4)),
+    methods = [("default (dopri5)", sh.solver_options()), ("CVODE", sh.solver_options("cvode")),
+               ("RK4, 4 substeps", sh.solver_options("rk4", rk4_substeps=4)),
                ("RK4, automatic", sh.solver_options("rk4"))]
     rows = ["| plant | states | " + " | ".join(f"{m} [us/step] | RHS/step" for m, _ in methods) + " |",
             "|---|---|" + "---|---|" * len(methods)]
