@@ -164,10 +164,16 @@ void expose_rths(py::module_& m) {
       .def("validate", &Converter::validate).def("__call__", &Converter::operator());
   r.def("benchmark_converter", &benchmark_converter, py::arg("kind"));
   r.def("ideal_converter", &ideal_converter, py::arg("kind") = Converter::Kind::AnalogToDigital);
+  py::enum_<NoiseGenerator>(r, "NoiseGenerator")
+      .value("MersenneTwister", NoiseGenerator::MersenneTwister)
+      .value("SimulinkRandomNumber", NoiseGenerator::SimulinkRandomNumber);
   py::class_<GaussianSequence>(r, "GaussianSequence")
-      .def(py::init<std::uint64_t>(), py::arg("seed") = 0)
-      .def("reset", &GaussianSequence::reset, py::arg("seed"))
-      .def("next", &GaussianSequence::next);
+      .def(py::init<std::uint64_t, NoiseGenerator>(), py::arg("seed") = 0,
+           py::arg("generator") = NoiseGenerator::MersenneTwister)
+      .def("reset", &GaussianSequence::reset, py::arg("seed"), py::arg("generator") = NoiseGenerator::MersenneTwister)
+      .def("next", &GaussianSequence::next)
+      .def_property_readonly("generator", &GaussianSequence::generator)
+      .def_static("simulink_state", &GaussianSequence::simulink_state, py::arg("seed"));
   py::class_<SensorNoise>(r, "SensorNoise").def(py::init<>())
       .def(py::init([](double s, double g) { return SensorNoise{s, g}; }), py::arg("sigma"), py::arg("gain") = 1.0)
       .def_readwrite("sigma", &SensorNoise::sigma).def_readwrite("gain", &SensorNoise::gain)
@@ -320,6 +326,7 @@ void expose_rths(py::module_& m) {
       .def_readwrite("force_noise", &RthsLoopConfig::force_noise)
       .def_readwrite("independent_noise", &RthsLoopConfig::independent_noise)
       .def_readwrite("seed", &RthsLoopConfig::seed)
+      .def_readwrite("generator", &RthsLoopConfig::generator)
       .def("validate", &RthsLoopConfig::validate);
   py::class_<RthsLoop>(r, "RthsLoop")
       .def(py::init<ExperimentalSubstructure&, NumericalSubstructure&, TrackingController&, const RthsLoopConfig&>(),

@@ -87,6 +87,34 @@ void converters() {
   CHECK_NEAR(std::sqrt(s2 / n), 1.0, 4.5 / std::sqrt(2.0 * n));
   CHECK_NEAR(s11 / n, 0.0, 4.5 / std::sqrt(n));
   CHECK_NEAR(SensorNoise::band_limited_sigma(6.25e-14, kH), 1.6e-5, 1e-20);  // BENCHMARK.md 3.2
+  // The Simulink generator.  Seed scrambling: 0 maps to the block's replacement
+  // state, 65536 (high half 1) to state 1.  From state 1 the minimal standard
+  // generator is at 1043618065 after 10000 draws (Park and Miller 1988, CACM 31(10),
+  // the check value of a correct implementation).
+  CHECK(GaussianSequence::simulink_state(0) == 1144108930U);
+  CHECK(GaussianSequence::simulink_state(65536) == 1U);
+  GaussianSequence pm(65536, NoiseGenerator::SimulinkRandomNumber);
+  CHECK(pm.simulink_generator_state() == 1U);
+  double last = 0.0;
+  for (int k = 0; k < 10000; ++k) last = pm.simulink_uniform();
+  CHECK(pm.simulink_generator_state() == 1043618065U);
+  CHECK_NEAR(last, 1043618065.0 / 2147483647.0, 1e-16);
+  // Its normals: mean 0, sd 1, white, and the same for the same seed.
+  GaussianSequence sg(0, NoiseGenerator::SimulinkRandomNumber), sg2(0, NoiseGenerator::SimulinkRandomNumber);
+  double t = 0.0, t2 = 0.0, t11 = 0.0, tprev = 0.0;
+  bool tsame = true;
+  for (int k = 0; k < n; ++k) {
+    const double w = sg.next();
+    tsame = tsame && (w == sg2.next());
+    t += w;
+    t2 += w * w;
+    t11 += w * tprev;
+    tprev = w;
+  }
+  CHECK(tsame);
+  CHECK_NEAR(t / n, 0.0, 4.5 / std::sqrt(n));
+  CHECK_NEAR(std::sqrt(t2 / n), 1.0, 4.5 / std::sqrt(2.0 * n));
+  CHECK_NEAR(t11 / n, 0.0, 4.5 / std::sqrt(n));
   UnitDelay d(0.5);
   CHECK(d(1.0) == 0.5 && d(2.0) == 1.0 && d(3.0) == 2.0);
   d.reset();

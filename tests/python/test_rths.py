@@ -25,12 +25,27 @@ def data():
 
 
 def test_published_case1_row(data):
-    """BENCHMARK.md 10: the official noise realisation cannot be reproduced, so the
-    row is compared with the mean over noise seeds; the peak criteria (J3, J5)
-    depend on single samples and are compared with the seed-to-seed spread."""
+    """The published row with the official run's noise realisation: the Simulink
+    generator of the SENSORS subsystem at seed 0 (BENCHMARK.md 3.2), every J to the
+    acceptance tolerance (J1 to 0.1 ms, J2-J9 to 0.5 percentage points)."""
+    case, rec = rths.load_case(data, 1), rths.load_record(data, "elcentro")
+    J = rths.run_trial(case, rec, "sample", seed=0, noise="simulink").J
+    assert J[0] == pytest.approx(PUBLISHED_CASE1[0], abs=0.1)
+    for i in range(1, 9):
+        assert J[i] == pytest.approx(PUBLISHED_CASE1[i], abs=0.5), f"J{i + 1} = {J[i]}"
+    # The peak criteria J3 and J5 hang on single noise samples (seed-to-seed sd ~0.19 pp,
+    # below): they land on the published value rounded to 0.1 only with the official noise.
+    assert round(J[2], 1) == PUBLISHED_CASE1[2] and round(J[4], 1) == PUBLISHED_CASE1[4]
+
+
+def test_published_case1_row_over_noise_seeds(data):
+    """BENCHMARK.md 10's comparison for a generator that is not the official one:
+    the seed mean of the noise-insensitive J to 0.5 pp, the single-sample peaks (J3,
+    J5) to the seed-to-seed spread."""
     case, rec = rths.load_case(data, 1), rths.load_record(data, "elcentro")
     ref = rths.case_reference(case, rec)
-    Js = np.array([rths.run_trial(case, rec, "sample", seed=s, reference=ref).J for s in range(16)])
+    Js = np.array([rths.run_trial(case, rec, "sample", seed=s, reference=ref, noise="mersenne").J
+                   for s in range(16)])
     J, sd = Js.mean(axis=0), Js.std(axis=0, ddof=1)
     assert J[0] == pytest.approx(PUBLISHED_CASE1[0], abs=0.1)  # J1 to 0.1 ms
     for i in (1, 3, 5, 6, 7, 8):  # J2, J4, J6-J9: noise-insensitive (seed sd < 0.03), to 0.5 pp
@@ -38,7 +53,37 @@ def test_published_case1_row(data):
     for i in (2, 4):  # J3, J5: single-sample peaks (seed sd ~0.19 pp)
         assert 0.1 < sd[i] < 0.4, f"J{i + 1} sd {sd[i]}"
         assert abs(J[i] - PUBLISHED_CASE1[i]) <= max(0.5, 3.0 * sd[i]), f"J{i + 1} {J[i]} +- {sd[i]}"
-    # J5's seed mean is 18.48 against the published 19.0 (docs/rths-benchmark.md, "The J5 gap").
+
+
+def _minimal_standard(state: int):
+    """Park and Miller's minimal standard generator in exact integer arithmetic."""
+    while True:
+        state = 16807 * state % 2147483647
+        yield state
+
+
+def test_simulink_noise_generator_against_an_independent_implementation():
+    """The core's Simulink generator against this file's own: exact-integer minimal
+    standard (checked by Park and Miller's value 1043618065 after 10000 draws from 1),
+    the Random Number block's polar method keeping one variate per accepted pair."""
+    g = _minimal_standard(1)
+    for _ in range(9999):
+        next(g)
+    assert next(g) == 1043618065
+    assert rths.core.GaussianSequence.simulink_state(0) == 1144108930  # the block's state for a zero seed
+    uni = _minimal_standard(1144108930)
+    want = []
+    while len(want) < 5000:
+        sr = 2.0 * (next(uni) * 4.6566128752457969e-10) - 1.0
+        si = 2.0 * (next(uni) * 4.6566128752457969e-10) - 1.0
+        s = sr * sr + si * si
+        if 0.0 < s <= 1.0:
+            want.append(math.sqrt(-2.0 * math.log(s) / s) * sr)
+    seq = rths.core.GaussianSequence(0, rths.core.NoiseGenerator.SimulinkRandomNumber)
+    got = [seq.next() for _ in range(5000)]
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-15)
+    with pytest.raises(ValueError, match="noise"):
+        rths.run_trial(rths.embedded_case(1), rths.synthetic_record(duration=0.1), noise="gauss")
 
 
 def test_embedded_structure_matches_official_files(data):

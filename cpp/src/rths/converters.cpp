@@ -41,12 +41,44 @@ Converter ideal_converter(Converter::Kind kind) {
   return c;
 }
 
-void GaussianSequence::reset(std::uint64_t seed) noexcept {
+void GaussianSequence::reset(std::uint64_t seed, NoiseGenerator generator) noexcept {
+  generator_ = generator;
   gen_.seed(seed);
+  lcg_ = simulink_state(seed);
   has_spare_ = false;
 }
 
+std::uint32_t GaussianSequence::simulink_state(std::uint64_t seed) noexcept {
+  // The block takes floor(seed) mod 2^32 as an unsigned 32-bit integer, swaps in
+  // its high half and folds bit 15, then clamps into the generator's range.
+  std::uint32_t s = static_cast<std::uint32_t>(seed & 0xFFFFFFFFull);
+  const std::uint32_t r = s >> 16U;
+  const std::uint32_t t = s & 32768U;
+  s = ((((s - (r << 16U)) + t) << 16U) + t) + r;
+  if (s < 1U) return 1144108930U;  // the block's replacement for a zero state
+  if (s > 2147483646U) return 2147483646U;
+  return s;
+}
+
+double GaussianSequence::simulink_uniform() noexcept {
+  // 16807 u mod (2^31 - 1) without overflow (Schrage: 2^31 - 1 = 16807 * 127773 + 2836).
+  const std::uint32_t lo = (lcg_ % 127773U) * 16807U;
+  const std::uint32_t hi = (lcg_ / 127773U) * 2836U;
+  lcg_ = lo < hi ? 2147483647U - (hi - lo) : lo - hi;
+  return static_cast<double>(lcg_) * 4.6566128752457969e-10;  // 1 / (2^31 - 1)
+}
+
 double GaussianSequence::next() noexcept {
+  if (generator_ == NoiseGenerator::SimulinkRandomNumber) {
+    // Polar method as the block does it: accept s <= 1, keep the first variate only.
+    double u, s;
+    do {
+      u = 2.0 * simulink_uniform() - 1.0;
+      const double v = 2.0 * simulink_uniform() - 1.0;
+      s = u * u + v * v;
+    } while (s > 1.0 || s == 0.0);
+    return std::sqrt(-2.0 * std::log(s) / s) * u;
+  }
   if (has_spare_) {
     has_spare_ = false;
     return spare_;

@@ -29,8 +29,8 @@ void RthsLoop::reset() noexcept {
   exp_.reset();
   num_.reset();
   ctrl_.reset();
-  wx_.reset(cfg_.seed);
-  wf_.reset(cfg_.seed ^ 0x9E3779B97F4A7C15ull);
+  wx_.reset(cfg_.seed, cfg_.generator);
+  wf_.reset(cfg_.seed ^ 0x9E3779B97F4A7C15ull, cfg_.generator);
   dx_.reset();
   dv_.reset();
   delay_.reset();

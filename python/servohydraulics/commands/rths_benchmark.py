@@ -14,7 +14,7 @@ def _run(args) -> int:
     if args.record not in RECORDS and args.record != "chirp":
         raise ValueError(f"invalid --record = {args.record!r}: expected one of {sorted(RECORDS) + ['chirp']}")
     run = run_benchmark(args.data, args.record, args.cases, args.controller, args.perturbed, args.seed,
-                        workers=args.workers, progress=not args.quiet, csi=args.csi)
+                        workers=args.workers, progress=not args.quiet, csi=args.csi, noise=args.noise)
     out = write_outputs(run, args.out)
     from ..rths.report import j_table
     print(j_table(run["results"]))
@@ -33,7 +33,11 @@ def register(sub) -> None:
     p.add_argument("--controller", default="sample", choices=["sample", "polynomial", "ats", "model"],
                    help="tracking controller (default: the benchmark's sample controller)")
     p.add_argument("--perturbed", type=int, default=0, help="perturbed plants per case (default: 0)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the noise and of the perturbations (default: 0)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the noise and of the perturbations (default: 0; with "
+                        "--noise simulink, seed 0 is the official run's noise realisation)")
+    p.add_argument("--noise", default="simulink", choices=["simulink", "mersenne"],
+                   help="sensor-noise generator: simulink (default; the algorithm of Simulink's Random Number block "
+                        "in the official SENSORS subsystem) or mersenne (a 64-bit Mersenne twister)")
     p.add_argument("--workers", type=int, default=None, help="processes for the perturbed runs (default: all cores)")
     p.add_argument("--csi", default="exact", choices=["exact", "derivative-block"],
                    help="control-structure interaction: exact a2 dx/dt (default, the spec's) or the official code's "

@@ -12,7 +12,7 @@ The C++ blocks (plants, converters, substructures, controllers, the loop) are
 """
 
 from .. import _core
-from .benchmark import (CONTROLLERS, FORCE_LIMIT, Trial, case_psi, case_reference, make_controller,
+from .benchmark import (CONTROLLERS, FORCE_LIMIT, NOISE_GENERATORS, Trial, case_psi, case_reference, make_controller,
                         nominal_plant, partition, perturbed_plant, run_case, run_trial, trial_seed)
 from .data import (CASES, DT, EQ_INTENSITY, FS, RECORDS, BenchmarkCase, Record, chirp_record, embedded_case, load_case,
                    load_record, modal_damping, reference_stiffness, shear_building, synthetic_record)
@@ -22,7 +22,7 @@ from .opensees import OpenSeesSubstructure, spring_model
 core = _core.rths
 
 __all__ = ["CONTROLLERS", "FORCE_LIMIT", "Trial", "case_psi", "case_reference", "make_controller", "nominal_plant",
-           "partition", "perturbed_plant", "run_case", "run_trial", "trial_seed", "CASES", "DT", "EQ_INTENSITY",
+           "partition", "perturbed_plant", "run_case", "run_trial", "trial_seed", "NOISE_GENERATORS", "CASES", "DT", "EQ_INTENSITY",
            "FS", "RECORDS", "BenchmarkCase", "Record", "embedded_case", "load_case", "load_record",
            "modal_damping", "reference_stiffness", "shear_building", "synthetic_record", "chirp_record", "J_NAMES", "critical_delay", "evaluate",
            "matlab_round", "psi", "reference_response", "core", "OpenSeesSubstructure", "spring_model"]

@@ -18,7 +18,7 @@ from .evaluation import evaluate, psi, reference_response
 R = _core.rths
 
 __all__ = ["CONTROLLERS", "make_controller", "nominal_plant", "perturbed_plant", "partition", "Trial",
-           "run_trial", "run_case", "trial_seed", "FORCE_LIMIT"]
+           "run_trial", "run_case", "trial_seed", "FORCE_LIMIT", "NOISE_GENERATORS", "noise_generator"]
 
 FORCE_LIMIT = 8900.0  #: the benchmark's actuator capacity check on max|f| [N] (F4_evaluation.m L60-62)
 STROKE_LIMIT = 7e-3   #: paper limit (not checked by the code) [m]
@@ -129,14 +129,31 @@ def _ground_motion(record: Record, scale: float) -> "R.GroundMotion":
     return R.GroundMotion(record.time, record.acceleration, scale)
 
 
+NOISE_GENERATORS = ("simulink", "mersenne")
+
+
+def noise_generator(noise: str) -> "R.NoiseGenerator":
+    """The core's generator for a ``noise`` name (``simulink`` or ``mersenne``)."""
+    if noise == "simulink":
+        return R.NoiseGenerator.SimulinkRandomNumber
+    if noise == "mersenne":
+        return R.NoiseGenerator.MersenneTwister
+    raise ValueError(f"invalid noise = {noise!r}: expected one of {list(NOISE_GENERATORS)}")
+
+
 def run_trial(case: BenchmarkCase, record: Record, controller: str = "sample", plant=None, seed: int = 0,
               scale: float = EQ_INTENSITY, scheme: str = "RungeKutta4", reference: np.ndarray | None = None,
-              keep_signals: bool = False, timing: bool = False, experimental=None, numerical=None) -> Trial:
+              keep_signals: bool = False, timing: bool = False, experimental=None, numerical=None,
+              noise: str = "simulink") -> Trial:
     """One vRTHS run on the 4096 Hz grid of the record, then J1-J9.
 
     Args:
         plant: BenchmarkPlantParameters of the control plant (None: nominal).
         seed: of the sensor noise (one sequence shared by both channels).
+        noise: the noise generator: ``"simulink"`` (default), the algorithm of Simulink's
+            Random Number block inside the official SENSORS subsystem, so that seed 0 is
+            the official run's realisation (BENCHMARK.md 3.2); ``"mersenne"``: a 64-bit
+            Mersenne twister (the loop's general-purpose generator).
         scheme: the numerical substructure's integrator (``RungeKutta4`` as the
             benchmark, ``CentralDifference``, ``ExplicitNewmark``, ``AverageAcceleration``).
         reference: the reference displacements (N x 3), if already computed.
@@ -152,6 +169,7 @@ def run_trial(case: BenchmarkCase, record: Record, controller: str = "sample", p
     ctrl = make_controller(controller)
     cfg = R.RthsLoopConfig()
     cfg.seed = int(seed) & (2**64 - 1)
+    cfg.generator = noise_generator(noise)
     loop = R.RthsLoop(exp, num, ctrl, cfg)
     gm = _ground_motion(record, scale)
     n = record.samples()
@@ -208,11 +226,11 @@ def case_psi(case: BenchmarkCase) -> float:
 
 
 def _perturbed_job(rig, trial: int, case: BenchmarkCase, record: Record, controller: str, seed: int,
-                   scale: float, csi_derivative_block: bool = False) -> dict[str, Any]:
+                   scale: float, csi_derivative_block: bool = False, noise: str = "simulink") -> dict[str, Any]:
     """One perturbed trial in a sweep worker (the rig argument of sh.sweep is unused)."""
     plant = perturbed_plant(seed, case.number, trial, csi_derivative_block)
     t = run_trial(case, record, controller, plant=plant, seed=seed, scale=scale,
-                  reference=case_reference(case, record, scale))
+                  reference=case_reference(case, record, scale), noise=noise)
     out = {f"J{i + 1}": t.J[i] for i in range(9)}
     out.update(ok=t.ok, max_force_N=t.max_force_N, max_displacement_m=t.max_displacement_m,
                max_velocity_m_per_s=t.max_velocity_m_per_s, wall_time=t.wall_time,
@@ -223,14 +241,15 @@ def _perturbed_job(rig, trial: int, case: BenchmarkCase, record: Record, control
 def run_case(case: BenchmarkCase, record: Record, controller: str = "sample", perturbed: int = 0, seed: int = 0,
              scale: float = EQ_INTENSITY, executor=None, max_workers: int | None = None,
              progress: bool = True, keep_signals: bool = False,
-             csi_derivative_block: bool = False) -> dict[str, Any]:
+             csi_derivative_block: bool = False, noise: str = "simulink") -> dict[str, Any]:
     """The nominal trial and ``perturbed`` perturbed trials (through ``sh.sweep``) of one case.
 
     Returns ``{"nominal": {...}, "perturbed": {...} (if any), "trial": Trial, "table": DataFrame | None}``.
     """
+    noise_generator(noise)  # validates the name before any run
     ref = case_reference(case, record, scale)
     nom = run_trial(case, record, controller, plant=nominal_plant(csi_derivative_block), seed=seed, scale=scale,
-                    reference=ref, keep_signals=keep_signals)
+                    reference=ref, keep_signals=keep_signals, noise=noise)
     res: dict[str, Any] = {"nominal": {"J": nom.J, "max_force_N": nom.max_force_N,
                                        "max_displacement_m": nom.max_displacement_m,
                                        "max_velocity_m_per_s": nom.max_velocity_m_per_s,
@@ -241,9 +260,9 @@ def run_case(case: BenchmarkCase, record: Record, controller: str = "sample", pe
         from ..sweep import sweep
         df = sweep(grid={"trial": list(range(1, perturbed + 1))}, run=_perturbed_job,
                    fixed={"case": case, "record": record, "controller": controller, "seed": seed, "scale": scale,
-                          "csi_derivative_block": bool(csi_derivative_block)},
+                          "csi_derivative_block": bool(csi_derivative_block), "noise": noise},
                    executor=executor, max_workers=max_workers, progress=progress)
-        df = df.drop(columns=["case", "record", "csi_derivative_block"])
+        df = df.drop(columns=["case", "record", "csi_derivative_block", "noise"])
         if "error" in df.columns and df["error"].notna().any():
             raise RuntimeError(f"perturbed trial failed: {df['error'].dropna().iloc[0]}")
         Js = df[[f"J{i + 1}" for i in range(9)]].to_numpy(dtype=float)

@@ -13,7 +13,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..atomic import FileSet
-from .benchmark import CONTROLLERS, FORCE_LIMIT, run_case
+from .benchmark import CONTROLLERS, FORCE_LIMIT, noise_generator, run_case
 from .data import EQ_INTENSITY, embedded_case, load_case, load_record, synthetic_record
 from .evaluation import J_NAMES
 
@@ -38,17 +38,21 @@ def parse_cases(text: str | Sequence[int]) -> list[int]:
 
 def run_benchmark(data: str | Path | None = None, record: str = "elcentro", cases: str | Sequence[int] = "1,2,3,4",
                   controller: str = "sample", perturbed: int = 0, seed: int = 0, scale: float = EQ_INTENSITY,
-                  workers: int | None = None, progress: bool = True, csi: str = "exact") -> dict[str, Any]:
+                  workers: int | None = None, progress: bool = True, csi: str = "exact",
+                  noise: str = "simulink") -> dict[str, Any]:
     """Runs the benchmark: per case the nominal trial (signals kept) and
     ``perturbed`` perturbed trials (through ``sh.sweep`` on one process pool).
 
     ``csi``: ``"exact"`` (a2 x', the spec's default) or ``"derivative-block"`` (the code's
     Simulink Derivative block, BENCHMARK.md 2.1).
+    ``noise``: ``"simulink"`` (the official SENSORS subsystem's generator; seed 0 is the
+    official run's realisation) or ``"mersenne"``.
     Without ``data``: the embedded default (published parameters, synthetic
     ground motion), labelled as not the benchmark's.
     Returns ``{"results": <results.json content>, "trials": {case: Trial}, "tables": {case: DataFrame}}``.
     """
     case_list = parse_cases(cases)
+    noise_generator(noise)
     if csi not in ("exact", "derivative-block"):
         raise ValueError(f"invalid csi = {csi!r}: expected 'exact' or 'derivative-block'")
     if controller not in CONTROLLERS:
@@ -65,7 +69,7 @@ def run_benchmark(data: str | Path | None = None, record: str = "elcentro", case
     meta = {"record": rec.name, "record_source": rec.source, "synthetic": rec.synthetic,
             "controller": controller, "controller_description": CONTROLLERS[controller][1],
             "eq_intensity": scale, "seed": seed, "perturbed_runs": int(perturbed), "fs_Hz": 4096,
-            "J_names": list(J_NAMES), "force_limit_N": FORCE_LIMIT, "csi": csi}
+            "J_names": list(J_NAMES), "force_limit_N": FORCE_LIMIT, "csi": csi, "noise": noise}
     if rec.synthetic:
         meta["label"] = SYNTHETIC_LABEL
     elif data is None:
@@ -82,7 +86,7 @@ def run_benchmark(data: str | Path | None = None, record: str = "elcentro", case
             case = load(n)
             out = run_case(case, rec, controller, perturbed=int(perturbed), seed=seed, scale=scale,
                            executor=executor, progress=False, keep_signals=True,
-                           csi_derivative_block=csi == "derivative-block")
+                           csi_derivative_block=csi == "derivative-block", noise=noise)
             nom = out["nominal"]
             entry: dict[str, Any] = {"nominal": {"J": nom["J"], "max_force_N": nom["max_force_N"],
                                                  "max_displacement_m": nom["max_displacement_m"],
@@ -186,9 +190,12 @@ def _write_all(run: dict[str, Any], out: Path, files: FileSet) -> None:
     lines = ["# RTHS benchmark (Silva et al. 2020)", ""]
     if meta.get("label"):
         lines += [f"**{meta['label']}**", ""]
+    noise = meta.get("noise", "simulink")
+    official = "; seed 0 is the official run's realisation" if noise == "simulink" and meta["seed"] == 0 else ""
     lines += [f"- record: {meta['record']} × {meta['eq_intensity']} ({meta['record_source']})",
               f"- controller: {meta['controller']}: {meta['controller_description']}",
-              f"- noise seed / perturbation seed: {meta['seed']}; perturbed runs per case: {meta['perturbed_runs']}",
+              f"- noise seed / perturbation seed: {meta['seed']} (noise generator: {noise}{official}); "
+              f"perturbed runs per case: {meta['perturbed_runs']}",
               f"- CSI: {meta['csi']} ({'a2 dx/dt' if meta['csi'] == 'exact' else 'the code Derivative block'})",
               "- J in the official code's order (F4_evaluation.m): J1 [ms], J2-J9 [%]; PSI = log10(tau_cr / ms)", ""]
     lines += [j_table(res), ""]

@@ -50,16 +50,44 @@ Converter benchmark_converter(Converter::Kind kind);
 //! An ideal converter (enabled = false; the saturation at +-DBL_MAX and no quantizer if it is enabled).
 Converter ideal_converter(Converter::Kind kind = Converter::Kind::AnalogToDigital);
 
-//! Standard normal draws, one per sample, from a seeded 64-bit Mersenne twister
-//! (Marsaglia polar method: the same sequence on every platform for one seed).
+//! Which generator draws the standard normals of the sensor noise.
+enum class NoiseGenerator {
+  //! A 64-bit Mersenne twister and the Marsaglia polar method, both variates of a pair used.
+  MersenneTwister,
+  //! The algorithm of Simulink's Random Number block, inside the Band-Limited White Noise
+  //! block that the benchmark's SENSORS subsystem uses: the block's seed scrambling, the
+  //! Lewis-Goodman-Miller "minimal standard" generator u <- 16807 u mod (2^31 - 1) (Park
+  //! and Miller 1988, by Schrage's method), uniforms u / (2^31 - 1), and the polar method
+  //! keeping one variate per accepted pair.  With the official run's seed this is the
+  //! official noise realisation, sample for sample (BENCHMARK.md section 3.2).
+  SimulinkRandomNumber,
+};
+
+//! Standard normal draws, one per sample, from a seeded generator (the same
+//! sequence on every platform for one seed and generator).
 class GaussianSequence {
  public:
-  explicit GaussianSequence(std::uint64_t seed = 0) noexcept { reset(seed); }
-  void reset(std::uint64_t seed) noexcept;
+  explicit GaussianSequence(std::uint64_t seed = 0,
+                            NoiseGenerator generator = NoiseGenerator::MersenneTwister) noexcept {
+    reset(seed, generator);
+  }
+  void reset(std::uint64_t seed, NoiseGenerator generator = NoiseGenerator::MersenneTwister) noexcept;
   double next() noexcept;  //!< w_k ~ N(0, 1)
+  NoiseGenerator generator() const noexcept { return generator_; }
+
+  //! The Random Number block's initial generator state for a seed (its
+  //! scrambling of the seed's 32 low bits, clamped to [1, 2^31 - 2]).
+  static std::uint32_t simulink_state(std::uint64_t seed) noexcept;
+  //! One uniform in (0, 1) from the Simulink stream (the Uniform Random Number
+  //! block's draw): advances the minimal-standard state and returns state / (2^31 - 1).
+  double simulink_uniform() noexcept;
+  //! The minimal-standard generator's state (Simulink generator).
+  std::uint32_t simulink_generator_state() const noexcept { return lcg_; }
 
  private:
+  NoiseGenerator generator_ = NoiseGenerator::MersenneTwister;
   std::mt19937_64 gen_;
+  std::uint32_t lcg_ = 1;
   double spare_ = 0.0;
   bool has_spare_ = false;
 };

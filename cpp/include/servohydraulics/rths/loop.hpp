@@ -31,6 +31,7 @@ struct RthsLoopConfig {
   SensorNoise force_noise{2.1797614548385793};  //!< sigma = sqrt(1.16e-3 * 4096) N (F1 L177)
   bool independent_noise = false;         //!< false: one w_k for both channels, as the official code
   std::uint64_t seed = 0;                 //!< of the noise generator(s)
+  NoiseGenerator generator = NoiseGenerator::MersenneTwister;  //!< which generator draws w_k
   void validate() const;
 };
 
