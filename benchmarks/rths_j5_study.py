@@ -1,13 +1,17 @@
-"""The J5 study of docs/rths-benchmark.md ("The J5 gap"): the seed-to-seed spread of
-the case-1 nominal row, and the spec readings tried against the published Table 3 row.
+"""The J5 study of docs/rths-benchmark.md ("J5 and the official noise realisation"):
+the case-1 nominal row with the official run's noise, the seed-to-seed spread with
+other noise, and the spec readings tried against the published Table 3 row.
 
     PYTHONPATH=python SERVOHYDRAULICS_CORE_DIR=build/dev python benchmarks/rths_j5_study.py \
-        --data ../shared/rths-data/mat [--seeds 60]
+        --data ../shared/rths-data/mat [--seeds 60] [--readings]
 
-Part 1 runs the C++ loop (rths.run_trial) over noise seeds, with the exact CSI
-(default) and with the code's Derivative block on the CSI.  Part 2 re-implements
-the loop of BENCHMARK.md 5.4 in Python on the same C++ blocks (plant, substructure,
-controller), with one reading changed at a time, 6 seeds each."""
+Part 0 runs the C++ loop with the Simulink Random Number block's generator at seed
+0, the official run's realisation (BENCHMARK.md 3.2), exact CSI and the code's
+Derivative block.  Part 1 runs it over noise seeds of a Mersenne twister and of the
+Simulink generator: how often J3 and J5 land on the published values by chance.
+Part 2 (--readings, about 10 min) re-implements the loop of BENCHMARK.md 5.4 in
+Python on the same C++ blocks (plant, substructure, controller), with one reading
+changed at a time, 6 seeds each (numpy noise)."""
 
 from __future__ import annotations
 
@@ -28,18 +32,36 @@ def fmt(v) -> str:
     return " ".join(f"{x:6.2f}" for x in v)
 
 
-def seed_spread(case, rec, ref, seeds: int) -> None:
-    print(f"{'published':34s} {fmt(PUBLISHED)}")
+def rounded(v) -> np.ndarray:
+    """J as a printed table shows them: sprintf('%.1f') of the double (so 14.85, which is
+    14.8499... in binary, prints 14.8)."""
+    return np.vectorize(lambda x: float(f"{x:.1f}"))(np.asarray(v, dtype=float))
+
+
+def official(case, rec, ref) -> None:
+    print(f"{'published':44s} {fmt(PUBLISHED)}")
     for csi in (False, True):
-        p = nominal_plant()
-        p.csi_derivative_block = csi
-        Js = np.array([rths.run_trial(case, rec, "sample", plant=p, seed=s, reference=ref).J for s in range(seeds)])
-        name = "CSI Derivative block" if csi else "exact CSI (default)"
-        print(f"{name + f', mean of {seeds}':34s} {fmt(Js.mean(0))}")
-        print(f"{'  sd':34s} {fmt(Js.std(0, ddof=1))}")
-        j5 = np.floor(10 * Js[:, 4] + 0.5) / 10
-        print(f"  J5 min {Js[:, 4].min():.2f} max {Js[:, 4].max():.2f}; seeds rounding to >= 19.0: "
-              f"{int((j5 >= 19.0).sum())} of {seeds}")
+        p = nominal_plant(csi)
+        J = rths.run_trial(case, rec, "sample", plant=p, seed=0, reference=ref, noise="simulink").J
+        name = "Simulink noise, seed 0, " + ("CSI Derivative block" if csi else "exact CSI (default)")
+        hits = int(np.sum(np.abs(rounded(J[1:]) - PUBLISHED[1:]) < 1e-9)) + int(abs(J[0] - PUBLISHED[0]) < 1e-9)
+        print(f"{name:44s} {fmt(J)}   ({hits} of 9 equal to the published row at its precision)")
+
+
+def seed_spread(case, rec, ref, seeds: int) -> None:
+    for noise in ("mersenne", "simulink"):
+        for csi in (False, True):
+            p = nominal_plant(csi)
+            first = 1 if noise == "simulink" else 0  # Simulink seed 0 is the official run, shown above
+            Js = np.array([rths.run_trial(case, rec, "sample", plant=p, seed=s, reference=ref, noise=noise).J
+                           for s in range(first, first + seeds)])
+            name = f"{noise} seeds {first}-{first + seeds - 1}, " + ("CSI Derivative block" if csi else "exact CSI")
+            print(f"{name:44s} {fmt(Js.mean(0))}  (mean)")
+            print(f"{'  sd':44s} {fmt(Js.std(0, ddof=1))}")
+            r = rounded(Js)
+            j3, j5 = r[:, 2] == PUBLISHED[2], r[:, 4] == PUBLISHED[4]
+            print(f"  J5 min {Js[:, 4].min():.2f} max {Js[:, 4].max():.2f}; seeds with J3 = 11.5: {int(j3.sum())}, "
+                  f"J5 = 19.0: {int(j5.sum())}, both: {int((j3 & j5).sum())} of {seeds}", flush=True)
 
 
 def py_loop(case, rec, seed, ag_hold=False, csi=False, force_delay=1, noise=True):
@@ -98,11 +120,14 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--data", required=True)
     ap.add_argument("--seeds", type=int, default=60)
+    ap.add_argument("--readings", action="store_true", help="also part 2, the Python loop's spec readings (~10 min)")
     a = ap.parse_args()
     case, rec = rths.load_case(a.data, 1), rths.load_record(a.data, "elcentro")
     ref = rths.case_reference(case, rec)
+    official(case, rec, ref)
     seed_spread(case, rec, ref, a.seeds)
-    readings(case, rec, ref)
+    if a.readings:
+        readings(case, rec, ref)
 
 
 if __name__ == "__main__":
