@@ -95,6 +95,7 @@ def run_benchmark(data: str | Path | None = None, record: str = "elcentro", case
                 p = out["perturbed"]
                 entry["perturbed"] = {"J_mean": p["J_mean"], "J_std": p["J_std"], "runs": p["runs"]}
                 meta.setdefault("perturbed_stable", {})[str(n)] = p["stable"]
+                meta.setdefault("perturbed_ran_to_end", {})[str(n)] = p["ran_to_end"]
                 meta.setdefault("perturbed_capacity_exceeded", {})[str(n)] = p["capacity_exceeded"]
                 tables[n] = out["table"]
             meta.setdefault("case_source", {})[str(n)] = case.source
@@ -203,6 +204,7 @@ def _write_all(run: dict[str, Any], out: Path, files: FileSet) -> None:
     lines += [f"Actuator capacity (max|f| >= {FORCE_LIMIT / 1e3:.1f} kN) exceeded in the nominal trial of case(s): "
               f"{', '.join(flagged) if flagged else 'none'}."]
     if "perturbed_stable" in meta:
-        lines += [f"Perturbed trials that ran to the end (stable), per case: {meta['perturbed_stable']}."]
+        lines += [f"Perturbed trials that were stable (ran to the end with J2 < 100 %), per case: "
+                  f"{meta['perturbed_stable']}; that ran to the end: {meta.get('perturbed_ran_to_end', {})}."]
     lines += ["", "![tracking](tracking.png)", "", "![criteria](criteria.png)", ""]
     files.write_text(out / "report.md", "\n".join(lines))
