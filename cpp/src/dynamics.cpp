@@ -114,7 +114,16 @@ double Dynamics::state_scale(int i) const noexcept {
   if (i == L.bw_z) return 1e-6;                  // [m], as the LuGre bristle
   if (i == L.mr_y) return 1e-3;                  // [m], as x
   if (L.mr_y >= 0 && i == L.mr_y + 1) return 1e-6;  // [m]
-  return 1e-3;                                   // Pade states [V]
+  if (L.pade >= 0 && i >= L.pade && i < L.pade + L.pade_order) {
+    // Pade state q_k [V]: the full-scale drive (the one that opens the valve fully)
+    // over the largest coefficient through which q_k acts (the denominator a_k on the
+    // chain, the output row c_k on the drive), so that its tolerance weighs the drive
+    // error it makes, as the valve states' tolerances do.
+    const int k = i - L.pade;
+    const double drive = rig_.x_v_max / rig_.K_s;
+    return drive / std::max({1.0, std::fabs(pade_.a[k]), std::fabs(pade_.c[k])});
+  }
+  return 1e-3;
 }
 
 double Dynamics::static_force(double x) const noexcept {
