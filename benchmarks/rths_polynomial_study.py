@@ -16,6 +16,7 @@ force passed the 8.9 kN capacity (diverged).  About 1 min per design on one core
 from __future__ import annotations
 
 import argparse
+from functools import partial
 
 import numpy as np
 
@@ -23,15 +24,6 @@ from servohydraulics import rths
 from servohydraulics.rths import benchmark as B
 
 DESIGNS = ((2, 16), (1, 16), (1, 32), (2, 32), (2, 48), (3, 32))
-
-
-def controller(order: int, stride: int):
-    def make(plant, dt):
-        c = B.R.PolynomialConfig()
-        c.dt, c.tau, c.order, c.stride = dt, B.R.plant_delay(plant), order, stride
-        c.static_gain = plant.numerator() / plant.denominator()[5]
-        return B.R.PolynomialExtrapolation(c)
-    return make
 
 
 def main() -> None:
@@ -47,7 +39,7 @@ def main() -> None:
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     try:
         for order, stride in DESIGNS:
-            B.CONTROLLERS["polynomial"] = (controller(order, stride), saved[1])
+            B.CONTROLLERS["polynomial"] = (partial(B.polynomial_controller, order=order, stride=stride), saved[1])
             w = np.asarray(B.make_controller("polynomial").weights)
             nom = [rths.run_trial(cases[c], rec, "polynomial", seed=a.seed, reference=refs[c]).J for c in cases]
             worst, bad = 0.0, []

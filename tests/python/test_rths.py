@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+from functools import partial
 
 import numpy as np
 import pytest
@@ -162,15 +163,9 @@ def test_a_diverging_trial_is_not_stable(data, monkeypatch):
     case, rec = rths.load_case(data, 4), rths.load_record(data, "elcentro")
     plant = B.perturbed_plant(0, 4, 20)
 
-    def quadratic(p, dt):
-        c = rths.core.PolynomialConfig()
-        c.dt, c.tau, c.order, c.stride = dt, rths.core.plant_delay(p), 2, 16
-        c.static_gain = p.numerator() / p.denominator()[5]
-        return rths.core.PolynomialExtrapolation(c)
-
     good = rths.run_trial(case, rec, "polynomial", plant=plant)
     assert good.ok and good.stable and good.J[1] < 5.0
-    monkeypatch.setitem(B.CONTROLLERS, "polynomial", (quadratic, "quadratic"))
+    monkeypatch.setitem(B.CONTROLLERS, "polynomial", (partial(B.polynomial_controller, order=2), "quadratic"))
     bad = rths.run_trial(case, rec, "polynomial", plant=plant)
     assert bad.ok and not bad.stable and bad.max_force_N > 100 * B.FORCE_LIMIT
 

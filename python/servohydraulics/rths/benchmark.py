@@ -18,7 +18,8 @@ from .evaluation import evaluate, psi, reference_response
 R = _core.rths
 
 __all__ = ["CONTROLLERS", "make_controller", "nominal_plant", "perturbed_plant", "partition", "Trial",
-           "run_trial", "run_case", "trial_seed", "FORCE_LIMIT", "NOISE_GENERATORS", "noise_generator"]
+           "run_trial", "run_case", "trial_seed", "FORCE_LIMIT", "NOISE_GENERATORS", "noise_generator",
+           "polynomial_controller"]
 
 FORCE_LIMIT = 8900.0  #: the benchmark's actuator capacity check on max|f| [N] (F4_evaluation.m L60-62)
 STROKE_LIMIT = 7e-3   #: paper limit (not checked by the code) [m]
@@ -65,16 +66,22 @@ def _sample(plant, dt):
     return R.SampleController(R.SampleControllerConfig())
 
 
-def _polynomial(plant, dt):
+def polynomial_controller(plant, dt, order: int = 1, stride: int = 16):
+    """The polynomial extrapolation designed on ``plant``: lead tau = A1/A0 (plant_delay), a
+    Lagrange polynomial of ``order`` through points ``stride`` samples apart, plus the PI."""
     c = R.PolynomialConfig()
     c.dt = dt
     c.tau = R.plant_delay(plant)
-    # First order: its gain at Nyquist is 1 + 2 tau / (16 h) = 13.8; the quadratic's is 109,
+    # First order by default: its gain at Nyquist is 1 + 2 tau / (16 h) = 13.8; the quadratic's is 109,
     # which lost one of 80 perturbed plants at 59 Hz (benchmarks/rths_polynomial_study.py).
-    c.order = 1
-    c.stride = 16
+    c.order = order
+    c.stride = stride
     c.static_gain = plant.numerator() / plant.denominator()[5]
     return R.PolynomialExtrapolation(c)
+
+
+def _polynomial(plant, dt):
+    return polynomial_controller(plant, dt)
 
 
 def _ats(plant, dt):
