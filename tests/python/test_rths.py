@@ -187,6 +187,12 @@ def test_cli_embedded_default_is_labelled(tmp_path, capsys):
     assert res["meta"]["synthetic"] is True
     assert "NOT the benchmark" in (tmp_path / "report.md").read_text()
     assert (tmp_path / "tracking.png").is_file() and (tmp_path / "criteria.png").is_file()
+    assert res["meta"]["noise"] == "simulink" and "official run's realisation" in (tmp_path / "report.md").read_text()
+    other = tmp_path / "mersenne"
+    assert main(["rths-benchmark", "--cases", "1", "--controller", "model", "--noise", "mersenne", "--quiet",
+                 "--out", str(other)]) == 0
+    res2 = json.loads((other / "results.json").read_text())
+    assert res2["meta"]["noise"] == "mersenne" and res2["cases"]["1"]["nominal"]["J"] != nom["J"]
 
 
 def test_cli_bad_input_names_the_field(tmp_path, capsys):
