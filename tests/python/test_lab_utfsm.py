@@ -85,9 +85,9 @@ CURRENT = {"0A": 0.0, "1A": 1.0}
 #: held-out cases where ours still loses (docs/lab-records.md says why); strict: a win fails
 #: the test until this table is updated
 KNOWN_LOSSES = {("chirp20Hz_0A", "sweep15Hz_0A", "force"):
-                "the June 0 A damper forces are 1.5 x the May ones (best gain 0.66)",
+                "the measured June 0 A |F/x| is 1.50-1.60 x the May one at 2-14 Hz (benchmarks/utfsm_losses.py)",
                 ("chirp20Hz_1A", "sweep15Hz_1A", "force"):
-                "the chirp-fitted hysteresis lags the May sweep's by 1-6 ms"}
+                "the measured June 1 A force lags the May one by 3-7.5 deg at 2-14 Hz (benchmarks/utfsm_losses.py)"}
 
 
 @functools.lru_cache(maxsize=None)
