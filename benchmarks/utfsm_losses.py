@@ -154,7 +154,7 @@ def cut_below(rec, f_max: float):
 
 
 def band(sh, lab, fit_options) -> None:
-    from servohydraulics.lab import generic, keys
+    from servohydraulics.lab import keys
     from servohydraulics.lab.frf import command_band
 
     default = keys.LOOP_KEYS["displacement"] + keys.SPECIMEN_KEYS["mr_damper"]
@@ -167,13 +167,7 @@ def band(sh, lab, fit_options) -> None:
         if train == "chirp20Hz_1A":
             runs.append(("extra keys", {"measurement_delay_force": 1e-3, "mr_k0": 1e3}, default + extra))
         for label, start, fit in runs:
-            rig = None
-            if start is not None:
-                rig = generic.generic_rig(cut)
-                generic.mr_damper_start(rig, cut)
-                rig.effects.mr_damper = True
-                for k, v in start.items():
-                    setattr(rig, k, v)
+            rig = None if start is None else started_rig(cut, start)
             ident = sh.identify([cut], rig=rig, fit=fit, mode="displacement", specimen="mr_damper", progress=False)
             pred, whole = (lab.compare(r, ident.rig, "displacement",
                                        options=fit_options(ident.rig, [r], "displacement")) for r in (held, rec))
@@ -183,8 +177,20 @@ def band(sh, lab, fit_options) -> None:
                   f"{whole.nrmse('force'):.2f} %")
 
 
+def started_rig(record, start: dict):
+    """The generic rig scaled from ``record`` with the MR damper's start, then the ``start`` keys."""
+    from servohydraulics.lab import generic
+
+    rig = generic.generic_rig(record)
+    generic.mr_damper_start(rig, record)
+    rig.effects.mr_damper = True
+    for k, v in start.items():
+        setattr(rig, k, v)
+    return rig
+
+
 def extra_keys(sh, lab, fit_options) -> None:
-    from servohydraulics.lab import generic, keys
+    from servohydraulics.lab import keys
 
     from servohydraulics.lab import baselines
 
@@ -194,11 +200,7 @@ def extra_keys(sh, lab, fit_options) -> None:
     for label, start, fit in (("extra keys", {"measurement_delay_force": 1e-3, "mr_k0": 1e3}, default + extra),
                               ("thesis start", baselines.spencer_rig_keys(baselines.thesis_mr_parameters(1.0)),
                                default)):
-        rig = generic.generic_rig(train)
-        generic.mr_damper_start(rig, train)
-        rig.effects.mr_damper = True
-        for k, v in start.items():
-            setattr(rig, k, v)
+        rig = started_rig(train, start)
         ident = sh.identify([train], rig=rig, fit=fit, mode="displacement", specimen="mr_damper", progress=False)
         pred = lab.compare(test, ident.rig, "displacement", options=fit_options(ident.rig, [test], "displacement"))
         print(f"chirp20Hz_1A, {label}: " + ", ".join(f"{k} = {ident.values[k]:.4g}" for k in fit[3:])
