@@ -32,22 +32,29 @@ def _frame(M, K, a, b, yielding=None):
     return rths.spring_model(M, K, rayleigh=(a, b), yielding=yielding)
 
 
+
+def _step_both(ours, osp, n: int, seed: int) -> tuple[float, float]:
+    """Steps our substructure and the OpenSees one n samples with the same rough ground
+    motion [m/s^2] and interface force [N]: (worst difference, peak) of the displacements [m]."""
+    rng = np.random.default_rng(seed)
+    ag = np.cumsum(rng.standard_normal(n + 1)) * 0.05
+    f = np.cumsum(rng.standard_normal(n + 1)) * 20.0
+    worst, peak = 0.0, 0.0
+    for k in range(n):
+        ours.step(ag[k], 0.5 * (ag[k] + ag[k + 1]), ag[k + 1], f[k])
+        osp.step(ag[k], 0.5 * (ag[k] + ag[k + 1]), ag[k + 1], f[k])
+        x = np.asarray(ours.displacement)
+        worst = max(worst, float(np.max(np.abs(np.asarray(osp.displacements()) - x))))
+        peak = max(peak, float(np.max(np.abs(x))))
+    return worst, peak
+
 def test_linear_opensees_model_equals_our_substructure_step_by_step():
     case, M, K, a, b = _matrices()
     g = np.diag(case.M).copy()
     ours = R.LinearSubstructure(R.LinearSubstructureModel(M, a * M + b * K, K, g, np.array([1.0, 0, 0])), rths.DT,
                                 R.SubstructureScheme.CentralDifference)
     osp = rths.OpenSeesSubstructure(_frame(M, K, a, b), dofs=[(1, 1), (2, 1), (3, 1)], ground=g, interface=0)
-    rng = np.random.default_rng(4)
-    ag = np.cumsum(rng.standard_normal(4097)) * 0.05  # a rough ground motion [m/s^2]
-    f = np.cumsum(rng.standard_normal(4097)) * 20.0   # and interface force [N]
-    worst, peak = 0.0, 0.0
-    for k in range(4096):
-        ours.step(ag[k], 0.5 * (ag[k] + ag[k + 1]), ag[k + 1], f[k])
-        osp.step(ag[k], 0.5 * (ag[k] + ag[k + 1]), ag[k + 1], f[k])
-        x = np.asarray(ours.displacement)
-        worst = max(worst, float(np.max(np.abs(np.asarray(osp.displacements()) - x))))
-        peak = max(peak, float(np.max(np.abs(x))))
+    worst, peak = _step_both(ours, osp, 4096, seed=4)
     print(f"OpenSees vs ours, central difference, 1 s at 4096 Hz: worst {worst:.3g} m of peak {peak:.3g} m")
     assert peak > 1e-4 and worst <= 1e-9 * peak
 
@@ -205,16 +212,7 @@ def test_opensees_frame_is_the_benchmark_structure_and_steps_as_ours():
                                 R.SubstructureScheme.AverageAcceleration)
     osp = rths.OpenSeesSubstructure(_benchmark_frame(np.diag(Mn), alpha, sp.k), dofs=[(10, 1), (20, 1), (30, 1)],
                                     ground=g, scheme="newmark")
-    rng = np.random.default_rng(5)
-    ag = np.cumsum(rng.standard_normal(2049)) * 0.05
-    f = np.cumsum(rng.standard_normal(2049)) * 20.0
-    worst, peak = 0.0, 0.0
-    for k in range(2048):
-        ours.step(ag[k], 0.5 * (ag[k] + ag[k + 1]), ag[k + 1], f[k])
-        osp.step(ag[k], 0.5 * (ag[k] + ag[k + 1]), ag[k + 1], f[k])
-        x = np.asarray(ours.displacement)
-        worst = max(worst, float(np.max(np.abs(np.asarray(osp.displacements()) - x))))
-        peak = max(peak, float(np.max(np.abs(x))))
+    worst, peak = _step_both(ours, osp, 2048, seed=5)
     print(f"OpenSees frame vs ours, average acceleration, 0.5 s: worst {worst:.3g} m of peak {peak:.3g} m")
     assert peak > 1e-4 and worst <= 1e-6 * peak  # A = 100 m^2: axial flexibility ~1e-8 of the lateral
     # ... and in the RTHS loop, with the benchmark plant and the sample controller
