@@ -7,7 +7,7 @@ other noise, and the spec readings tried against the published Table 3 row.
 
 Part 0 runs the C++ loop with the Simulink Random Number block's generator at seed
 0, the official run's realisation (BENCHMARK.md 3.2), exact CSI and the code's
-Derivative block.  Part 1 runs it over noise seeds of a Mersenne twister and of the
+Derivative block, and prints the largest peaks of |X_m - Ref1| without noise.  Part 1 runs it over noise seeds of a Mersenne twister and of the
 Simulink generator: how often J3 and J5 land on the published values by chance.
 Part 2 (--readings, about 10 min) re-implements the loop of BENCHMARK.md 5.4 in
 Python on the same C++ blocks (plant, substructure, controller), with one reading
@@ -46,6 +46,22 @@ def official(case, rec, ref) -> None:
         name = "Simulink noise, seed 0, " + ("CSI Derivative block" if csi else "exact CSI (default)")
         hits = int(np.sum(np.abs(rounded(J[1:]) - PUBLISHED[1:]) < 1e-9)) + int(abs(J[0] - PUBLISHED[0]) < 1e-9)
         print(f"{name:44s} {fmt(J)}   ({hits} of 9 equal to the published row at its precision)")
+
+
+def noiseless_peaks(case, rec, ref, count: int = 3, apart: float = 0.05) -> None:
+    """The largest peaks of |X_m - Ref1| without sensor noise (the Python loop, part 2's
+    "no sensor noise" reading), at least ``apart`` seconds from each other: J5 is the
+    largest of them once each is raised by the noise sample there."""
+    xm, _ = py_loop(case, rec, 0, noise=False)
+    e = np.abs(xm - ref[: xm.size, 0])
+    picked: list[int] = []
+    for k in np.argsort(-e):
+        if all(abs(int(k) - j) * DT >= apart for j in picked):
+            picked.append(int(k))
+        if len(picked) == count:
+            break
+    print("no noise, largest peaks of |X_m - Ref1|: "
+          + ", ".join(f"{1e6 * e[k]:.0f} um at {k * DT:.2f} s" for k in picked))
 
 
 def seed_spread(case, rec, ref, seeds: int) -> None:
@@ -125,6 +141,7 @@ def main() -> None:
     case, rec = rths.load_case(a.data, 1), rths.load_record(a.data, "elcentro")
     ref = rths.case_reference(case, rec)
     official(case, rec, ref)
+    noiseless_peaks(case, rec, ref)
     seed_spread(case, rec, ref, a.seeds)
     if a.readings:
         readings(case, rec, ref)

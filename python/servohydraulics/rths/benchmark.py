@@ -66,16 +66,17 @@ def _sample(plant, dt):
     return R.SampleController(R.SampleControllerConfig())
 
 
-def polynomial_controller(plant, dt, order: int = 1, stride: int = 16):
+def polynomial_controller(plant, dt, order: int | None = None, stride: int | None = None):
     """The polynomial extrapolation designed on ``plant``: lead tau = A1/A0 (plant_delay), a
-    Lagrange polynomial of ``order`` through points ``stride`` samples apart, plus the PI."""
+    Lagrange polynomial of ``order`` through points ``stride`` samples apart, plus the PI.
+    ``None``: the core's defaults (first order, stride 16; PolynomialConfig says why)."""
     c = R.PolynomialConfig()
     c.dt = dt
     c.tau = R.plant_delay(plant)
-    # First order by default: its gain at Nyquist is 1 + 2 tau / (16 h) = 13.8; the quadratic's is 109,
-    # which lost one of 80 perturbed plants at 59 Hz (benchmarks/rths_polynomial_study.py).
-    c.order = order
-    c.stride = stride
+    if order is not None:
+        c.order = order
+    if stride is not None:
+        c.stride = stride
     c.static_gain = plant.numerator() / plant.denominator()[5]
     return R.PolynomialExtrapolation(c)
 
