@@ -55,11 +55,12 @@ from .simulate import make_plant, simulate, solver_options  # noqa: E402
 __version__ = "0.1.0"
 
 #: Lazily imported submodules (first attribute access imports them).
-_SUBMODULES = ("analysis", "identify", "excitations", "sweep", "plots", "diagnosis", "paper")
+_SUBMODULES = ("analysis", "identification", "excitations", "sweep", "plots", "diagnosis", "paper")
 
 #: Lazily resolved names: name -> (module, attribute).
 _LAZY = {
     "linearize": (".analysis", "linearize"),
+    "identify": (".identification", "identify"),
     "sweep": (".sweep", "sweep"),
     "summary_run": (".sweep", "summary_run"),
     "diagnose": (".diagnosis", "diagnose"),
@@ -101,13 +102,16 @@ def __dir__():
 
 
 class _Package(_types.ModuleType):
-    """``sh.sweep`` is the function although a submodule of the same name
-    exists (``sweep.py``): importing that submodule must not rebind the package
-    attribute to the module.  The submodule stays importable by its name
+    """``sh.sweep`` and ``sh.identify`` are functions although submodules of the
+    same names exist (``sweep.py``; ``identify.py``, a deprecated alias of
+    ``identification``): importing such a submodule must not rebind the package
+    attribute to the module.  The submodules stay importable by their names
     (``importlib.import_module``, ``from servohydraulics.sweep import ...``)."""
 
     sweep = property(lambda self: _resolve("sweep"), lambda self, value: None,
                      doc="servohydraulics.sweep, resolved on first use")
+    identify = property(lambda self: _resolve("identify"), lambda self, value: None,
+                        doc="servohydraulics.identification.identify, resolved on first use")
 
 
 _sys.modules[__name__].__class__ = _Package

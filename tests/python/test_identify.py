@@ -7,7 +7,7 @@ import pytest
 
 import servohydraulics as sh
 from servohydraulics import analysis as an
-from servohydraulics import identify as idf
+from servohydraulics.identification import paper as idf
 
 
 def free_record(seed: int, sigma: float = 5e-5, duration: float = 5.0, dt: float = 2e-3):
