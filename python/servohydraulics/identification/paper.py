@@ -4,9 +4,8 @@
   damping c and Coulomb friction F_c of Eq (5) fitted by least squares on the
   simulation error of the C++ free-structure model (released from rest at x0,
   or driven by a measured force: the paper's forced-vibration tests with the
-  actuator attached), with standard errors from the Jacobian and the residual
-  variance, inflated for autocorrelated residuals by the AR(1) effective sample
-  size.
+  actuator attached), with standard errors from the HAC sandwich covariance of
+  :mod:`.stats` (the package's one rule).
 * :func:`identify_first_order`: the equivalent first-order roll-off and delay
   of a displacement-controlled actuator from a sweep record (Eq 13: 1.96 Hz,
   81 ms in the paper).
@@ -34,7 +33,7 @@ from ..response import uniform_dt
 from ..rig import Rig, copy_rig
 from ..simulate import make_plant, solver_options
 from .frf import dft_ratio
-from .stats import ar1_coefficient, ar1_effective_n, quantile
+from .stats import ar1_coefficient, ar1_effective_n, covariance, quantile
 
 
 @dataclass
@@ -113,10 +112,10 @@ def identify_damping_friction(time: ArrayLike, displacement: ArrayLike, rig: Rig
 
     The simulation error x_sim(c, F_c) - x_meas is minimised with
     ``scipy.optimize.least_squares`` (trust region reflective).  The
-    covariance s^2 (J^T J)^-1 uses the residual variance s^2; it is inflated
-    by (n - 2)/(n_eff - 2), n_eff = n (1 - rho1)/(1 + rho1), so that
-    correlated residuals (model error, coloured noise) do not give
-    overconfident intervals.
+    covariance is the package's one rule, the HAC sandwich of
+    :func:`.stats.covariance`, so that correlated residuals (model error,
+    coloured noise) do not give overconfident intervals; ``n_eff`` and
+    ``rho1`` summarise the residual's AR(1) autocorrelation.
     """
     dt = _uniform_dt(time)
     x = np.asarray(displacement, dtype=float)
@@ -149,11 +148,9 @@ def identify_damping_friction(time: ArrayLike, displacement: ArrayLike, rig: Rig
     res = sol.fun
     J = sol.jac / scale  # d res / d (c, F_c[, x0])
     p = J.shape[1]
-    s2 = float(res @ res) / (n - p)
     rho = ar1_coefficient(res)
     n_eff = ar1_effective_n(res.size, rho)
-    inflate = (n - p) / max(n_eff - p, 1.0)
-    cov_all = s2 * inflate * np.linalg.pinv(J.T @ J)
+    cov_all = covariance(J, res, scale).matrix
     cov = cov_all[:2, :2]
     q = sol.x * scale
     c, fc = float(q[0]), float(q[1])
