@@ -27,12 +27,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import least_squares
 
-from .. import _core
 from ..excitations import TWO_PI, linear_chirp
-from ..response import uniform_dt
+from ..response import SimulationError, uniform_dt
 from ..rig import Rig, copy_rig
-from ..simulate import make_plant, solver_options
+from ..simulate import solver_options
 from .frf import dft_ratio
+from .run import simulate_command
 from .stats import ar1_coefficient, ar1_effective_n, covariance, quantile
 
 
@@ -75,11 +75,13 @@ def simulate_structure(rig: Rig, c: float, F_c: float, n: int, dt: float, x0: fl
     r = copy_rig(rig)
     r.c, r.F_c = float(c), float(F_c)
     r.effects.coulomb_friction = True
-    plant = make_plant(r, "free", dt, solver_options(rtol=rtol, max_steps_per_sample=20000), x0)
     u = np.zeros(n) if force is None else _interval_mean(np.asarray(force, dtype=float))
-    channels, s = _core.run_record(plant, u)
-    x = np.asarray(channels["displacement"])
-    if s.rows < n or not np.all(np.isfinite(x[:n])):
+    try:
+        res = simulate_command(r, "free", u, dt, x0, solver_options(rtol=rtol, max_steps_per_sample=20000))
+    except SimulationError:
+        return np.full(n, np.nan)
+    x = res.displacement
+    if x.size < n or not np.all(np.isfinite(x[:n])):
         return np.full(n, np.nan)
     return x[:n]
 
