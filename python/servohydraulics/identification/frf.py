@@ -63,14 +63,20 @@ def default_nperseg(n: int) -> int:
     return 2 ** int(math.floor(math.log2(n / 6)))
 
 
-def h1(command: ArrayLike, output: ArrayLike, dt: float, nperseg: int | None = None) -> FrequencyResponse:
-    """H1 estimate output/command and coherence of one record sampled at dt [s]."""
+def _signals(command: ArrayLike, output: ArrayLike, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """The command and output as float arrays, checked: 1-D, the same shape, dt finite and > 0."""
     u = np.asarray(command, dtype=float)
     y = np.asarray(output, dtype=float)
     if u.shape != y.shape or u.ndim != 1:
         raise ValueError(f"invalid output shape = {y.shape}: must be 1-D and match the command {u.shape}")
     if not (math.isfinite(dt) and dt > 0):
         raise ValueError(f"invalid dt = {dt!r}: must be finite and > 0 [s]")
+    return u, y
+
+
+def h1(command: ArrayLike, output: ArrayLike, dt: float, nperseg: int | None = None) -> FrequencyResponse:
+    """H1 estimate output/command and coherence of one record sampled at dt [s]."""
+    u, y = _signals(command, output, dt)
     n = int(nperseg) if nperseg is not None else default_nperseg(u.size)
     if not 16 <= n <= u.size:
         raise ValueError(f"invalid nperseg = {n}: must be in [16, {u.size}] (the record's length)")
@@ -94,12 +100,7 @@ def dft_ratio(command: ArrayLike, output: ArrayLike, dt: float, min_level: float
     ``from_rest``: the first sample of each signal is removed first (the record starts at
     rest there; the sweep must also end at rest, faded out, so that no window is needed).
     The response is NaN where |U| < ``min_level`` max|U| (outside the sweep, ``excited``)."""
-    u = np.asarray(command, dtype=float)
-    y = np.asarray(output, dtype=float)
-    if u.shape != y.shape or u.ndim != 1:
-        raise ValueError(f"invalid output shape = {y.shape}: must be 1-D and match the command {u.shape}")
-    if not (math.isfinite(dt) and dt > 0):
-        raise ValueError(f"invalid dt = {dt!r}: must be finite and > 0 [s]")
+    u, y = _signals(command, output, dt)
     if from_rest:
         y, u = y - y[0], u - u[0]
     Y, U = np.fft.rfft(y), np.fft.rfft(u)
