@@ -10,17 +10,8 @@ import warnings as _warnings
 
 import numpy as _np
 
-from .excitations import linear_chirp  # noqa: F401
 from .identification.frf import dft_ratio as _dft_ratio
-from .identification.paper import (  # noqa: F401
-    FirstOrderEstimate,
-    FreeVibration,
-    FrictionEstimate,
-    identify_damping_friction,
-    identify_first_order,
-    identify_free_vibration,
-    simulate_structure,
-)
+from .identification.paper import *  # noqa: F403 (the paper-era fits under their old module)
 from .identification.stats import ar1_coefficient, ar1_effective_n, lag1_autocorrelation  # noqa: F401
 from .response import uniform_dt as _uniform_dt
 

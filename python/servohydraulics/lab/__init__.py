@@ -22,24 +22,5 @@ for _old, _new in _MOVED.items():
     _sys.modules[f"{__name__}.{_old}"] = _module
     globals()[_old] = _module
 
-from ..identification import (  # noqa: E402
-    LOOP_KEYS,
-    SPECIMEN_KEYS,
-    Comparison,
-    FrequencyResponse,
-    Identification,
-    compare,
-    generic_rig,
-    h1,
-    identify,
-    nrmse_demeaned_pct,
-    nrmse_pct,
-    simulate_record,
-    thesis_displacement,
-    thesis_mr_force,
-    thesis_mr_parameters,
-)
-
-__all__ = ["LOOP_KEYS", "SPECIMEN_KEYS", "Comparison", "FrequencyResponse", "Identification", "compare",
-           "generic_rig", "h1", "identify", "nrmse_demeaned_pct", "nrmse_pct", "simulate_record",
-           "thesis_displacement", "thesis_mr_force", "thesis_mr_parameters"]
+from ..identification import *  # noqa: E402, F403 (every name of the package under its old one)
+from ..identification import __all__  # noqa: E402, F401
