@@ -236,6 +236,40 @@ def _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar
     return z, nfev
 
 
+def _setup(records, rig, fit, mode: str, specimen: str, channels) -> tuple[list, Rig, bool, tuple, tuple]:
+    """(records, start rig, generic start?, keys, channels), validated."""
+    if mode not in LOOP_KEYS:
+        raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(LOOP_KEYS)}")
+    recs = as_records(records)
+    spec = specimen_keys(specimen)
+    start, generic = _start_rig(rig, recs)
+    if generic:
+        specimen_start(start, recs[0], specimen)
+    use_specimen(start, specimen)
+    keys = check_keys(start, fit if fit is not None else LOOP_KEYS[mode] + spec)
+    chans = tuple(channels) if channels is not None else channels_of(recs[0], mode)
+    for r in recs:
+        missing = [c for c in chans if c not in channels_of(r, mode)]
+        if missing:
+            raise ValueError(f"record {r.path or '?'}: channel(s) {missing} absent or constant")
+    return recs, start, generic, keys, chans
+
+
+def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options, dt, max_nfev, progress, workers):
+    """Stage 2 from stage 1's z1 (again from the start when that ends worse than the start), then
+    ``fit.keep_best`` of the start and the stages; returns keep_best's result and the evaluations."""
+    from tqdm.auto import tqdm
+
+    with tqdm(desc="identify (simulations)", unit="sim", disable=not progress, leave=False) as bar:
+        stages = {"start": np.zeros(len(coords.keys)), "frequency": z1} if frequency_stage else {"start": z1}
+        stages["time"], nfev = _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar, workers)
+        if frequency_stage and best(time_costs(recs, start, coords, stages, mode, chans, options, dt)) != "time":
+            stages["time"], n2 = _time_stage(recs, start, coords, stages["start"], mode, chans, options, dt,
+                                             max_nfev, bar, workers)
+            nfev += n2
+        return (*keep_best(recs, start, coords, stages, mode, chans, options, dt, bar, workers), nfev)
+
+
 def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | None = None,
              mode: str = "displacement", specimen: str = "linear", channels: Sequence[str] | None = None,
              dt: float | None = None, frequency_stage: bool = True, max_nfev: int = 60,
@@ -256,21 +290,8 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         progress: a tqdm bar over the simulations.
         workers: threads for the Jacobian's columns (default: up to 2).
     """
-    if mode not in LOOP_KEYS:
-        raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(LOOP_KEYS)}")
     t_start = time.perf_counter()
-    recs = as_records(records)
-    spec = specimen_keys(specimen)
-    start, generic = _start_rig(rig, recs)
-    if generic:
-        specimen_start(start, recs[0], specimen)
-    use_specimen(start, specimen)
-    keys = check_keys(start, fit if fit is not None else LOOP_KEYS[mode] + spec)
-    chans = tuple(channels) if channels is not None else channels_of(recs[0], mode)
-    for r in recs:
-        missing = [c for c in chans if c not in channels_of(r, mode)]
-        if missing:
-            raise ValueError(f"record {r.path or '?'}: channel(s) {missing} absent or constant")
+    recs, start, generic, keys, chans = _setup(records, rig, fit, mode, specimen, channels)
     coords = Coordinates.about(start, keys)
     runtime: dict[str, float] = {}
     z1, stage1_keys, nfev = np.zeros(len(keys)), [], {}
@@ -280,18 +301,8 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         z1, nfev["frequency"], runtime["frequency"] = s1.z, s1.nfev, time.perf_counter() - t0
     options = fit_options(coords.apply(start, z1), recs, mode)
     t0 = time.perf_counter()
-    from tqdm.auto import tqdm
-
-    with tqdm(desc="identify (simulations)", unit="sim", disable=not progress, leave=False) as bar:
-        stages = {"start": np.zeros(len(keys)), "frequency": z1} if frequency_stage else {"start": z1}
-        stages["time"], nfev["time"] = _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar,
-                                                   workers)
-        if frequency_stage and best(time_costs(recs, start, coords, stages, mode, chans, options, dt)) != "time":
-            # stage 1 led the time stage astray (worse than where it started): a second time stage from the start
-            stages["time"], n2 = _time_stage(recs, start, coords, stages["start"], mode, chans, options, dt,
-                                             max_nfev, bar, workers)
-            nfev["time"] += n2
-        kept, costs, weights, final = keep_best(recs, start, coords, stages, mode, chans, options, dt, bar, workers)
+    kept, costs, weights, final, nfev["time"] = _time_stages(recs, start, coords, z1, frequency_stage, mode, chans,
+                                                             options, dt, max_nfev, progress, workers)
     runtime["time"] = time.perf_counter() - t0
     lengths = [r.time.size for r in recs for _ in chans]
     u = uncertainty(final, coords, lengths)
