@@ -8,9 +8,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
-from .excitations import time_axis
 from .response import Response, SimulationError, finish
 from .rig import Rig
+from .timegrid import time_axis
 
 #: Largest initial displacement [m]: the plant's divergence guard (plant.cpp, kMaxDisplacement).
 MAX_X0 = 100.0
