@@ -2,7 +2,7 @@
 # The README's entry point.  On a fresh Debian machine (root, Python and a C++
 # compiler present) it installs what it needs itself, then:
 #   scripts/run.sh demo    the main job on built-in defaults (plots + summaries in demo_out/)
-#   scripts/run.sh test    all tests: C++ (ctest) and Python (pytest), but those marked slow
+#   scripts/run.sh test    ruff, then all tests: C++ (ctest) and Python (pytest), but those marked slow
 #   scripts/run.sh test-all  the same with the slow diagnosis tests (minutes each)
 #   scripts/run.sh bench   the step-time benchmarks (docs/benchmarks.md)
 #   scripts/run.sh sanitize  the C++ tests (with the SUNDIALS failure injection) and a short
@@ -39,6 +39,11 @@ python_env() {
   # Build tools for the C++ tests, then the package itself (scikit-build-core builds the C++ core).
   "$venv/bin/python" -m pip install -q cmake ninja "pybind11>=2.12"
   "$venv/bin/python" -m pip install -q "$root[test]"
+}
+
+# Lint every Python file of the tree ([tool.ruff] in pyproject.toml); any finding fails the run.
+lint() {
+  "$venv/bin/ruff" check "$root/python" "$root/tests" "$root/benchmarks" "$root/examples" "$root/scripts"
 }
 
 cxx_tests() {
@@ -83,6 +88,7 @@ case "${1:-}" in
     ;;
   test)
     system_deps; python_env
+    lint
     cxx_tests
     # Run pytest from the tests directory so that the installed package is the one imported;
     # one worker process per core (pytest-xdist): the diagnosis tests dominate and are independent.
@@ -91,6 +97,7 @@ case "${1:-}" in
     ;;
   test-all)
     system_deps; python_env
+    lint
     cxx_tests
     PATH="$venv/bin:$PATH" "$venv/bin/python" -m pytest "$root/tests/python" -q -p no:cacheprovider -n auto
     ;;
