@@ -43,7 +43,8 @@ python_env() {
 
 # Lint every Python file of the tree ([tool.ruff] in pyproject.toml); any finding fails the run.
 lint() {
-  "$venv/bin/ruff" check "$root/python" "$root/tests" "$root/benchmarks" "$root/examples" "$root/scripts"
+  "$venv/bin/ruff" check "$root/python" "$root/tests" "$root/benchmarks" "$root/evaluation" "$root/studies" \
+    "$root/examples" "$root/scripts"
 }
 
 cxx_tests() {

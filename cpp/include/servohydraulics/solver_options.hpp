@@ -28,7 +28,7 @@ struct SolverOptions {
   Method method = Method::Dopri5;
   Restart restart = Restart::OnInputChange;
   //! Relative tolerance of every error-controlled method [-].  1e-8 keeps the default's error within
-  //! 1e-3 of the peak displacement and force on random rigs (benchmarks/accuracy_random_rigs.py): at
+  //! 1e-3 of the peak displacement and force on random rigs (evaluation/accuracy_random_rigs.py): at
   //! 1e-6 a fifth of them were off by up to 3e-3, at 1e-7 one in 200 by 2e-3 (stick-slip with a
   //! large Coulomb force, where the sticking times amplify the local errors).
   double rtol = 1e-8;
@@ -56,7 +56,7 @@ struct SolverOptions {
   //! (rk4_flag_rtol, atol), exceeds 1 is flagged (Status::inaccurate).  The estimate is the
   //! 3rd-order error, far above RK4's own on smooth runs: 5e-5 flags no sample of the preset on
   //! the benchmark record (3e-5 flags 4 %, 1e-5 half of them) and every random rig beyond 1e-2
-  //! (benchmarks/accuracy_random_rigs.py; 1e-4 missed 2 of 1,200, at 1.1e-2).
+  //! (evaluation/accuracy_random_rigs.py; 1e-4 missed 2 of 1,200, at 1.1e-2).
   double rk4_flag_rtol = 5e-5;
   //! Rk4: a flagged sample is redone with twice the substeps, up to this many times (0 = flag only:
   //! fixed cost); it stays flagged.  Bounded by kMaxSubsteps substeps per sample.

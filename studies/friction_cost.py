@@ -5,7 +5,7 @@ setting), with Coulomb friction off, and on with several v_stick.  Prints CVODE
 internal steps and RHS evaluations per 0.5 ms sample, and the displacement
 difference to the sharpest regularisation.
 
-    python scripts/friction_cost.py
+    python studies/friction_cost.py
 """
 
 import numpy as np

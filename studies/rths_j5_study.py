@@ -2,7 +2,7 @@
 the case-1 nominal row with the official run's noise, the seed-to-seed spread with
 other noise, and the spec readings tried against the published Table 3 row.
 
-    PYTHONPATH=python SERVOHYDRAULICS_CORE_DIR=build/dev python benchmarks/rths_j5_study.py \
+    PYTHONPATH=python SERVOHYDRAULICS_CORE_DIR=build/dev python studies/rths_j5_study.py \
         --data ../shared/rths-data/mat [--seeds 60] [--readings]
 
 Part 0 runs the C++ loop with the Simulink Random Number block's generator at seed
