@@ -33,12 +33,34 @@ system_deps() {
   fi
 }
 
+# A digest of everything the installed package is built from: the C++ core, the bindings, the
+# Python layer and the build files (pyproject.toml holds the extras).  Caches and built modules
+# are left out, so a test run or a dev build does not change it.
+source_digest() {
+  (cd "$root" && find cpp bindings python cmake CMakeLists.txt pyproject.toml -type f \
+      ! -name '*.pyc' ! -name '*.so' ! -path '*/__pycache__/*' -print0 |
+    LC_ALL=C sort -z | xargs -0 sha256sum | sha256sum | cut -d' ' -f1)
+}
+
+# The virtual environment with the package and its test extras.  The install (scikit-build-core
+# builds the C++ core: minutes on two cores) runs only when the sources differ from the last
+# successful install, recorded in $venv/.servohydraulics-sources, so `demo` then `test` build
+# the package once.  SH_REINSTALL=1 forces it.
 python_env() {
   [ -x "$venv/bin/python" ] || "$py" -m venv "$venv"
+  local stamp="$venv/.servohydraulics-sources" digest
+  digest=$(source_digest)
+  if [ -z "${SH_REINSTALL:-}" ] && [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$digest" ] &&
+      "$venv/bin/python" -c "import servohydraulics, pytest, ruff" 2>/dev/null; then
+    echo "servohydraulics: installed in $venv from these sources already (SH_REINSTALL=1 reinstalls)"
+    return
+  fi
+  rm -f "$stamp"
   "$venv/bin/python" -m pip install -q --upgrade pip
-  # Build tools for the C++ tests, then the package itself (scikit-build-core builds the C++ core).
+  # Build tools for the C++ tests, then the package itself with its test extras.
   "$venv/bin/python" -m pip install -q cmake ninja "pybind11>=2.12"
   "$venv/bin/python" -m pip install -q "$root[test]"
+  echo "$digest" > "$stamp"
 }
 
 # Lint every Python file of the tree ([tool.ruff] in pyproject.toml); any finding fails the run.
