@@ -144,7 +144,8 @@ def write_markdown(report: dict, md_path: Path) -> None:
     md_path = Path(md_path)
     accuracy = {}
     for key in ("after", "before"):
-        f = ROOT / "evaluation" / ("accuracy_random_rigs.json" if key == "after" else "accuracy_random_rigs_before.json")
+        name = "accuracy_random_rigs.json" if key == "after" else "accuracy_random_rigs_before.json"
+        f = ROOT / "evaluation" / name
         if f.exists():
             accuracy[key] = json.loads(f.read_text())
     text = markdown(report, accuracy, kept_soak_section(md_path))
@@ -340,7 +341,8 @@ def accuracy_section(acc: dict) -> list[str]:
            "`SERVOHYDRAULICS_CORE_DIR` pointing at a build of the starting commit 902a731 (its default: CVODE "
            "with fixed absolute tolerances; its RK4: no error estimate) and `--json "
            "evaluation/accuracy_random_rigs_before.json`.", "",
-           "| run | method | rigs compared | within | flagged | silent | worst silent error |", "|---|---|---|---|---|---|---|"]
+           "| run | method | rigs compared | within | flagged | silent | worst silent error |",
+           "|---|---|---|---|---|---|---|"]
     for key in ("before", "after"):
         if key not in acc:
             continue

@@ -190,9 +190,7 @@ def started_rig(record, start: dict):
 
 
 def extra_keys(sh, lab, fit_options) -> None:
-    from servohydraulics.lab import keys
-
-    from servohydraulics.lab import baselines
+    from servohydraulics.lab import baselines, keys
 
     train, test = (sh.read_record(DATA / f"{n}.csv") for n in ("chirp20Hz_1A", "sweep15Hz_1A"))
     default = keys.LOOP_KEYS["displacement"] + keys.SPECIMEN_KEYS["mr_damper"]
