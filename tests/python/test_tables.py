@@ -11,7 +11,7 @@ import inspect
 import pytest
 
 import servohydraulics as sh
-from servohydraulics import _core, loops
+from servohydraulics import _core, loops, rig
 from servohydraulics.cli import build_parser
 from servohydraulics.simulate import DEFAULT_METHOD, METHODS, MODES, RESTARTS
 
@@ -24,6 +24,7 @@ TABLES = {
     "schemes": (loops.SCHEMES, _core.SCHEME_NAMES, _core.IntegrationScheme),
     "restoring_force": (loops.RESTORING_FORCE, _core.RESTORING_FORCE_NAMES, _core.RestoringForce),
     "force_measurement": (loops.FORCE_MEASUREMENT, _core.FORCE_MEASUREMENT_NAMES, _core.ForceMeasurement),
+    "flow_curve_kind": (rig.FLOW_CURVE_KINDS, _core.FLOW_CURVE_KIND_NAMES, _core.FlowCurve.Kind),
 }
 
 
