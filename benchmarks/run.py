@@ -22,8 +22,8 @@
    regenerated wholesale except the section between the markers
    <!-- BEGIN soak --> and <!-- END soak --> (written by the soak benchmark),
    which is kept as it is; the random-rig accuracy counts come from
-   benchmarks/accuracy_random_rigs.json (and _before.json), written by
-   benchmarks/accuracy_random_rigs.py.
+   evaluation/accuracy_random_rigs.json (and _before.json), written by
+   evaluation/accuracy_random_rigs.py.
 """
 
 from __future__ import annotations
@@ -144,7 +144,8 @@ def write_markdown(report: dict, md_path: Path) -> None:
     md_path = Path(md_path)
     accuracy = {}
     for key in ("after", "before"):
-        f = ROOT / "benchmarks" / ("accuracy_random_rigs.json" if key == "after" else "accuracy_random_rigs_before.json")
+        name = "accuracy_random_rigs.json" if key == "after" else "accuracy_random_rigs_before.json"
+        f = ROOT / "evaluation" / name
         if f.exists():
             accuracy[key] = json.loads(f.read_text())
     text = markdown(report, accuracy, kept_soak_section(md_path))
@@ -322,7 +323,7 @@ def speed_table(r: dict) -> list[str]:
 
 
 def accuracy_section(acc: dict) -> list[str]:
-    """Random-rig accuracy counts (benchmarks/accuracy_random_rigs.py), before and after issue 16."""
+    """Random-rig accuracy counts (evaluation/accuracy_random_rigs.py), before and after issue 16."""
     if "after" not in acc:
         return []
     a = acc["after"]
@@ -335,12 +336,13 @@ def accuracy_section(acc: dict) -> list[str]:
            f"stated tolerance ({a['tolerance']['default']:g} for the default, {a['tolerance']['rk4']:g} for RK4); "
            "flagged: not within, and the run says so (a non-ok status, or RK4 samples flagged by its error "
            "estimate); silent: a wrong answer with nothing said.", "",
-           "Commands: `python3 benchmarks/accuracy_random_rigs.py --rigs 1200 --json "
-           "benchmarks/accuracy_random_rigs.json` (after); before: the same script with `PYTHONPATH` and "
+           "Commands: `python3 evaluation/accuracy_random_rigs.py --rigs 1200 --json "
+           "evaluation/accuracy_random_rigs.json` (after); before: the same script with `PYTHONPATH` and "
            "`SERVOHYDRAULICS_CORE_DIR` pointing at a build of the starting commit 902a731 (its default: CVODE "
            "with fixed absolute tolerances; its RK4: no error estimate) and `--json "
-           "benchmarks/accuracy_random_rigs_before.json`.", "",
-           "| run | method | rigs compared | within | flagged | silent | worst silent error |", "|---|---|---|---|---|---|---|"]
+           "evaluation/accuracy_random_rigs_before.json`.", "",
+           "| run | method | rigs compared | within | flagged | silent | worst silent error |",
+           "|---|---|---|---|---|---|---|"]
     for key in ("before", "after"):
         if key not in acc:
             continue

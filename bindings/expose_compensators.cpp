@@ -2,6 +2,7 @@
 #include <pybind11/pybind11.h>
 
 #include "busy.hpp"
+#include "enums_py.hpp"
 #include "servohydraulics/compensators.hpp"
 
 namespace py = pybind11;
@@ -45,10 +46,8 @@ void expose_compensators(py::module_& m) {
 
   py::class_<VelocityFeedbackCompensator> vfc(m, "VelocityFeedbackCompensator",
                                               "EFT velocity feedback compensation (linear or nonlinear)");
-  py::enum_<VelocityFeedbackCompensator::Kind>(vfc, "Kind")
-      .value("None_", VelocityFeedbackCompensator::Kind::None)
-      .value("Linear", VelocityFeedbackCompensator::Kind::Linear)
-      .value("Nonlinear", VelocityFeedbackCompensator::Kind::Nonlinear);
+  sh_py::bind_enum(vfc, "Kind", kCompensationNames);
+  m.attr("COMPENSATION_NAMES") = sh_py::enum_names(kCompensationNames);
   vfc.def(py::init<const Rig&, VelocityFeedbackCompensator::Kind, double, double, double>(), py::arg("model"),
           py::arg("kind"), py::arg("lead_T"), py::arg("alpha"), py::arg("dt"))
       .def("reset", bindings::guarded(&VelocityFeedbackCompensator::reset, "VelocityFeedbackCompensator.reset"))

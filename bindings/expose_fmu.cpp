@@ -1,5 +1,7 @@
 // The FMU's variable table (cpp/fmu/model.hpp) for the Python exporter, which
 // writes modelDescription.xml and resources/ from it.
+#include <iterator>
+
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
@@ -46,6 +48,9 @@ py::list fmu_variables(const std::string& kind, const std::string& mode, const R
 }  // namespace
 
 void expose_fmu(py::module_& m) {
+  py::tuple kinds(std::size(fmu::kKindNames));
+  for (std::size_t i = 0; i < kinds.size(); ++i) kinds[i] = fmu::kKindNames[i].name;
+  m.attr("FMU_KINDS") = kinds;  // fmu.KINDS, the CLI's --kind choices
   m.def("fmu_variables", &fmu_variables, py::arg("kind"), py::arg("mode"), py::arg("rig"), py::arg("dt"),
         py::arg("x0"), py::arg("solver"), py::arg("eft"), py::arg("rpsd"),
         "The FMU's variables (name, value_reference, type, causality, variability, unit, description, "

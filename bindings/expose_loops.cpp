@@ -7,6 +7,7 @@
 #include <pybind11/stl.h>
 
 #include "busy.hpp"
+#include "enums_py.hpp"
 #include "channels_py.hpp"
 #include "protocol.hpp"
 #include "servohydraulics/controllers.hpp"
@@ -100,9 +101,8 @@ void expose_loops(py::module_& m) {
       .def_readonly("acceleration", &IntegratorState::acceleration)
       .def_readonly("next_displacement", &IntegratorState::next_displacement);
   m.attr("SolverState") = m.attr("IntegratorState");  // the name before issue 11
-  py::enum_<IntegrationScheme>(m, "IntegrationScheme")
-      .value("CentralDifference", IntegrationScheme::CentralDifference)
-      .value("ExplicitNewmark", IntegrationScheme::ExplicitNewmark);
+  sh_py::bind_enum(m, "IntegrationScheme", kSchemeNames);
+  m.attr("SCHEME_NAMES") = sh_py::enum_names(kSchemeNames);
   m.attr("SolverKind") = m.attr("IntegrationScheme");  // the name before issue 11
   py::class_<CentralDifference>(m, "CentralDifference", "Explicit central-difference solver of Eq (15)")
       .def(py::init<const ModelSDOF&, double>(), py::arg("model"), py::arg("dt"))
@@ -195,14 +195,10 @@ void expose_loops(py::module_& m) {
                              py::return_value_policy::reference_internal);
 
   // --- RPsD ------------------------------------------------------------------
-  py::enum_<RestoringForce>(m, "RestoringForce")
-      .value("CalculatedDisplacement", RestoringForce::CalculatedDisplacement)
-      .value("MeasuredDisplacement", RestoringForce::MeasuredDisplacement)
-      .value("MeasuredForce", RestoringForce::MeasuredForce)
-      .value("MeasuredForceCorrected", RestoringForce::MeasuredForceCorrected);
-  py::enum_<ForceMeasurement>(m, "ForceMeasurement")
-      .value("LoadCell", ForceMeasurement::LoadCell)
-      .value("ActuatorPressure", ForceMeasurement::ActuatorPressure);
+  sh_py::bind_enum(m, "RestoringForce", kRestoringForceNames);
+  sh_py::bind_enum(m, "ForceMeasurement", kForceMeasurementNames);
+  m.attr("RESTORING_FORCE_NAMES") = sh_py::enum_names(kRestoringForceNames);
+  m.attr("FORCE_MEASUREMENT_NAMES") = sh_py::enum_names(kForceMeasurementNames);
   py::class_<RpsdConfig> rpsd_config(m, "RpsdConfig");
   rpsd_config.def(py::init<>())
       .def_readwrite("dt", &RpsdConfig::dt)

@@ -1,4 +1,5 @@
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <pybind11/numpy.h>
@@ -7,6 +8,7 @@
 
 #include "busy.hpp"
 #include "channels_py.hpp"
+#include "enums_py.hpp"
 #include "protocol.hpp"
 #include "servohydraulics/plant.hpp"
 
@@ -50,10 +52,8 @@ py::dict layout_dict(const Dynamics& d) {
 }  // namespace
 
 void expose_plant(py::module_& m) {
-  py::enum_<ControlMode>(m, "ControlMode")
-      .value("Displacement", ControlMode::Displacement)
-      .value("Force", ControlMode::Force)
-      .value("Free", ControlMode::Free);
+  sh_py::bind_enum(m, "ControlMode", kControlModeNames);
+  m.attr("CONTROL_MODE_NAMES") = sh_py::enum_names(kControlModeNames);
 
   // The state vector: StateIndex values named after kStates, and _core.STATES = ((name, unit), ...).
   py::enum_<StateIndex> si(m, "StateIndex", "Indices of the plant's state vector");
@@ -81,35 +81,23 @@ void expose_plant(py::module_& m) {
   m.attr("FLAG_STROKE_EXCEEDED") = static_cast<unsigned>(kStrokeExceeded);
 
   py::class_<SolverOptions> so(m, "SolverOptions");
-  py::enum_<SolverOptions::Method>(so, "Method")
-      .value("Dopri5", SolverOptions::Method::Dopri5)
-      .value("CvodeBdf", SolverOptions::Method::CvodeBdf)
-      .value("Rk4", SolverOptions::Method::Rk4)
-      .value("ArkodeErk", SolverOptions::Method::ArkodeErk)
-      .value("ArkodeDirk", SolverOptions::Method::ArkodeDirk);
-  py::enum_<SolverOptions::Restart>(so, "Restart")
-      .value("OnInputChange", SolverOptions::Restart::OnInputChange)
-      .value("Never", SolverOptions::Restart::Never);
+  sh_py::bind_enum(so, "Method", kMethodNames);
+  sh_py::bind_enum(so, "Restart", kRestartNames);
+  m.attr("METHOD_NAMES") = sh_py::enum_names(kMethodNames);
+  m.attr("RESTART_NAMES") = sh_py::enum_names(kRestartNames);
   so.def(py::init<>())
-      .def_readwrite("method", &SolverOptions::method)
-      .def_readwrite("restart", &SolverOptions::restart)
-      .def_readwrite("rtol", &SolverOptions::rtol)
-      .def_readwrite("atol_fraction", &SolverOptions::atol_fraction)
-      .def_readwrite("max_order", &SolverOptions::max_order)
-      .def_readwrite("max_steps_per_sample", &SolverOptions::max_steps_per_sample)
-      .def_readwrite("max_internal_step", &SolverOptions::max_internal_step)
-      .def_readwrite("rk4_substeps", &SolverOptions::rk4_substeps)
-      .def_readwrite("rk4_h_rho", &SolverOptions::rk4_h_rho)
-      .def_readwrite("rk4_v_ref", &SolverOptions::rk4_v_ref)
-      .def_readwrite("stiff_steps", &SolverOptions::stiff_steps)
-      .def_readwrite("stiff_fallback", &SolverOptions::stiff_fallback)
-      .def_readwrite("rk4_flag_rtol", &SolverOptions::rk4_flag_rtol)
-      .def_readwrite("rk4_max_refinements", &SolverOptions::rk4_max_refinements)
       .def_readonly_static("MAX_SUBSTEPS", &SolverOptions::kMaxSubsteps)
       .def("validate", &SolverOptions::validate);
-  bindings::add_protocol(so, {"method", "restart", "rtol", "atol_fraction", "max_order", "max_steps_per_sample",
-                              "max_internal_step", "stiff_steps", "stiff_fallback", "rk4_substeps", "rk4_h_rho",
-                              "rk4_v_ref", "rk4_flag_rtol", "rk4_max_refinements"});
+  // The fields from kSolverOptionFields: one attribute each, the object protocol over all of them.
+  std::vector<std::string> fields;
+  py::list field_info;
+  for (const SolverOptionField& f : kSolverOptionFields) {
+    std::visit([&](auto member) { so.def_readwrite(f.name, member, f.doc); }, f.member);
+    fields.emplace_back(f.name);
+    field_info.append(py::dict(py::arg("name") = f.name, py::arg("unit") = f.unit, py::arg("doc") = f.doc));
+  }
+  bindings::add_protocol(so, fields);
+  m.attr("SOLVER_OPTION_FIELDS") = py::tuple(field_info);
 
   py::class_<Status> st(m, "Status");
   py::enum_<Status::Code>(st, "Code")

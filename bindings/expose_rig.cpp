@@ -4,6 +4,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "enums_py.hpp"
 #include "protocol.hpp"
 #include "servohydraulics/parameters.hpp"
 #include "servohydraulics/rig.hpp"
@@ -49,7 +50,8 @@ py::list effects_table() {
 
 void expose_rig(py::module_& m) {
   py::class_<FlowCurve> fc(m, "FlowCurve", "Normalised flow-spool opening curve g(x_v) of Fig 4(a)");
-  py::enum_<FlowCurve::Kind>(fc, "Kind").value("Rational", FlowCurve::Kind::Rational).value("Table", FlowCurve::Kind::Table);
+  sh_py::bind_enum(fc, "Kind", kFlowCurveKindNames);
+  m.attr("FLOW_CURVE_KIND_NAMES") = sh_py::enum_names(kFlowCurveKindNames);
   fc.def(py::init<>())
       .def_readwrite("kind", &FlowCurve::kind)
       .def_readwrite("b", &FlowCurve::b)

@@ -16,7 +16,7 @@ import ast
 import re
 from pathlib import Path
 
-CODE_DIRS = ("cpp", "bindings", "python", "scripts", "examples", "benchmarks")
+CODE_DIRS = ("cpp", "bindings", "python", "scripts", "examples", "benchmarks", "evaluation", "studies")
 
 # The defining expression of each equation or constant, as it appears where it is *written*
 # (a call of the one home does not match).  Each pattern is searched in Python and C++ sources.

@@ -2,7 +2,7 @@
 # The README's entry point.  On a fresh Debian machine (root, Python and a C++
 # compiler present) it installs what it needs itself, then:
 #   scripts/run.sh demo    the main job on built-in defaults (plots + summaries in demo_out/)
-#   scripts/run.sh test    all tests: C++ (ctest) and Python (pytest), but those marked slow
+#   scripts/run.sh test    ruff, then all tests: C++ (ctest) and Python (pytest), but those marked slow
 #   scripts/run.sh test-all  the same with the slow diagnosis tests (minutes each)
 #   scripts/run.sh bench   the step-time benchmarks (docs/benchmarks.md)
 #   scripts/run.sh sanitize  the C++ tests (with the SUNDIALS failure injection) and a short
@@ -33,12 +33,40 @@ system_deps() {
   fi
 }
 
+# A digest of everything the installed package is built from: the C++ core, the bindings, the
+# Python layer and the build files (pyproject.toml holds the extras).  Caches and built modules
+# are left out, so a test run or a dev build does not change it.
+source_digest() {
+  (cd "$root" && find cpp bindings python cmake CMakeLists.txt pyproject.toml -type f \
+      ! -name '*.pyc' ! -name '*.so' ! -path '*/__pycache__/*' -print0 |
+    LC_ALL=C sort -z | xargs -0 sha256sum | sha256sum | cut -d' ' -f1)
+}
+
+# The virtual environment with the package and its test extras.  The install (scikit-build-core
+# builds the C++ core: minutes on two cores) runs only when the sources differ from the last
+# successful install, recorded in $venv/.servohydraulics-sources, so `demo` then `test` build
+# the package once.  SH_REINSTALL=1 forces it.
 python_env() {
   [ -x "$venv/bin/python" ] || "$py" -m venv "$venv"
+  local stamp="$venv/.servohydraulics-sources" digest
+  digest=$(source_digest)
+  if [ -z "${SH_REINSTALL:-}" ] && [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$digest" ] &&
+      "$venv/bin/python" -c "import servohydraulics, pytest, ruff" 2>/dev/null; then
+    echo "servohydraulics: installed in $venv from these sources already (SH_REINSTALL=1 reinstalls)"
+    return
+  fi
+  rm -f "$stamp"
   "$venv/bin/python" -m pip install -q --upgrade pip
-  # Build tools for the C++ tests, then the package itself (scikit-build-core builds the C++ core).
+  # Build tools for the C++ tests, then the package itself with its test extras.
   "$venv/bin/python" -m pip install -q cmake ninja "pybind11>=2.12"
   "$venv/bin/python" -m pip install -q "$root[test]"
+  echo "$digest" > "$stamp"
+}
+
+# Lint every Python file of the tree ([tool.ruff] in pyproject.toml); any finding fails the run.
+lint() {
+  "$venv/bin/ruff" check "$root/python" "$root/tests" "$root/benchmarks" "$root/evaluation" "$root/studies" \
+    "$root/examples" "$root/scripts"
 }
 
 cxx_tests() {
@@ -83,6 +111,7 @@ case "${1:-}" in
     ;;
   test)
     system_deps; python_env
+    lint
     cxx_tests
     # Run pytest from the tests directory so that the installed package is the one imported;
     # one worker process per core (pytest-xdist): the diagnosis tests dominate and are independent.
@@ -91,6 +120,7 @@ case "${1:-}" in
     ;;
   test-all)
     system_deps; python_env
+    lint
     cxx_tests
     PATH="$venv/bin:$PATH" "$venv/bin/python" -m pytest "$root/tests/python" -q -p no:cacheprovider -n auto
     ;;

@@ -4,19 +4,14 @@
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <type_traits>
+#include <variant>
 
 #include "servohydraulics/parameters.hpp"
 
 namespace servohydraulics::fmu {
 
-const char* to_string(Kind kind) noexcept {
-  switch (kind) {
-    case Kind::Plant: return "plant";
-    case Kind::Eft: return "eft";
-    case Kind::Rpsd: return "rpsd";
-  }
-  return "?";
-}
+const char* to_string(Kind kind) noexcept { return name_of(kKindNames, kind); }
 const char* to_string(Type t) noexcept {
   switch (t) {
     case Type::Real: return "Real";
@@ -44,17 +39,9 @@ const char* to_string(Variability v) noexcept {
   return "?";
 }
 
-Kind parse_kind(const std::string& name) {
-  for (Kind k : {Kind::Plant, Kind::Eft, Kind::Rpsd})
-    if (name == to_string(k)) return k;
-  throw Error("invalid kind = \"" + name + "\": expected one of plant, eft, rpsd");
-}
+Kind parse_kind(const std::string& name) { return parse_enum(kKindNames, "kind", name); }
 
-ControlMode parse_mode(const std::string& name) {
-  for (ControlMode m : {ControlMode::Displacement, ControlMode::Force, ControlMode::Free})
-    if (name == servohydraulics::to_string(m)) return m;
-  throw Error("invalid mode = \"" + name + "\": expected one of displacement, force, free");
-}
+ControlMode parse_mode(const std::string& name) { return parse_enum(kControlModeNames, "mode", name); }
 
 void resolve_defaults(Settings& s) {
   s.eft.dt = s.dt;
@@ -138,18 +125,29 @@ Variable integer(std::string name, std::string doc, std::function<I&(Values&)> r
   return x;
 }
 
-template <class E>
-Variable enumeration(std::string name, std::string type_name, std::vector<std::string> items, std::string doc,
+//! An enum parameter; its items are the names of the enum's table (enum_name.hpp), in the enum's order.
+template <class E, std::size_t N>
+Variable enumeration(std::string name, std::string type_name, const EnumName<E> (&table)[N], std::string doc,
                      std::function<E&(Values&)> ref) {
   Variable x = base(name, Type::Enumeration, Causality::Parameter, Variability::Fixed, "", std::move(doc));
   x.type_name = std::move(type_name);
-  x.items = std::move(items);
+  for (const auto& row : table) x.items.emplace_back(row.name);
   x.get = [ref](const Values& v) { return static_cast<double>(static_cast<int>(ref(const_cast<Values&>(v)))); };
   const std::string expected = "expected one of " + expected_items(x);
   const double n = static_cast<double>(x.items.size());
   x.set = [ref, name, expected, n](Values& v, double d) {
     if (!(d >= 0.0 && d < n) || d != std::floor(d)) bad_value(name, d, expected);
     ref(v) = static_cast<E>(static_cast<int>(d));
+  };
+  return x;
+}
+
+Variable boolean(std::string name, std::string doc, std::function<bool&(Values&)> ref) {
+  Variable x = base(name, Type::Boolean, Causality::Parameter, Variability::Fixed, "", std::move(doc));
+  x.get = [ref](const Values& v) { return ref(const_cast<Values&>(v)) ? 1.0 : 0.0; };
+  x.set = [ref, name](Values& v, double d) {
+    if (d != 0.0 && d != 1.0) bad_value(name, d, "expected a Boolean");
+    ref(v) = d != 0.0;
   };
   return x;
 }
@@ -171,14 +169,9 @@ void add_rig(std::vector<Variable>& out, Kind kind) {
   }
   for (const EffectInfo& e : kEffects) {
     const auto member = e.member;
-    const std::string name = std::string("effects.") + e.key;
-    Variable x = base(name, Type::Boolean, Causality::Parameter, Variability::Fixed, "", e.doc);
+    Variable x = boolean(std::string("effects.") + e.key, e.doc,
+                         [member](Values& v) -> bool& { return v.settings.rig.effects.*member; });
     x.in_rig = true;
-    x.get = [member](const Values& v) { return v.settings.rig.effects.*member ? 1.0 : 0.0; };
-    x.set = [member, name](Values& v, double d) {
-      if (d != 0.0 && d != 1.0) bad_value(name, d, "expected a Boolean");
-      v.settings.rig.effects.*member = d != 0.0;
-    };
     out.push_back(std::move(x));
   }
 }
@@ -209,6 +202,32 @@ void add_dt(std::vector<Variable>& out) {
                           [](Values& v) -> double& { return v.settings.dt; }));
 }
 
+//! Every SolverOptions field as "solver.<name>" (kSolverOptionFields), so the plant FMU integrates
+//! with exactly the options it was exported with.
+void add_solver(std::vector<Variable>& out) {
+  using SO = SolverOptions;
+  for (const SolverOptionField& f : kSolverOptionFields) {
+    const std::string name = std::string("solver.") + f.name;
+    out.push_back(std::visit(
+        [&](auto member) -> Variable {
+          using T = std::remove_reference_t<decltype(std::declval<SO&>().*member)>;
+          auto ref = [member](Values& v) -> T& { return v.settings.solver.*member; };
+          if constexpr (std::is_same_v<T, SO::Method>) {
+            return enumeration<T>(name, "SolverMethod", kMethodNames, f.doc, ref);
+          } else if constexpr (std::is_same_v<T, SO::Restart>) {
+            return enumeration<T>(name, "SolverRestart", kRestartNames, f.doc, ref);
+          } else if constexpr (std::is_same_v<T, bool>) {
+            return boolean(name, f.doc, ref);
+          } else if constexpr (std::is_same_v<T, double>) {
+            return parameter(name, f.unit, f.doc, ref);
+          } else {
+            return integer<T>(name, f.doc, ref);
+          }
+        },
+        f.member));
+  }
+}
+
 void add_plant(std::vector<Variable>& out, ControlMode mode) {
   out.push_back(real("command", mode == ControlMode::Displacement ? "m" : "N",
                      "command held over each sample (displacement [m] or force [N] per the control mode)",
@@ -227,20 +246,7 @@ void add_plant(std::vector<Variable>& out, ControlMode mode) {
   add_dt(out);
   out.push_back(parameter("x0", "m", "initial displacement (static equilibrium there)",
                           [](Values& v) -> double& { return v.settings.x0; }));
-  // The names of SolverOptions::Method, in the enum's order (those of simulate.py's METHODS); a new
-  // method needs its name here, else exporting with it is a ValueError naming solver.method.
-  out.push_back(enumeration<SolverOptions::Method>(
-      "solver.method", "SolverMethod", {"dopri5", "cvode", "rk4", "arkode_erk", "arkode_dirk"}, "the plant's ODE integrator (solver_options.hpp)",
-      [](Values& v) -> SolverOptions::Method& { return v.settings.solver.method; }));
-  out.push_back(enumeration<SolverOptions::Restart>(
-      "solver.restart", "SolverRestart", {"on_input_change", "never"}, "CVODE restart on a command jump",
-      [](Values& v) -> SolverOptions::Restart& { return v.settings.solver.restart; }));
-  out.push_back(parameter("solver.rtol", "", "relative tolerance (dopri5, CVODE, ARKODE)",
-                          [](Values& v) -> double& { return v.settings.solver.rtol; }));
-  out.push_back(integer<int>("solver.rk4_substeps", "RK4 substeps per sample (0 = automatic)",
-                             [](Values& v) -> int& { return v.settings.solver.rk4_substeps; }));
-  out.push_back(integer<long>("solver.max_steps_per_sample", "cap on CVODE internal steps in one sample",
-                              [](Values& v) -> long& { return v.settings.solver.max_steps_per_sample; }));
+  add_solver(out);
 }
 
 void add_eft(std::vector<Variable>& out) {
@@ -252,7 +258,7 @@ void add_eft(std::vector<Variable>& out) {
   out.push_back(resolved("eft.mass", "kg", "m in P_eff = -m a_g",
                          [](Values& v) -> std::optional<double>& { return v.settings.eft.mass; }));
   out.push_back(enumeration<VelocityFeedbackCompensator::Kind>(
-      "eft.compensation", "Compensation", {"none", "linear", "nonlinear"}, "velocity feedback compensation",
+      "eft.compensation", "Compensation", kCompensationNames, "velocity feedback compensation",
       [](Values& v) -> VelocityFeedbackCompensator::Kind& { return v.settings.eft.compensation; }));
   out.push_back(parameter("eft.lead_T", "s", "phase lead on the compensation (0 = none)",
                           [](Values& v) -> double& { return v.settings.eft.lead_T; }));
@@ -271,15 +277,12 @@ void add_rpsd_config(std::vector<Variable>& out) {
   out.push_back(resolved("rpsd.k_m", "N/m", "stiffness of the displacement-based restoring forces",
                          [](Values& v) -> Opt& { return v.settings.rpsd.k_m; }));
   out.push_back(enumeration<IntegrationScheme>(
-      "rpsd.scheme", "IntegrationScheme", {"central_difference", "explicit_newmark"}, "integration scheme of Eq (15)",
+      "rpsd.scheme", "IntegrationScheme", kSchemeNames, "integration scheme of Eq (15)",
       [](Values& v) -> IntegrationScheme& { return v.settings.rpsd.scheme; }));
   out.push_back(enumeration<RestoringForce>(
-      "rpsd.restoring_force", "RestoringForce",
-      {"calculated_displacement", "measured_displacement", "measured_force", "measured_force_corrected"},
-      "restoring force option (a)-(d)", [](Values& v) -> RestoringForce& { return v.settings.rpsd.restoring_force; }));
+      "rpsd.restoring_force", "RestoringForce", kRestoringForceNames, "restoring force option (a)-(d)", [](Values& v) -> RestoringForce& { return v.settings.rpsd.restoring_force; }));
   out.push_back(enumeration<ForceMeasurement>(
-      "rpsd.force_measurement", "ForceMeasurement", {"load_cell", "actuator_pressure"},
-      "measured force: load cell or p A",
+      "rpsd.force_measurement", "ForceMeasurement", kForceMeasurementNames, "measured force: load cell or p A",
       [](Values& v) -> ForceMeasurement& { return v.settings.rpsd.force_measurement; }));
   out.push_back(parameter("rpsd.amplitude_T", "s", "amplitude compensation T_d on the command (0 = none)",
                           [](Values& v) -> double& { return v.settings.rpsd.amplitude_T; }));

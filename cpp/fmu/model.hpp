@@ -25,8 +25,11 @@ enum class Kind {
   Eft,    //!< the EFT controller: inputs a_g and the sensors, output the force command
   Rpsd,   //!< the RPsD controller: inputs a_g, P_ext, the restoring-force error and the sensors
 };
+inline constexpr EnumName<Kind> kKindNames[] = {
+    {Kind::Plant, "plant", "Plant"}, {Kind::Eft, "eft", "Eft"}, {Kind::Rpsd, "rpsd", "Rpsd"}};
+static_assert(in_enum_order(kKindNames), "kKindNames: one row per enumerator, in order");
 const char* to_string(Kind kind) noexcept;
-Kind parse_kind(const std::string& name);          //!< "plant", "eft", "rpsd"; throws Error
+Kind parse_kind(const std::string& name);          //!< kKindNames: "plant", "eft", "rpsd"; throws Error
 ControlMode parse_mode(const std::string& name);  //!< "displacement", "force", "free"; throws Error
 
 //! Everything the FMU's parameters set.  The optional defaults of the configs

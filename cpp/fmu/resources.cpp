@@ -1,7 +1,9 @@
 #include "resources.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <locale>
 #include <sstream>
 
@@ -65,9 +67,10 @@ bool flow_curve_entry(const Entry& e, FlowCurve& fc) {
   const std::string key = e.key.substr(prefix.size());
   if (key == "kind") {
     const std::string kind = string_value(e);
-    if (kind == "rational") fc.kind = FlowCurve::Kind::Rational;
-    else if (kind == "table") fc.kind = FlowCurve::Kind::Table;
-    else fail(e, "expected \"rational\" or \"table\"");
+    const auto* row = std::find_if(std::begin(kFlowCurveKindNames), std::end(kFlowCurveKindNames),
+                                   [&](const auto& r) { return kind == r.name; });
+    if (row == std::end(kFlowCurveKindNames)) fail(e, "expected one of " + names_of(kFlowCurveKindNames));
+    fc.kind = row->value;
   } else if (key == "b") {
     fc.b = number(e, e.value);
   } else if (key == "opening") {

@@ -9,16 +9,15 @@ Zhao, French, Shield, Posbergh (2003), Earthquake Engng Struct. Dyn. 32:1773-179
     res.displacement, res.units["displacement"], res.warnings(), res.to_pandas()
 
 Importing the package loads the library (model, integration, control loops,
-records) only.  The heavier parts load on first use (PEP 562): ``analysis``
-(python-control), ``sweep`` (pandas), the diagnosis and the paper's
+records) only, and no SciPy.  The heavier parts load on first use (PEP 562): ``analysis``
+(python-control), ``sweep`` (pandas; the module is ``parameter_sweep``, so the
+name ``sweep`` is only ever the function), the diagnosis and the paper's
 reproduction (matplotlib).  Importing the package never touches matplotlib's
 backend.
 """
 
 import importlib as _importlib
 import os as _os
-import sys as _sys
-import types as _types
 
 # Development hook: SERVOHYDRAULICS_CORE_DIR names a CMake build directory whose
 # _core module is used instead of an installed one (scripts/dev-build.sh).
@@ -26,7 +25,7 @@ if _os.environ.get("SERVOHYDRAULICS_CORE_DIR"):
     __path__.insert(0, _os.environ["SERVOHYDRAULICS_CORE_DIR"])
 
 try:
-    from . import _core  # noqa: E402
+    from . import _core  # noqa: E402, F401 - fails here, with the message below, when the core is not built
 except ImportError as e:  # pragma: no cover - only without a built core
     raise ImportError(
         "the servohydraulics C++ core (_core) is not built here: install the package "
@@ -55,14 +54,14 @@ from .simulate import make_plant, simulate, solver_options  # noqa: E402
 __version__ = "0.1.0"
 
 #: Lazily imported submodules (first attribute access imports them).
-_SUBMODULES = ("analysis", "identification", "excitations", "sweep", "plots", "diagnosis", "paper")
+_SUBMODULES = ("analysis", "identification", "excitations", "parameter_sweep", "plots", "diagnosis", "paper")
 
 #: Lazily resolved names: name -> (module, attribute).
 _LAZY = {
     "linearize": (".analysis", "linearize"),
     "identify": (".identification", "identify"),
-    "sweep": (".sweep", "sweep"),
-    "summary_run": (".sweep", "summary_run"),
+    "sweep": (".parameter_sweep", "sweep"),
+    "summary_run": (".parameter_sweep", "summary_run"),
     "diagnose": (".diagnosis", "diagnose"),
     "Diagnosis": (".diagnosis", "Diagnosis"),
     "reproduce": (".paper.reproduce", "reproduce"),
@@ -100,21 +99,6 @@ def __getattr__(name: str):
 def __dir__():
     return sorted(set(globals()) | set(_LAZY) | set(_SUBMODULES))
 
-
-class _Package(_types.ModuleType):
-    """``sh.sweep`` and ``sh.identify`` are functions although submodules of the
-    same names exist (``sweep.py``; ``identify.py``, a deprecated alias of
-    ``identification``): importing such a submodule must not rebind the package
-    attribute to the module.  The submodules stay importable by their names
-    (``importlib.import_module``, ``from servohydraulics.sweep import ...``)."""
-
-    sweep = property(lambda self: _resolve("sweep"), lambda self, value: None,
-                     doc="servohydraulics.sweep, resolved on first use")
-    identify = property(lambda self: _resolve("identify"), lambda self, value: None,
-                        doc="servohydraulics.identification.identify, resolved on first use")
-
-
-_sys.modules[__name__].__class__ = _Package
 
 __all__ = [
     "PARAMETERS",

@@ -29,7 +29,7 @@ def _simulate(args: argparse.Namespace) -> int:
     res.to_csv(args.out)
     for w in res.warnings():
         print("warning:", w, file=sys.stderr)
-    print(f"wrote {args.out}: {len(res)} rows, {res.work.internal_steps} CVODE steps")
+    print(f"wrote {args.out}: {len(res)} rows, {res.work.internal_steps} integrator steps")
     return 0
 
 

@@ -27,11 +27,11 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy import signal
 
-from . import _core
+from .timegrid import DT, MAX_SAMPLES, time_axis  # noqa: F401 - DT, MAX_SAMPLES, time_axis: public here too
+from .timegrid import positive as _positive
 
 TWO_PI = 2.0 * math.pi
 G = 9.80665  #: standard gravity [m/s^2]
-DT = _core.EftConfig().dt  #: the paper's controller sample time (2 kHz), the core's default [s]
 SWEEP_DURATION = 40.0  #: default duration of the 0-10 Hz sweeps [s] (our choice, see module doc)
 
 #: The paper's sweep amplitudes (SI).
@@ -39,27 +39,6 @@ SWEEP_FORCE_SMALL = 2.3e3  #: EFT sweep, Fig 3 [N]
 SWEEP_FORCE_LARGE = 8.9e3  #: EFT sweep, Fig 4 [N]
 SWEEP_DISPLACEMENT = 0.0127  #: displacement sweep, Fig 5 [m]
 SWEEP_GROUND_ACCELERATION = 0.15 * G  #: RPsD sweep, Fig 8 [m/s^2]
-
-
-def _positive(name: str, value: float) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
-        raise ValueError(f"invalid {name} = {value!r}: must be finite and > 0")
-    return float(value)
-
-
-#: Longest time axis made here: 50 M samples (7 h at 2 kHz, 400 MB per channel).
-MAX_SAMPLES = 50_000_000
-
-
-def time_axis(duration: float, dt: float = DT) -> np.ndarray:
-    """t_k = k dt for k = 0..round(duration/dt) [s] (at most MAX_SAMPLES samples)."""
-    _positive("duration", duration)
-    _positive("dt", dt)
-    n = duration / dt
-    if not n < MAX_SAMPLES:
-        raise ValueError(f"invalid duration = {duration!r} s at dt = {dt!r} s: {n:.3g} samples, more than "
-                         f"the {MAX_SAMPLES:,} allowed")
-    return np.arange(int(round(n)) + 1) * dt
 
 
 def sine(amplitude: float, frequency: float, duration: float, dt: float = DT, phase: float = 0.0) -> np.ndarray:

@@ -33,7 +33,7 @@ from .loops import eft_config, rpsd_config
 from .rig import Rig, rig_to_dict
 from .simulate import MODES
 
-KINDS = ("plant", "eft", "rpsd")
+KINDS = _core.FMU_KINDS  #: ("plant", "eft", "rpsd"), the FMU model's table (cpp/fmu/model.hpp)
 #: The binary CMake builds (cpp/fmu) and installs into the package.
 BINARY = "servohydraulics_fmu.so"
 #: The control mode each controller drives.

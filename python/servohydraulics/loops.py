@@ -35,17 +35,11 @@ from .rig import Rig
 from .simulate import _assign, simulate
 from .simulate import solver_options as _solver_options
 
-COMPENSATION = {"none": _core.VelocityFeedbackCompensator.Kind.None_,
-                "linear": _core.VelocityFeedbackCompensator.Kind.Linear,
-                "nonlinear": _core.VelocityFeedbackCompensator.Kind.Nonlinear}
-RESTORING_FORCE = {"calculated_displacement": _core.RestoringForce.CalculatedDisplacement,
-                   "measured_displacement": _core.RestoringForce.MeasuredDisplacement,
-                   "measured_force": _core.RestoringForce.MeasuredForce,
-                   "measured_force_corrected": _core.RestoringForce.MeasuredForceCorrected}
-SCHEMES = {"central_difference": _core.IntegrationScheme.CentralDifference,
-           "explicit_newmark": _core.IntegrationScheme.ExplicitNewmark}
-FORCE_MEASUREMENT = {"load_cell": _core.ForceMeasurement.LoadCell,
-                     "actuator_pressure": _core.ForceMeasurement.ActuatorPressure}
+# Names from the core's tables (enum_name.hpp), in the enum's order.
+COMPENSATION = dict(_core.COMPENSATION_NAMES)
+RESTORING_FORCE = dict(_core.RESTORING_FORCE_NAMES)
+SCHEMES = dict(_core.SCHEME_NAMES)
+FORCE_MEASUREMENT = dict(_core.FORCE_MEASUREMENT_NAMES)
 
 
 def _default(value: float | None, config: object, name: str) -> float:
@@ -111,7 +105,7 @@ def sensor_channel(sigma: float = 0.0, quantum: float = 0.0, range: tuple[float,
     return ch
 
 
-def _converter(kind: str, quantum: float, range: tuple[float, float] | None) -> "_core.rths.Converter":
+def _converter(kind: str, quantum: float, range: tuple[float, float] | None) -> _core.rths.Converter:
     c = _core.rths.Converter()
     c.kind = getattr(_core.rths.Converter.Kind, kind)
     c.enabled = quantum != 0.0 or range is not None

@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from .atomic import atomic_path
+from .timegrid import uniform_dt
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -320,23 +321,6 @@ class Response:
         with atomic_path(path) as tmp:
             np.savetxt(tmp, np.column_stack(cols), delimiter=",", header=",".join(names), comments="", fmt="%.10g")
         return path
-
-
-def uniform_dt(time: ArrayLike, where: str = "time", min_rows: int = 2) -> float:
-    """The sample time [s] of a uniformly sampled, increasing time axis; errors name ``where``."""
-    t = np.asarray(time, dtype=float)
-    if t.ndim != 1 or t.size < min_rows:
-        raise ValueError(f"{where}: a record needs at least {min_rows} rows in a 1-D time axis, got shape {t.shape}")
-    d = np.diff(t)
-    if np.any(d <= 0):
-        i = int(np.flatnonzero(d <= 0)[0])
-        raise ValueError(f"{where}: time must be increasing; time[{i + 1}] = {t[i + 1]} <= time[{i}] = {t[i]}")
-    dt = (t[-1] - t[0]) / (t.size - 1)
-    worst = int(np.argmax(np.abs(d - dt)))
-    if abs(d[worst] - dt) > 1e-6 * dt + 1e-12:
-        raise ValueError(f"{where}: time must be uniform; step {worst} is {d[worst]:.9g} s, "
-                         f"the mean step is {dt:.9g} s")
-    return float(dt)
 
 
 _LABELS = {"plant": "simulation", "eft": "EFT", "rpsd": "RPsD", "tracking": "tracking", "record": "record"}

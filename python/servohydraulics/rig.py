@@ -3,9 +3,11 @@
 A rig file is TOML with one table per subsystem and keys named after the
 symbols of Zhao et al. (2003), Table I, in SI units; the specimens
 (Bouc-Wen, MR damper) are in ``[specimen]`` and the delays inside the loop in
-``[delays]`` (docs/specimens.md).  Unknown keys are an error.  ``PARAMETERS`` (keys, units, sources) and ``EFFECTS`` come from the
-core's one parameter table (``_core.RIG_PARAMETERS``, ``_core.EFFECTS``); the
-README's key table is generated from it (``python -m servohydraulics.rig``).
+``[delays]`` (docs/specimens.md).  Unknown keys are an error.  ``PARAMETERS``
+(keys, units, sources) and ``EFFECTS`` come from the core's one parameter table
+(``_core.RIG_PARAMETERS``, ``_core.EFFECTS``), ``FLOW_CURVE_KINDS`` from its
+flow-curve name table; the README's key table is generated from it
+(``python -m servohydraulics.rig``).
 ``Rig`` has ``==``, ``repr``, ``copy.copy`` and pickle from the binding.
 """
 
@@ -50,6 +52,12 @@ PARAMETERS: tuple[Parameter, ...] = tuple(
 EFFECTS: tuple[str, ...] = tuple(e["key"] for e in _core.EFFECTS)
 
 FLOW_CURVE_KEYS = ("kind", "b", "opening", "flow")
+#: servovalve.flow_curve.kind: name -> FlowCurve.Kind (the core's table, rig.hpp).
+FLOW_CURVE_KINDS = dict(_core.FLOW_CURVE_KIND_NAMES)
+
+
+def _flow_curve_kind_name(kind: _core.FlowCurve.Kind) -> str:
+    return next(name for name, value in FLOW_CURVE_KINDS.items() if value == kind)
 
 
 def zhao2003(variant: str = "calibrated", actuator_attached: bool = True) -> Rig:
@@ -74,7 +82,7 @@ def rig_to_dict(rig: Rig) -> dict[str, dict[str, Any]]:
     for p in PARAMETERS:
         out.setdefault(p.section, {})[p.key] = float(getattr(rig, p.key))
     fc = rig.flow_curve
-    curve: dict[str, Any] = {"kind": "rational" if fc.kind == _core.FlowCurve.Kind.Rational else "table"}
+    curve: dict[str, Any] = {"kind": _flow_curve_kind_name(fc.kind)}
     if fc.kind == _core.FlowCurve.Kind.Rational:
         curve["b"] = float(fc.b)
     else:
@@ -141,19 +149,18 @@ def _flow_curve_from_dict(table: Any) -> _core.FlowCurve:
         if key not in FLOW_CURVE_KEYS:
             raise ValueError(f"unknown rig key servovalve.flow_curve.{key}: expected one of {list(FLOW_CURVE_KEYS)}")
     fc = _core.FlowCurve()
-    kind = table.get("kind", "rational")
-    if kind == "rational":
-        fc.kind = _core.FlowCurve.Kind.Rational
+    kind = table.get("kind", _flow_curve_kind_name(fc.kind))
+    if not isinstance(kind, str) or kind not in FLOW_CURVE_KINDS:
+        raise ValueError(f"invalid servovalve.flow_curve.kind = {kind!r}: expected one of {list(FLOW_CURVE_KINDS)}")
+    fc.kind = FLOW_CURVE_KINDS[kind]
+    if fc.kind == _core.FlowCurve.Kind.Rational:
         fc.b = _number("servovalve.flow_curve.b", table.get("b", fc.b))
-    elif kind == "table":
-        fc.kind = _core.FlowCurve.Kind.Table
+    else:
         for key in ("opening", "flow"):
             if key not in table or not isinstance(table[key], list):
                 raise ValueError(f"invalid servovalve.flow_curve.{key}: a table curve needs a list of numbers")
         fc.opening = [_number(f"servovalve.flow_curve.opening[{i}]", v) for i, v in enumerate(table["opening"])]
         fc.flow = [_number(f"servovalve.flow_curve.flow[{i}]", v) for i, v in enumerate(table["flow"])]
-    else:
-        raise ValueError(f"invalid servovalve.flow_curve.kind = {kind!r}: expected 'rational' or 'table'")
     fc.validate()
     return fc
 

@@ -7,6 +7,5 @@ import warnings as _warnings
 _warnings.warn("signals is deprecated and will be removed in 0.3.0; import servohydraulics.identification",
                DeprecationWarning, stacklevel=2)
 
-with _warnings.catch_warnings():  # one warning for this alias, not a second one for the alias it reads
-    _warnings.simplefilter("ignore", DeprecationWarning)
-    from .identify import FreeVibration, fourier_ratio, identify_free_vibration  # noqa: F401
+from .identification._compat import fourier_ratio  # noqa: E402, F401
+from .identification.paper import FreeVibration, identify_free_vibration  # noqa: E402, F401

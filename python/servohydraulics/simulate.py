@@ -8,35 +8,32 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
-from .excitations import time_axis
 from .response import Response, SimulationError, finish
 from .rig import Rig
+from .timegrid import time_axis
 
 #: Largest initial displacement [m]: the plant's divergence guard (plant.cpp, kMaxDisplacement).
 MAX_X0 = 100.0
 
-MODES = {
-    "displacement": _core.ControlMode.Displacement,
-    "force": _core.ControlMode.Force,
-    "free": _core.ControlMode.Free,
-}
-METHODS = {
-    "dopri5": _core.SolverOptions.Method.Dopri5,  # the default: error-controlled, fast, CVODE for stiff samples
-    "rk4": _core.SolverOptions.Method.Rk4,  # the real-time option: fixed cost, flagged by its error estimate
-    "cvode": _core.SolverOptions.Method.CvodeBdf,  # the reference
-    "arkode_erk": _core.SolverOptions.Method.ArkodeErk,
-    "arkode_dirk": _core.SolverOptions.Method.ArkodeDirk,
-}
-RESTARTS = {"on_input_change": _core.SolverOptions.Restart.OnInputChange, "never": _core.SolverOptions.Restart.Never}
+# Names from the core's tables (enum_name.hpp), in the enum's order.  Integrators: dopri5 (the
+# default: error-controlled, fast, CVODE for stiff samples), cvode (the reference), rk4 (the
+# real-time option: fixed cost, flagged by its error estimate), arkode_erk, arkode_dirk.
+MODES = dict(_core.CONTROL_MODE_NAMES)
+METHODS = dict(_core.METHOD_NAMES)
+RESTARTS = dict(_core.RESTART_NAMES)
+#: The core's default integrator's name (SolverOptions().method): "dopri5".
+DEFAULT_METHOD = next(name for name, value in METHODS.items() if value == _core.SolverOptions().method)
 
 
-def solver_options(method: str = "dopri5", rtol: float | None = None, restart: str = "on_input_change",
-                   rk4_substeps: int = 0, max_steps_per_sample: int = 2000,
-                   max_order: int = 5, rk4_h_rho: float | None = None,
+def solver_options(method: str = DEFAULT_METHOD, rtol: float | None = None, restart: str | None = None,
+                   rk4_substeps: int | None = None, max_steps_per_sample: int | None = None,
+                   max_order: int | None = None, rk4_h_rho: float | None = None,
                    rk4_v_ref: float | None = None, atol_fraction: float | None = None,
-                   stiff_fallback: bool = True, stiff_steps: int | None = None,
-                   rk4_flag_rtol: float | None = None, rk4_max_refinements: int = 0) -> _core.SolverOptions:
-    """Builds solver options; see ``SolverOptions`` in solver_options.hpp.
+                   stiff_fallback: bool | None = None, stiff_steps: int | None = None,
+                   rk4_flag_rtol: float | None = None, rk4_max_refinements: int | None = None,
+                   max_internal_step: float | None = None) -> _core.SolverOptions:
+    """Builds solver options; see ``SolverOptions`` in solver_options.hpp (one keyword per row of
+    its field table, ``_core.SOLVER_OPTION_FIELDS``).
 
     ``method``: ``"dopri5"`` (default: Dormand-Prince 5(4) with error control at ``rtol``, a sample
     where it turns stiff is redone by CVODE, or reported as status ``stiff`` if ``stiff_fallback`` is
@@ -48,15 +45,16 @@ def solver_options(method: str = "dopri5", rtol: float | None = None, restart: s
     keeps the core's default."""
     if method not in METHODS:
         raise ValueError(f"invalid method = {method!r}: expected one of {sorted(METHODS)}")
-    if restart not in RESTARTS:
+    if restart is not None and restart not in RESTARTS:
         raise ValueError(f"invalid restart = {restart!r}: expected one of {sorted(RESTARTS)}")
     o = _core.SolverOptions()
     o.method = METHODS[method]
-    o.restart = RESTARTS[restart]
-    _assign(o, rtol=rtol, rk4_substeps=rk4_substeps, max_steps_per_sample=max_steps_per_sample,
-            max_order=max_order, rk4_h_rho=rk4_h_rho, rk4_v_ref=rk4_v_ref, atol_fraction=atol_fraction,
-            stiff_fallback=bool(stiff_fallback), stiff_steps=stiff_steps, rk4_flag_rtol=rk4_flag_rtol,
-            rk4_max_refinements=rk4_max_refinements)
+    _assign(o, restart=None if restart is None else RESTARTS[restart], rtol=rtol, rk4_substeps=rk4_substeps,
+            max_steps_per_sample=max_steps_per_sample, max_order=max_order, rk4_h_rho=rk4_h_rho,
+            rk4_v_ref=rk4_v_ref, atol_fraction=atol_fraction,
+            stiff_fallback=None if stiff_fallback is None else bool(stiff_fallback), stiff_steps=stiff_steps,
+            rk4_flag_rtol=rk4_flag_rtol, rk4_max_refinements=rk4_max_refinements,
+            max_internal_step=max_internal_step)
     o.validate()
     return o
 

@@ -5,7 +5,7 @@ force control.  Every run is within the method's stated tolerance (1e-3 of the
 peak displacement and force for the default, 1e-2 for RK4) or says it is not
 (a non-ok status, RK4 samples flagged by its error estimate): never silently
 off.  The rigs, the commands and the counting are those of
-benchmarks/accuracy_random_rigs.py (1,200 rigs of 1 s there, published in
+evaluation/accuracy_random_rigs.py (1,200 rigs of 1 s there, published in
 docs/benchmarks.md); here 200 rigs of 0.4 s keep the test near a minute.
 """
 
@@ -19,7 +19,7 @@ import pytest
 
 import servohydraulics as sh
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "evaluation"))
 import accuracy_random_rigs as ar  # noqa: E402
 
 RIGS = 200

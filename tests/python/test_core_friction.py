@@ -8,7 +8,7 @@ Oracles:
 * steady sliding: a constant force F0 drives the free structure to the terminal
   velocity v* with F0 = c v* + g(v*) (LuGre's steady state is the static law);
 * the independent plain-Python simulator of the diagnose evaluation
-  (benchmarks/diagnose_eval/independent_plant.py), which has its own LuGre model.
+  (evaluation/diagnose_eval/independent_plant.py), which has its own LuGre model.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from scipy.optimize import brentq
 
 import servohydraulics as sh
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks" / "diagnose_eval"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "evaluation" / "diagnose_eval"))
 import independent_plant as ip  # noqa: E402
 
 DT = 5e-4

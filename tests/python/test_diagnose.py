@@ -1,10 +1,10 @@
 """Diagnose: the contract (API, CLI, files, JSON) and hidden-effect cases end to end.
 
 Records are made by the independent plain-Python simulator of the evaluation
-(benchmarks/diagnose_eval/independent_plant.py), not by the core the workflow uses,
+(evaluation/diagnose_eval/independent_plant.py), not by the core the workflow uses,
 with measurement noise; the workflow sees only the record, mode and nominal rig.
 The full evaluation (many records, graded strengths, other forms) is
-benchmarks/diagnose_eval/evaluate.py, reported in docs/diagnose_eval.md.
+evaluation/diagnose_eval/evaluate.py, reported in docs/diagnose_eval.md.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from servohydraulics.diagnosis import NAMES
 from servohydraulics.diagnosis import engine
 from servohydraulics.records import Record
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks" / "diagnose_eval"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "evaluation" / "diagnose_eval"))
 import independent_plant as ip  # noqa: E402
 
 DT = 5e-4

@@ -3,7 +3,7 @@ the Bouc-Wen specimen, the invariant that a candidate's fit never ends worse tha
 its "absent" value, and candidates on rigs other than the paper's.
 
 Records are made by the evaluation's independent plain-Python simulator
-(benchmarks/diagnose_eval/independent_plant.py: a true transport delay in the loop,
+(evaluation/diagnose_eval/independent_plant.py: a true transport delay in the loop,
 not the core's Pade approximant; its own Bouc-Wen law), never by the core.
 """
 
@@ -23,7 +23,7 @@ from servohydraulics.diagnosis.confirm import fit_space
 from servohydraulics.diagnosis.effects import Context
 from servohydraulics.records import Record
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks" / "diagnose_eval"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "evaluation" / "diagnose_eval"))
 import generate as gen  # noqa: E402
 import independent_plant as ip  # noqa: E402
 

@@ -1,7 +1,7 @@
 """Diagnose: the joint re-fit of two hidden effects.
 
 The record is made by the independent plain-Python simulator of the evaluation
-(benchmarks/diagnose_eval/independent_plant.py, no code shared with the core the
+(evaluation/diagnose_eval/independent_plant.py, no code shared with the core the
 workflow uses) with two effects hidden at known values, and measurement noise;
 the workflow sees only the record, the mode and the nominal rig.  Fitted one
 after the other, the first effect's parameter absorbs part of the second (a
@@ -22,7 +22,7 @@ import numpy as np
 import servohydraulics as sh
 from servohydraulics.records import Record
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks" / "diagnose_eval"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "evaluation" / "diagnose_eval"))
 import independent_plant as ip  # noqa: E402
 
 DT = 5e-4  #: 2 kHz [s]

@@ -169,9 +169,36 @@ def test_parameters_come_from_the_core_tables(fmus):
             assert v[name].causality == "output"
             assert v[name].unit == (None if unit == "-" else unit)
     assert v["command"].unit == "m" and v["command"].causality == "input"
-    # The FMU's method names are simulate.py's, in the C++ enum's order.
-    from servohydraulics.simulate import METHODS
-    assert [i.name for i in v["solver.method"].declaredType.items] == sorted(METHODS, key=lambda k: int(METHODS[k]))
+    # Every enum parameter's items are the core's name table (enum_name.hpp), in the enum's order,
+    # and every SolverOptions field (kSolverOptionFields) is a parameter.
+    tables = {"solver.method": _core.METHOD_NAMES, "solver.restart": _core.RESTART_NAMES}
+    for name, table in tables.items():
+        assert [i.name for i in v[name].declaredType.items] == [n for n, _ in table]
+        assert [int(e) for _, e in table] == list(range(len(table)))
+    assert {f["name"] for f in _core.SOLVER_OPTION_FIELDS} == {n[len("solver."):] for n in v if n.startswith("solver.")}
+    for key, table in (("eft", {"eft.compensation": _core.COMPENSATION_NAMES}),
+                       ("rpsd", {"rpsd.scheme": _core.SCHEME_NAMES, "rpsd.restoring_force": _core.RESTORING_FORCE_NAMES,
+                                 "rpsd.force_measurement": _core.FORCE_MEASUREMENT_NAMES})):
+        cv = {x.name: x for x in read_model_description(str(fmus[key])).modelVariables}
+        for name, names in table.items():
+            assert [i.name for i in cv[name].declaredType.items] == [n for n, _ in names]
+
+
+def test_plant_fmu_takes_every_solver_option(rig, tmp_path):
+    """The FMU integrates with the options it was exported with, all of them: with CVODE at a
+    coarse atol_fraction and order 2 (fields the FMU once dropped) it still equals sh.simulate."""
+    options = sh.solver_options(method="cvode", rtol=1e-6, atol_fraction=0.5, max_order=2)
+    path = sh.export_fmu(rig, tmp_path / "options.fmu", solver_options=options)
+    v = {x["name"]: x["start"] for x in _core.fmu_variables("plant", "displacement", rig, DT, 0.0, options,
+                                                              _core.EftConfig(), _core.RpsdConfig())}
+    for f in _core.SOLVER_OPTION_FIELDS:
+        value = getattr(options, f["name"])
+        assert v["solver." + f["name"]] == (value if isinstance(value, float) else float(int(value))), f["name"]
+    u = 0.01 * np.sin(2 * np.pi * 2.0 * np.arange(400) * DT)
+    ref = sh.simulate(rig, "displacement", u, DT, options=options)
+    dropped = sh.simulate(rig, "displacement", u, DT, options=sh.solver_options(method="cvode", rtol=1e-6))
+    assert _rel(ref.channels["pressure"], dropped.channels["pressure"]) > 1e3 * RTOL  # the options matter
+    _equal(run_plant(path, tmp_path, u), ref, PLANT_OUT)
 
 
 @pytest.mark.parametrize("mode", ["displacement", "force"])

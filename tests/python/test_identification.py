@@ -230,18 +230,23 @@ def test_identify_and_the_diagnosis_give_the_same_interval_for_the_same_fit():
 # --- the package: a plain function, deprecated aliases, no import cycle ------------------------
 
 def test_identify_is_a_plain_function_and_the_old_names_are_deprecated_aliases():
+    """``sh.identify`` is the package's function (no callable module, no class swap); the old
+    module paths warn, naming the new one and the removal version.  (Importing the deprecated
+    module ``servohydraulics.identify`` binds the package attribute to it, as any submodule
+    import does; its warning says to use ``servohydraulics.identification``.)"""
     from servohydraulics import identification
 
     assert isinstance(sh.identify, types.FunctionType) and sh.identify is identification.identify
-    code = ("import warnings, servohydraulics as sh\n"
+    code = ("import types, warnings, servohydraulics as sh\n"
+            "assert isinstance(sh.identify, types.FunctionType), sh.identify\n"
             "for name in ('servohydraulics.identify', 'servohydraulics.lab'):\n"
             "    with warnings.catch_warnings(record=True) as w:\n"
             "        warnings.simplefilter('always')\n"
             "        __import__(name)\n"
             "    msg = [str(x.message) for x in w if issubclass(x.category, DeprecationWarning)]\n"
             "    assert any('servohydraulics.identification' in m and '0.3.0' in m for m in msg), (name, msg)\n"
-            "import types\n"
-            "assert isinstance(sh.identify, types.FunctionType), sh.identify\n"
+            "from servohydraulics.identification import identify\n"
+            "assert isinstance(identify, types.FunctionType)\n"
             "from servohydraulics.lab import keys, fitting\n"
             "from servohydraulics.identification import coordinates, fit\n"
             "assert keys is coordinates and fitting is fit\n"
@@ -319,5 +324,6 @@ def test_the_identification_modules_import_no_cycle():
                                            ("servohydraulics.lab", "servohydraulics.identification.records")])
 def test_modules_import_in_either_order_in_a_fresh_interpreter(first, second):
     code = (f"import warnings; warnings.simplefilter('ignore', DeprecationWarning)\n"
-            f"import {first}\nimport {second}\nimport servohydraulics as sh\nassert callable(sh.identify)\n")
+            f"import {first}\nimport {second}\nfrom servohydraulics.identification import identify\n"
+            "assert callable(identify)\n")
     subprocess.run([sys.executable, "-c", code], check=True)

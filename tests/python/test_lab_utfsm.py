@@ -1,7 +1,7 @@
 """The UTFSM records (../shared/real-data/utfsm-mts-mrdamper, never copied here):
 the thesis' baselines as its README reports them, our H1 against the README's
 table, a loop identified from the 0 A chirp predicting the 0 A sweep at least as
-well as the thesis' G(s), and the rigs benchmarks/utfsm_eval.py identified
+well as the thesis' G(s), and the rigs evaluation/utfsm_eval.py identified
 (MR damper) against the thesis' models on every held-out record and channel."""
 
 from __future__ import annotations
@@ -76,21 +76,21 @@ def test_loop_identified_from_chirp_predicts_sweep_no_worse_than_thesis():
                                                                  chirp.displacement)
 
 
-#: (identified from, held out) at the same current; the rigs are those benchmarks/utfsm_eval.py
-#: identified (generic start, --specimen mr_damper) and committed in benchmarks/utfsm_rigs/
+#: (identified from, held out) at the same current; the rigs are those evaluation/utfsm_eval.py
+#: identified (generic start, --specimen mr_damper) and committed in evaluation/utfsm_rigs/
 HELD_OUT = (("chirp20Hz_0A", "sweep15Hz_0A"), ("sweep15Hz_0A", "chirp20Hz_0A"),
             ("chirp20Hz_1A", "sweep15Hz_1A"), ("sweep15Hz_1A", "chirp20Hz_1A"))
-RIGS = Path(__file__).resolve().parents[2] / "benchmarks" / "utfsm_rigs"
+RIGS = Path(__file__).resolve().parents[2] / "evaluation" / "utfsm_rigs"
 CURRENT = {"0A": 0.0, "1A": 1.0}
 #: held-out cases where ours still loses (docs/lab-records.md says why); strict: a win fails
 #: the test until this table is updated
 KNOWN_LOSSES = {("chirp20Hz_0A", "sweep15Hz_0A", "force"):
-                "the measured June 0 A |F/x| is 1.50-1.60 x the May one at 2-14 Hz (benchmarks/utfsm_losses.py)",
+                "the measured June 0 A |F/x| is 1.50-1.60 x the May one at 2-14 Hz (evaluation/utfsm_losses.py)",
                 ("chirp20Hz_1A", "sweep15Hz_1A", "force"):
-                "the measured June 1 A force lags the May one by 3-7.5 deg at 2-14 Hz (benchmarks/utfsm_losses.py)"}
+                "the measured June 1 A force lags the May one by 3-7.5 deg at 2-14 Hz (evaluation/utfsm_losses.py)"}
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def held_out(train: str, test: str) -> tuple[dict, dict]:
     """(ours, thesis) NRMSE [%] per channel on the held-out record."""
     rec = record(test)

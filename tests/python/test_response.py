@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import importlib
 import pickle
-import subprocess
 import sys
 
 import numpy as np
@@ -120,10 +119,12 @@ def _overrun() -> _core.SolverOptions:
 def test_failure_raises_simulation_error_with_the_partial_response(calibrated, run):
     """Every runner raises by default; the error carries the status and the rows
     up to the failure, the same rows raise_on_failure=False returns."""
+    ag = _ag()
     call = {"simulate": lambda **kw: sh.simulate(calibrated, command=np.full(N, 1e-3), options=_overrun(), **kw),
-            "run_eft": lambda **kw: sh.run_eft(calibrated, ground_acceleration=_ag(), solver_options=_overrun(), **kw),
-            "run_rpsd": lambda **kw: sh.run_rpsd(calibrated, ground_acceleration=_ag(), solver_options=_overrun(), **kw),
-            "run_tracking": lambda **kw: sh.run_tracking(calibrated, np.full(N, 1e-3), solver_options=_overrun(), **kw)}[run]
+            "run_eft": lambda **kw: sh.run_eft(calibrated, ground_acceleration=ag, solver_options=_overrun(), **kw),
+            "run_rpsd": lambda **kw: sh.run_rpsd(calibrated, ground_acceleration=ag, solver_options=_overrun(), **kw),
+            "run_tracking": lambda **kw: sh.run_tracking(calibrated, np.full(N, 1e-3), solver_options=_overrun(),
+                                                         **kw)}[run]
     with pytest.raises(sh.SimulationError, match=r"failed at t = [0-9.e-]+ s: overrun") as info:
         call()
     err = info.value
@@ -161,39 +162,3 @@ def test_method_defaults_are_the_core_configs(calibrated):
                     amplitude_T=rpsd.amplitude_T, delay_T=rpsd.delay_T, alpha=rpsd.alpha)
     np.testing.assert_array_equal(a.calc_displacement, b.calc_displacement)
     assert a.rig.m == rpsd.model.m_m
-
-
-# ---- the package ---------------------------------------------------------------------------
-
-
-def _python(code: str) -> str:
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    return out.stdout.strip()
-
-
-def test_import_loads_no_heavy_dependency():
-    """import servohydraulics imports neither matplotlib, pandas nor python-control."""
-    code = ("import sys, servohydraulics as sh\n"
-            "print(sorted(m for m in ('matplotlib', 'pandas', 'control') if m in sys.modules))\n"
-            "sh.analysis\n"
-            "print('control' in sys.modules)")
-    assert _python(code).splitlines() == ["[]", "True"]
-
-
-def test_import_leaves_the_plotting_backend_alone():
-    code = ("import matplotlib\nmatplotlib.use('svg')\n"
-            "import servohydraulics as sh\nimport servohydraulics.plots, servohydraulics.analysis\n"
-            "fig, ax = servohydraulics.plots.new_figure('t')\n"
-            "print(matplotlib.get_backend())")
-    assert _python(code) == "svg"
-
-
-def test_functions_do_not_shadow_their_modules():
-    """sh.sweep, sh.diagnose, sh.reproduce stay functions after their modules are imported."""
-    for name in ("sweep", "diagnose", "reproduce"):
-        assert callable(getattr(sh, name)) and not isinstance(getattr(sh, name), type(sh))
-    for module in ("servohydraulics.sweep", "servohydraulics.analysis", "servohydraulics.loops"):
-        assert importlib.import_module(module).__name__ == module
-    assert callable(sh.sweep) and sh.sweep.__module__ == "servohydraulics.sweep"
-    assert "_core" not in sh.__all__
-    assert sh.linearize is importlib.import_module("servohydraulics.analysis").linearize

@@ -157,7 +157,7 @@ def test_perturbed_trials_stable_and_reproducible(data):
 
 def test_a_diverging_trial_is_not_stable(data, monkeypatch):
     """The quadratic extrapolation loses perturbed plant 20 of case 4 (seed-0 draws) at
-    59 Hz (benchmarks/rths_polynomial_study.py): it runs to the end in floating point,
+    59 Hz (studies/rths_polynomial_study.py): it runs to the end in floating point,
     so only the stability test can say so; the first-order default keeps it."""
     from servohydraulics.rths import benchmark as B
     case, rec = rths.load_case(data, 4), rths.load_record(data, "elcentro")

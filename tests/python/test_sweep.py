@@ -18,7 +18,7 @@ import pytest
 from scipy import stats
 
 import servohydraulics as sh
-from servohydraulics.sweep import summary_run
+from servohydraulics.parameter_sweep import summary_run
 
 AMPLITUDE = 2e-3  # [m]: small, the flow curve and friction stay negligible
 FREQUENCY = 0.5  # [Hz]

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "servohydraulics/enum_name.hpp"
 #include "servohydraulics/plant.hpp"
 #include "servohydraulics/rig.hpp"
 
@@ -102,5 +103,12 @@ class VelocityFeedbackCompensator {
   double A_, K_v_, Kx_, Kf_, x_v_max_;  // Kx_ = K_s C_F G_p [1/N]
   double x_total_ = 0.0;
 };
+//! Velocity feedback compensation by name ("none" is None_ in Python, where None is a keyword).
+inline constexpr EnumName<VelocityFeedbackCompensator::Kind> kCompensationNames[] = {
+    {VelocityFeedbackCompensator::Kind::None, "none", "None_"},
+    {VelocityFeedbackCompensator::Kind::Linear, "linear", "Linear"},
+    {VelocityFeedbackCompensator::Kind::Nonlinear, "nonlinear", "Nonlinear"},
+};
+static_assert(in_enum_order(kCompensationNames), "kCompensationNames: one row per enumerator, in order");
 
 }  // namespace servohydraulics

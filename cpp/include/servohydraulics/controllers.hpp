@@ -102,6 +102,18 @@ enum class ForceMeasurement {
   LoadCell,          //!< the plant's load cell between piston and structure
   ActuatorPressure,  //!< p A, the force on the piston (includes the piston's inertia: the paper's "pA")
 };
+inline constexpr EnumName<RestoringForce> kRestoringForceNames[] = {
+    {RestoringForce::CalculatedDisplacement, "calculated_displacement", "CalculatedDisplacement"},
+    {RestoringForce::MeasuredDisplacement, "measured_displacement", "MeasuredDisplacement"},
+    {RestoringForce::MeasuredForce, "measured_force", "MeasuredForce"},
+    {RestoringForce::MeasuredForceCorrected, "measured_force_corrected", "MeasuredForceCorrected"},
+};
+static_assert(in_enum_order(kRestoringForceNames), "kRestoringForceNames: one row per enumerator, in order");
+inline constexpr EnumName<ForceMeasurement> kForceMeasurementNames[] = {
+    {ForceMeasurement::LoadCell, "load_cell", "LoadCell"},
+    {ForceMeasurement::ActuatorPressure, "actuator_pressure", "ActuatorPressure"},
+};
+static_assert(in_enum_order(kForceMeasurementNames), "kForceMeasurementNames: one row per enumerator, in order");
 
 struct RpsdConfig {
   double dt = Zhao2003TestMethods{}.dt;     //!< controller sample time [s]

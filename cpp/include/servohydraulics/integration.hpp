@@ -8,6 +8,8 @@
 // the displacement d_{k+1} to be reached one controller sample later.
 #pragma once
 
+#include "servohydraulics/enum_name.hpp"
+
 namespace servohydraulics {
 
 //! Modelled system of Eq (15).  No defaults here: Table I's values live in
@@ -20,6 +22,11 @@ struct ModelSDOF {
 
 //! Which scheme integrates Eq (15) online.
 enum class IntegrationScheme { CentralDifference, ExplicitNewmark };
+inline constexpr EnumName<IntegrationScheme> kSchemeNames[] = {
+    {IntegrationScheme::CentralDifference, "central_difference", "CentralDifference"},
+    {IntegrationScheme::ExplicitNewmark, "explicit_newmark", "ExplicitNewmark"},
+};
+static_assert(in_enum_order(kSchemeNames), "kSchemeNames: one row per enumerator, in order");
 
 //! State of an integration scheme at time t_k.
 struct IntegratorState {

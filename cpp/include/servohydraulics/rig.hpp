@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "servohydraulics/enum_name.hpp"
 #include "servohydraulics/error.hpp"
 
 namespace servohydraulics {
@@ -35,6 +36,12 @@ struct FlowCurve {
   double inverse(double q) const noexcept;  //!< x with g(x) = q (clamped to the curve's range)
   void validate() const;                    //!< throws Error naming the bad field
 };
+//! servovalve.flow_curve.kind of a rig file.
+inline constexpr EnumName<FlowCurve::Kind> kFlowCurveKindNames[] = {
+    {FlowCurve::Kind::Rational, "rational", "Rational"},
+    {FlowCurve::Kind::Table, "table", "Table"},
+};
+static_assert(in_enum_order(kFlowCurveKindNames), "kFlowCurveKindNames: one row per enumerator, in order");
 
 //! The flow curve of the preset: linear (g = x) below 10 % opening, where the
 //! paper found the constant initial gain adequate (p. 1780), bending to the

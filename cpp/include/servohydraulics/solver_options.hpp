@@ -2,6 +2,9 @@
 // not the structural integration scheme of Eq 15).
 #pragma once
 
+#include <variant>
+
+#include "servohydraulics/enum_name.hpp"
 #include "servohydraulics/state.hpp"
 
 namespace servohydraulics {
@@ -25,7 +28,7 @@ struct SolverOptions {
   Method method = Method::Dopri5;
   Restart restart = Restart::OnInputChange;
   //! Relative tolerance of every error-controlled method [-].  1e-8 keeps the default's error within
-  //! 1e-3 of the peak displacement and force on random rigs (benchmarks/accuracy_random_rigs.py): at
+  //! 1e-3 of the peak displacement and force on random rigs (evaluation/accuracy_random_rigs.py): at
   //! 1e-6 a fifth of them were off by up to 3e-3, at 1e-7 one in 200 by 2e-3 (stick-slip with a
   //! large Coulomb force, where the sticking times amplify the local errors).
   double rtol = 1e-8;
@@ -53,7 +56,7 @@ struct SolverOptions {
   //! (rk4_flag_rtol, atol), exceeds 1 is flagged (Status::inaccurate).  The estimate is the
   //! 3rd-order error, far above RK4's own on smooth runs: 5e-5 flags no sample of the preset on
   //! the benchmark record (3e-5 flags 4 %, 1e-5 half of them) and every random rig beyond 1e-2
-  //! (benchmarks/accuracy_random_rigs.py; 1e-4 missed 2 of 1,200, at 1.1e-2).
+  //! (evaluation/accuracy_random_rigs.py; 1e-4 missed 2 of 1,200, at 1.1e-2).
   double rk4_flag_rtol = 5e-5;
   //! Rk4: a flagged sample is redone with twice the substeps, up to this many times (0 = flag only:
   //! fixed cost); it stays flagged.  Bounded by kMaxSubsteps substeps per sample.
@@ -63,6 +66,54 @@ struct SolverOptions {
 
   //! Throws Error naming the first invalid field.
   void validate() const;
+};
+
+//! The integrators by name (sh.solver_options(method=...), the FMU's solver.method, the CLI's --method).
+inline constexpr EnumName<SolverOptions::Method> kMethodNames[] = {
+    {SolverOptions::Method::Dopri5, "dopri5", "Dopri5"},
+    {SolverOptions::Method::CvodeBdf, "cvode", "CvodeBdf"},
+    {SolverOptions::Method::Rk4, "rk4", "Rk4"},
+    {SolverOptions::Method::ArkodeErk, "arkode_erk", "ArkodeErk"},
+    {SolverOptions::Method::ArkodeDirk, "arkode_dirk", "ArkodeDirk"},
+};
+static_assert(in_enum_order(kMethodNames), "kMethodNames: one row per enumerator, in order");
+inline constexpr EnumName<SolverOptions::Restart> kRestartNames[] = {
+    {SolverOptions::Restart::OnInputChange, "on_input_change", "OnInputChange"},
+    {SolverOptions::Restart::Never, "never", "Never"},
+};
+static_assert(in_enum_order(kRestartNames), "kRestartNames: one row per enumerator, in order");
+
+//! One field of SolverOptions: the Python attribute, the FMU's variable "solver.<name>" and its
+//! fmu.toml key.  The binding (def_readwrite, the object protocol) and the FMU's parameters
+//! follow this table, so a new option needs its member and one row here.
+struct SolverOptionField {
+  const char* name;
+  std::variant<SolverOptions::Method SolverOptions::*, SolverOptions::Restart SolverOptions::*,
+               double SolverOptions::*, int SolverOptions::*, long SolverOptions::*, bool SolverOptions::*>
+      member;
+  const char* unit;  //!< "" for none
+  const char* doc;
+};
+
+inline constexpr SolverOptionField kSolverOptionFields[] = {
+    {"method", &SolverOptions::method, "", "the plant's ODE integrator (solver_options.hpp)"},
+    {"restart", &SolverOptions::restart, "", "CVODE restart on a command jump"},
+    {"rtol", &SolverOptions::rtol, "", "relative tolerance (dopri5, CVODE, ARKODE)"},
+    {"atol_fraction", &SolverOptions::atol_fraction, "",
+     "absolute tolerance of state i = rtol * atol_fraction * the state's scale"},
+    {"max_order", &SolverOptions::max_order, "", "BDF maximum order"},
+    {"max_steps_per_sample", &SolverOptions::max_steps_per_sample, "",
+     "cap on internal steps in one sample (CVODE, ARKODE, dopri5)"},
+    {"max_internal_step", &SolverOptions::max_internal_step, "s", "CVODE/ARKODE maximum step (0 = no limit)"},
+    {"stiff_steps", &SolverOptions::stiff_steps, "", "dopri5: steps in one sample beyond which it is stiff"},
+    {"stiff_fallback", &SolverOptions::stiff_fallback, "", "dopri5: redo a stiff sample with CVODE"},
+    {"rk4_substeps", &SolverOptions::rk4_substeps, "", "RK4 substeps per sample (0 = automatic)"},
+    {"rk4_h_rho", &SolverOptions::rk4_h_rho, "", "RK4 automatic substeps: bound on h * rho(J)"},
+    {"rk4_v_ref", &SolverOptions::rk4_v_ref, "m/s",
+     "RK4 automatic substeps with LuGre: sliding speed (0 = the no-load actuator speed)"},
+    {"rk4_flag_rtol", &SolverOptions::rk4_flag_rtol, "", "RK4: tolerance of the embedded error estimate"},
+    {"rk4_max_refinements", &SolverOptions::rk4_max_refinements, "",
+     "RK4: times a flagged sample is redone with twice the substeps"},
 };
 
 //! The magnitude of state i of this rig, the unit of its absolute tolerance: x: the half-stroke;

@@ -3,6 +3,8 @@
 
 #include <array>
 
+#include "servohydraulics/enum_name.hpp"
+
 namespace servohydraulics {
 
 //! What the analog servo controller feeds back (Eq 1), or no actuator at all.
@@ -12,14 +14,14 @@ enum class ControlMode {
   Free,          //!< structure alone, no actuator; command is an ideal external force [N]
 };
 
-constexpr const char* to_string(ControlMode mode) noexcept {
-  switch (mode) {
-    case ControlMode::Displacement: return "displacement";
-    case ControlMode::Force: return "force";
-    case ControlMode::Free: return "free";
-  }
-  return "?";
-}
+inline constexpr EnumName<ControlMode> kControlModeNames[] = {
+    {ControlMode::Displacement, "displacement", "Displacement"},
+    {ControlMode::Force, "force", "Force"},
+    {ControlMode::Free, "free", "Free"},
+};
+static_assert(in_enum_order(kControlModeNames), "kControlModeNames: one row per enumerator, in order");
+
+constexpr const char* to_string(ControlMode mode) noexcept { return name_of(kControlModeNames, mode); }
 
 //! Indices of the state vector's fixed part (always present, in this order).
 //! kZ is the LuGre bristle deflection [m] (held at 0 unless effects.lugre_friction).

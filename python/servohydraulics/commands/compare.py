@@ -13,7 +13,8 @@ def _run(args: argparse.Namespace) -> int:
     from ..simulate import solver_options
 
     rec = read_record(args.record)
-    c = compare(rec, load_rig(args.rig), args.mode, dt=args.dt, options=solver_options(method=args.method))
+    options = None if args.method is None else solver_options(method=args.method)
+    c = compare(rec, load_rig(args.rig), args.mode, dt=args.dt, options=options)
     path = c.write(args.out)
     for ch, m in c.channels.items():
         print(f"{c.name} {ch}: NRMSE {m['nrmse_pct']:.2f} % (error mean removed: {m['nrmse_demeaned_pct']:.2f} %)")
@@ -22,6 +23,8 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def register(sub) -> None:
+    from ..simulate import METHODS
+
     p = sub.add_parser("compare", help="simulate a record's command through a rig and compare (NRMSE, FRF, plots)")
     p.add_argument("record", help="record CSV (time, command, displacement, force; or time_s, command_m, ...)")
     p.add_argument("--rig", required=True, help="rig TOML file")
@@ -29,5 +32,6 @@ def register(sub) -> None:
     p.add_argument("--out", required=True, help="output directory (comparison.json, overlay.png, frf.png)")
     p.add_argument("--dt", type=float, default=None,
                    help="controller sample time [s] (default: the record's sample time)")
-    p.add_argument("--method", choices=["cvode", "rk4"], default="cvode", help="integrator (default: cvode)")
+    p.add_argument("--method", choices=list(METHODS), default=None,
+                   help="integrator (default: compare's reference, cvode)")
     p.set_defaults(func=_run)

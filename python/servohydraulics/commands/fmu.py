@@ -36,16 +36,20 @@ def _run(args) -> int:
 
 
 def register(sub) -> None:
+    from ..fmu import KINDS
+    from ..simulate import DEFAULT_METHOD, METHODS, MODES
+
     p = sub.add_parser("fmu", help="export the plant or the EFT/RPsD controller as an FMI 2.0 co-simulation FMU")
     p.add_argument("--rig", help="rig TOML file (default: the calibrated Zhao 2003 preset)")
-    p.add_argument("--kind", choices=["plant", "eft", "rpsd"], default="plant",
+    p.add_argument("--kind", choices=KINDS, default=KINDS[0],
                    help="the plant, or a controller (EFT drives force control, RPsD displacement control)")
-    p.add_argument("--mode", choices=["displacement", "force", "free"], default=None,
+    p.add_argument("--mode", choices=list(MODES), default=None,
                    help="the plant's control mode: the command in m (displacement) or N (default displacement)")
     p.add_argument("--out", required=True, help="the .fmu file to write")
     p.add_argument("--dt", type=float, default=None, help="controller sample [s] (default 0.0005)")
     p.add_argument("--x0", type=float, default=0.0, help="the plant's initial displacement [m]")
-    p.add_argument("--method", default="cvode", help="the plant's ODE integrator (cvode, rk4)")
+    p.add_argument("--method", choices=list(METHODS), default=DEFAULT_METHOD,
+                   help=f"the plant's ODE integrator (default: the library's, {DEFAULT_METHOD})")
     p.add_argument("--name", default=None, help="modelIdentifier (default servohydraulics_<kind>)")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                    help="a controller setting as run_eft / run_rpsd take it (repeatable), e.g. compensation=nonlinear")

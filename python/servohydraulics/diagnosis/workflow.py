@@ -22,9 +22,9 @@ from ..rig import Rig, rig_to_dict
 from ..simulate import MODES
 from . import engine
 from .confirm import confirm, param_report
-from .effects import LIBRARY, Context, check_names, nested, separating_experiment, split_delay
+from .effects import LIBRARY, Context, check_names, nested, separating_experiment
 from .joint import joint_refit
-from .types import Accepted, Case, CandidateLog, Fit, JointRefit, Round, Screening, Sim
+from .types import Accepted, CandidateLog, Case, Fit, JointRefit, Round, Screening, Sim
 
 #: acceptance thresholds (documented in docs/diagnose.md)
 DELTA_BIC_MIN = 10.0  #: "very strong" evidence on the Kass-Raftery scale

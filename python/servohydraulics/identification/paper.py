@@ -28,9 +28,10 @@ from numpy.typing import ArrayLike
 from scipy.optimize import least_squares
 
 from ..excitations import TWO_PI, linear_chirp
-from ..response import SimulationError, uniform_dt
+from ..response import SimulationError
 from ..rig import Rig, copy_rig
 from ..simulate import solver_options
+from ..timegrid import uniform_dt
 from .frf import dft_ratio
 from .run import simulate_command
 from .stats import ar1_coefficient, ar1_effective_n, covariance, quantile

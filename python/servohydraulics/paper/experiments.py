@@ -30,8 +30,8 @@ from ..identification.paper import (
     linear_chirp,
     simulate_structure,
 )
-from ..response import uniform_dt
 from ..rig import Rig
+from ..timegrid import uniform_dt
 
 TWO_PI = 2.0 * math.pi
 _EFT = _core.EftConfig()

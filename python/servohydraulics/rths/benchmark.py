@@ -276,7 +276,7 @@ def run_case(case: BenchmarkCase, record: Record, controller: str = "sample", pe
                                        "PSI": case_psi(case)},
                            "trial": nom, "table": None}
     if perturbed > 0:
-        from ..sweep import sweep
+        from ..parameter_sweep import sweep
         df = sweep(grid={"trial": list(range(1, perturbed + 1))}, run=_perturbed_job,
                    fixed={"case": case, "record": record, "controller": controller, "seed": seed, "scale": scale,
                           "csi_derivative_block": bool(csi_derivative_block), "noise": noise},

@@ -119,7 +119,7 @@ struct PolynomialConfig {
   //! polynomial order, 1..5.  First order by default: the gain at Nyquist is the sum of the
   //! weights' magnitudes, 1 + 2 tau / (stride dt) = 13.8 for the benchmark's 25.1 ms lead;
   //! order 2 gives 109, order 3 at stride 32 gives 128, and both lose perturbed benchmark
-  //! plants (benchmarks/rths_polynomial_study.py).
+  //! plants (studies/rths_polynomial_study.py).
   int order = 1;
   int stride = 16;           //!< samples between the points of the fit (>= 1)
   double static_gain = 1.0;  //!< the plant's DC gain (the command is divided by it)

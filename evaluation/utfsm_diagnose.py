@@ -1,7 +1,7 @@
 """Diagnose a real record: the UTFSM MTS frame driving an MR damper at 1 A,
 starting from the rig identified at 0 A (docs/utfsm_diagnose.md).
 
-    PYTHONPATH=python python benchmarks/utfsm_diagnose.py [--rig RIG_0A.toml] [--record chirp20Hz_1A]
+    PYTHONPATH=python python evaluation/utfsm_diagnose.py [--rig RIG_0A.toml] [--record chirp20Hz_1A]
         [--end 20] [--max-effects 2] [--out build/utfsm_diagnose] [--doc docs/utfsm_diagnose.md]
 
 Without ``--rig`` the 0 A rig is identified first from ``chirp20Hz_0A`` with
@@ -153,7 +153,7 @@ def main() -> None:
                                               ("max-effects", a.max_effects), ("out", a.out), ("label", a.label))
                     if v)
     args += "".join(f" --effect-off {e}" for e in a.effect_off)
-    cmd = f"PYTHONPATH=python python benchmarks/utfsm_diagnose.py {args}"
+    cmd = f"PYTHONPATH=python python evaluation/utfsm_diagnose.py {args}"
     (out / "utfsm_diagnose.json").write_text(json.dumps({"command": cmd, "nominal": how, "identify_s": t_ident,
                                                          "record": a.record, "end": end, "diagnosis": js},
                                                         indent=1, default=str))

@@ -109,7 +109,7 @@ def simulate(tr: Truth, mode: str, u: np.ndarray, dt: float, x0: float = 0.0, su
     def drive_of(y: list, uc: float) -> float:
         # the saturated valve drive of the inner loop, Eq (1); the force feedback F = p A - m_p a, a from the
         # structure's balance (independent of the drive)
-        x, v, p = y[0], y[1], y[2]
+        x, p = y[0], y[2]
         a = (p * tr.A - structure(y)) / M
         F = p * tr.A - mp * a
         err = (commanded(y, uc) - x) if mode == "displacement" else (commanded(y, uc) - F)

@@ -9,7 +9,7 @@ to ``DIR/calibration_bode.png``.
 
 Usage::
 
-    python scripts/calibration_table1.py --out DIR
+    python studies/calibration_table1.py --out DIR
 
 Units are SI throughout: m, kg, s, N, Pa, V; frequencies in Hz unless a name
 ends in ``_rad`` (rad/s); delays and time constants in ms when a name ends in
@@ -366,7 +366,7 @@ def main(argv: list[str] | None = None) -> int:
             for ka in (4e-13, 6.5e-13, 7.9e-13, 1.0e-12, 1.36e-12)
         },
         "swept_volume_L": CALIBRATED.A * 0.254 * 1e3,
-        "command": "python scripts/calibration_table1.py --out DIR",
+        "command": "python studies/calibration_table1.py --out DIR",
     }
     (args.out / "calibration.json").write_text(json.dumps(result, indent=2))
     plot(args.out / "calibration_bode.png")

@@ -1,7 +1,7 @@
 """Evaluation of the diagnose workflow on records with hidden effects.
 
-    python benchmarks/diagnose_eval/generate.py --out build/diagnose_eval
-    python benchmarks/diagnose_eval/evaluate.py --data build/diagnose_eval --jobs 2
+    python evaluation/diagnose_eval/generate.py --out build/diagnose_eval
+    python evaluation/diagnose_eval/evaluate.py --data build/diagnose_eval --jobs 2
 
 Runs ``sh.diagnose`` on every record of the manifest (the workflow sees only the
 record, the mode and the nominal rig), then, and only then, reads the answer key
@@ -180,7 +180,7 @@ def _issue13_section(m: dict, per: list[dict], ans: dict) -> list[str]:
          "In-loop (true transport) and command delays, load pressure with 400 N of Coulomb friction, Bouc-Wen "
          "specimens, and two rigs other than the paper's (rigB: 2.5 t, 250 kN/m, 50 cm^2, 40 Hz valve; rigC: "
          "80 kg, 20 kN/m, 10 cm^2, 120 Hz valve) in displacement and force control "
-         "(`plan_new` in benchmarks/diagnose_eval/generate.py).", "",
+         "(`plan_new` in evaluation/diagnose_eval/generate.py).", "",
          "| subset | single: right first | right anywhere | false positives | param within 20 % | gap closed "
          "(median) | pairs: both named |", "|---|---|---|---|---|---|---|"]
     for lab in ("issue13 snr>=30", "issue13"):
@@ -202,7 +202,7 @@ def write_doc(m: dict, per: list[dict], key: list[dict], doc: Path, cmd: str, wa
          "Made by (every number below):", "", "```", cmd, "```", "",
          f"Wall time {wall:.0f} s with {jobs} worker processes. Records: 2 kHz, "
          f"{key[0]['duration']:g} s each (one extra 10 s record for the runtime check), made by "
-         "`benchmarks/diagnose_eval/independent_plant.py` (plain-Python RK4 of Eqs 1-5, no code shared with the "
+         "`evaluation/diagnose_eval/independent_plant.py` (plain-Python RK4 of Eqs 1-5, no code shared with the "
          "core) with white noise on displacement and force. The workflow sees the record, the mode and the "
          "nominal rig only; the answer key is read after all diagnoses are done.", "",
          "## Against the targets (SNR >= 30 dB)", "",
@@ -260,7 +260,7 @@ def write_doc(m: dict, per: list[dict], key: list[dict], doc: Path, cmd: str, wa
         unmet.append("95 % interval coverage on in-library forms below 90 % (HAC sandwich intervals do not "
                      "include the bias of an unconverged or bound-limited fit, nor the nuisance initial state)")
     L += ["", "Not met, or met only in part: " + ("; ".join(unmet) if unmet else "none") + "."]
-    L += ["", "Truth for forms outside the library (fixed in benchmarks/diagnose_eval/generate.py before any "
+    L += ["", "Truth for forms outside the library (fixed in evaluation/diagnose_eval/generate.py before any "
           "diagnosis): Stribeck friction -> the energy-equivalent Coulomb force "
           "F_eq = sum(F_fr v) / sum(|v|) over the record (second truth, reported above: the sliding Coulomb "
           "level F_c); LuGre friction (with a Stribeck peak F_s = 1.3 F_c that the library's LuGre does not "
@@ -346,9 +346,9 @@ def main() -> None:
     m = metrics(results, key)
     gen = data / "generate.json"
     gen_cmd = (json.loads(gen.read_text())["command"] if gen.exists()
-               else f"python benchmarks/diagnose_eval/generate.py --out {a.data}")
+               else f"python evaluation/diagnose_eval/generate.py --out {a.data}")
     cmd = (f"{gen_cmd} --jobs {a.jobs}\n"
-           f"python benchmarks/diagnose_eval/evaluate.py --data {a.data} --jobs {a.jobs}")
+           f"python evaluation/diagnose_eval/evaluate.py --data {a.data} --jobs {a.jobs}")
     write_doc(m, results, key, doc, cmd, wall, a.jobs)
     doc.with_suffix(".json").write_text(json.dumps({"metrics": m, "records": results, "command": cmd,
                                                     "wall_s": wall}, indent=1, default=str))

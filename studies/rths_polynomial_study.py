@@ -1,7 +1,7 @@
 """The polynomial extrapolation's order and stride (docs/rths-benchmark.md, "Polynomial
 extrapolation: order and stride"): nominal J1/J2 per case and the 80 perturbed plants.
 
-    PYTHONPATH=python SERVOHYDRAULICS_CORE_DIR=build/dev python benchmarks/rths_polynomial_study.py \
+    PYTHONPATH=python SERVOHYDRAULICS_CORE_DIR=build/dev python studies/rths_polynomial_study.py \
         --data ../shared/rths-data/mat [--seed 0]
 
 Each design extrapolates the desired displacement tau = A1/A0 of the nominal plant

@@ -2,13 +2,14 @@
 the case-1 nominal row with the official run's noise, the seed-to-seed spread with
 other noise, and the spec readings tried against the published Table 3 row.
 
-    PYTHONPATH=python SERVOHYDRAULICS_CORE_DIR=build/dev python benchmarks/rths_j5_study.py \
+    PYTHONPATH=python SERVOHYDRAULICS_CORE_DIR=build/dev python studies/rths_j5_study.py \
         --data ../shared/rths-data/mat [--seeds 60] [--readings]
 
 Part 0 runs the C++ loop with the Simulink Random Number block's generator at seed
 0, the official run's realisation (BENCHMARK.md 3.2), exact CSI and the code's
-Derivative block, and prints the largest peaks of |X_m - Ref1| without noise.  Part 1 runs it over noise seeds of a Mersenne twister and of the
-Simulink generator: how often J3 and J5 land on the published values by chance.
+Derivative block, and prints the largest peaks of |X_m - Ref1| without noise.
+Part 1 runs it over noise seeds of a Mersenne twister and of the Simulink
+generator: how often J3 and J5 land on the published values by chance.
 Part 2 (--readings, about 10 min) re-implements the loop of BENCHMARK.md 5.4 in
 Python on the same C++ blocks (plant, substructure, controller), with one reading
 changed at a time, 6 seeds each (numpy noise)."""

@@ -1,6 +1,6 @@
 """Randomized accuracy of the integrators on random valid rigs (issue 16):
 
-    python3 benchmarks/accuracy_random_rigs.py --rigs 1200 --json benchmarks/accuracy_random_rigs.json
+    python3 evaluation/accuracy_random_rigs.py --rigs 1200 --json evaluation/accuracy_random_rigs.json
 
 Each rig is drawn (fixed seed) from wide, physically valid ranges around the
 calibrated preset (mass, stiffness, damping, friction with or without LuGre,
@@ -22,7 +22,7 @@ of docs/benchmarks.md come from running this script against the core of the
 starting commit (no dopri5, no RK4 flag: the old default is CVODE with fixed
 absolute tolerances, the old RK4 rule is unflagged):
 
-    SERVOHYDRAULICS_CORE_DIR=<old core> python3 benchmarks/accuracy_random_rigs.py --rigs 1200
+    SERVOHYDRAULICS_CORE_DIR=<old core> python3 evaluation/accuracy_random_rigs.py --rigs 1200
 
 tests/python/test_accuracy.py runs the same check on fewer, shorter runs.
 """

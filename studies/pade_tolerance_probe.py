@@ -1,7 +1,7 @@
 """The default integrator with a Pade loop delay: cost and accuracy against tight CVODE
 (docs/specimens.md, "Step-time cost").
 
-    PYTHONPATH=python SERVOHYDRAULICS_CORE_DIR=build/dev python benchmarks/pade_tolerance_probe.py
+    PYTHONPATH=python SERVOHYDRAULICS_CORE_DIR=build/dev python studies/pade_tolerance_probe.py
 
 The paper's plant with a 2 ms in-loop delay of Pade order 1, 2, 3, 6 (and order 3 with
 every specimen and delay element), 4000 samples at 2 kHz of 10 mm at 1 Hz plus 3 mm at

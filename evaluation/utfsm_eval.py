@@ -1,6 +1,6 @@
 """Real-data evaluation on the UTFSM MTS/MR-damper records (docs/lab-records.md).
 
-    PYTHONPATH=python python benchmarks/utfsm_eval.py [--data ../shared/real-data/utfsm-mts-mrdamper]
+    PYTHONPATH=python python evaluation/utfsm_eval.py [--data ../shared/real-data/utfsm-mts-mrdamper]
                                                      [--out utfsm_out] [--no-docs]
 
 For each current with a chirp and a sweep (0 A and 1 A): identify the rig
@@ -30,7 +30,7 @@ PAIRS = (("chirp20Hz_0A", "sweep15Hz_0A"), ("sweep15Hz_0A", "chirp20Hz_0A"),
          ("chirp20Hz_1A", "sweep15Hz_1A"), ("sweep15Hz_1A", "chirp20Hz_1A"), ("sweep15Hz_0p5A", None))
 SPECIMEN = "mr_damper"
 #: the identified rigs, committed: tests/python/test_lab_utfsm.py predicts the held-out records with them
-RIGS = ROOT / "benchmarks" / "utfsm_rigs"
+RIGS = ROOT / "evaluation" / "utfsm_rigs"
 START, END = "<!-- utfsm-table:start -->", "<!-- utfsm-table:end -->"
 
 

@@ -1,6 +1,6 @@
 """Seeded generator of records with hidden effects for the diagnose evaluation.
 
-    python benchmarks/diagnose_eval/generate.py --out build/diagnose_eval [--size default|quick] [--seed 2003]
+    python evaluation/diagnose_eval/generate.py --out build/diagnose_eval [--size default|quick] [--seed 2003]
         [--jobs 2] [--cases all|new|old]
 
 Writes OUT/records/*.csv (time, command, displacement, force), OUT/nominal_*.toml
@@ -8,7 +8,7 @@ Writes OUT/records/*.csv (time, command, displacement, force), OUT/nominal_*.tom
 nominal rig: what the workflow may see) and OUT/answer_key.json (what was hidden:
 read only by evaluate.py, never by the workflow).
 
-Records are made by benchmarks/diagnose_eval/independent_plant.py, a plain-Python
+Records are made by evaluation/diagnose_eval/independent_plant.py, a plain-Python
 RK4 simulator of Eqs (1)-(5) that shares no code with the C++ core, with effects
 at graded strengths, in forms the library does not have (Stribeck and LuGre
 friction, a tabulated flow curve, a delay made of a 2nd-order Bessel filter, a
@@ -356,7 +356,7 @@ def generate(out: Path, size: str = "default", seed: int = 2003, duration: float
                   flush=True)
     (out / "manifest.json").write_text(json.dumps(manifest, indent=1))
     args = f"--out {out} --size {size} --seed {seed} --duration {duration:g} --cases {cases}"
-    (out / "generate.json").write_text(json.dumps({"command": f"python benchmarks/diagnose_eval/generate.py {args}"}))
+    (out / "generate.json").write_text(json.dumps({"command": f"python evaluation/diagnose_eval/generate.py {args}"}))
     (out / "answer_key.json").write_text(json.dumps(key, indent=1))
 
 

@@ -5,7 +5,7 @@ sweeps (2.3 kN linear compensation: Fig 3b; 8.9 kN linear / nonlinear
 compensation: Figs 4b-c) and the RPsD damping ratio after a ramp-and-release
 to 1.6 cm at T_ld = 6 / 11.2 / 16 ms (Fig 8).  About 1 minute.
 
-    python scripts/flow_curve_study.py
+    python studies/flow_curve_study.py
 """
 
 import servohydraulics as sh

@@ -1,9 +1,9 @@
 """Why two held-out forces of the UTFSM table still lose (docs/lab-records.md).
 
-    SH_SHARED_DIR=../shared PYTHONPATH=python python benchmarks/utfsm_losses.py [--extra-keys] [--band]
+    SH_SHARED_DIR=../shared PYTHONPATH=python python evaluation/utfsm_losses.py [--extra-keys] [--band]
 
-For each held-out pair, the committed rig (benchmarks/utfsm_rigs/, made by
-benchmarks/utfsm_eval.py) predicts the held-out record's force from its
+For each held-out pair, the committed rig (evaluation/utfsm_rigs/, made by
+evaluation/utfsm_eval.py) predicts the held-out record's force from its
 command; printed: the NRMSE, the least-squares gain g of measured ~ g x
 predicted and the NRMSE at that gain (a level difference between the records),
 and, over six equal stretches of the record (the sweep's frequency rises with
@@ -66,7 +66,7 @@ def main() -> int:
         return 2
     for train, test in PAIRS:
         rec = sh.read_record(DATA / f"{test}.csv")
-        rig = sh.load_rig(ROOT / "benchmarks" / "utfsm_rigs" / f"identified_from_{train}.toml")
+        rig = sh.load_rig(ROOT / "evaluation" / "utfsm_rigs" / f"identified_from_{train}.toml")
         sim = lab.simulate_record(rig, rec, "displacement", options=fit_options(rig, [rec], "displacement")).force
         meas = np.asarray(rec.force, dtype=float)
         g = float(sim @ meas / (sim @ sim))
@@ -129,7 +129,7 @@ def measured_motion(sh, lab) -> None:
 
     print("each committed rig's damper (+ m a) driven by the MEASURED displacement (as the thesis' model is):")
     for train, test in PAIRS:
-        rig = sh.load_rig(ROOT / "benchmarks" / "utfsm_rigs" / f"identified_from_{train}.toml")
+        rig = sh.load_rig(ROOT / "evaluation" / "utfsm_rigs" / f"identified_from_{train}.toml")
         p = rig_spencer(rig, baselines)
         row = []
         for name in (train, test):
@@ -190,9 +190,8 @@ def started_rig(record, start: dict):
 
 
 def extra_keys(sh, lab, fit_options) -> None:
-    from servohydraulics.identification import coordinates as keys
-
     from servohydraulics.identification import baselines
+    from servohydraulics.identification import coordinates as keys
 
     train, test = (sh.read_record(DATA / f"{n}.csv") for n in ("chirp20Hz_1A", "sweep15Hz_1A"))
     default = keys.LOOP_KEYS["displacement"] + keys.SPECIMEN_KEYS["mr_damper"]

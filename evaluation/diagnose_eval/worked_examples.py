@@ -1,6 +1,6 @@
 """The worked examples of docs/diagnose.md, from the paper's own experiments.
 
-    python benchmarks/diagnose_eval/worked_examples.py --out build/diagnose_examples
+    python evaluation/diagnose_eval/worked_examples.py --out build/diagnose_examples
 
 1. Fig 2(b): free vibration from 1.3 cm of the structure alone; the nominal model
    has the identified viscous damping (0.8 %, c = 1.1 kN s/m) but no friction.  The

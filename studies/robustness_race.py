@@ -3,7 +3,7 @@ running ``_core.run_record`` on the same plant (RK4, 200,000 samples each).
 Counts the trials that raised ``ConcurrentUseError`` and those whose results no
 serial order of the two runs gives (silent corruption).
 
-    PYTHONPATH=python SERVOHYDRAULICS_CORE_DIR=build/dev python scripts/robustness_race.py
+    PYTHONPATH=python SERVOHYDRAULICS_CORE_DIR=build/dev python studies/robustness_race.py
 """
 
 from __future__ import annotations
