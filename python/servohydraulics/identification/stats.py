@@ -20,6 +20,12 @@ weights the autocorrelation by each parameter's own score series, so a key the
 slow drift loads on gets the wider interval and one the fast content determines
 does not.  It needs no noise model, reduces to s^2 (J'J)^-1 for white residuals,
 and stays valid for weighted residuals (the channel weights of ``sh.identify``).
+Its known weakness: with strongly persistent residuals and few effective samples
+it under-covers a little (AR(1) noise with phi = 0.95, about 60 effective samples:
+8 and 9 of 10 intervals cover, ``test_identify.py``); against an AR(1) mean it
+recovers the long-run variance within 15 % (``test_identification.py``).  The
+paper-era fits (``paper.py``), ``sh.identify`` (``records.py``) and ``sh.diagnose``
+(``diagnosis/engine.py``) all call :func:`covariance`.
 
 The pseudo-inverse is taken from the SVD of the scaled Jacobian: a direction
 whose singular value is below ``RCOND`` times the largest is not determined by
