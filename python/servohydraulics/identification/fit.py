@@ -292,15 +292,20 @@ def time_costs(recs, start, coords, candidates: dict, mode, chans, options, dt) 
     comparison reports (no channel weights, so that every candidate is judged alike)."""
     out = {}
     for name, z in candidates.items():
-        r = time_residual(coords.apply(start, z), recs, mode, chans, options, dt)
+        try:
+            r = time_residual(coords.apply(start, z), recs, mode, chans, options, dt)
+        except ValueError:  # the candidate is no valid rig
+            out[name] = float("inf")
+            continue
         out[name] = float(r @ r) / 2
     return out
 
 
 def best(costs: dict) -> str:
-    """The candidate of least cost (a tie keeps the later one)."""
+    """The candidate of least cost; a tie keeps the earlier one (a stage that leaves the cost
+    where it was did not improve on it)."""
     names = list(costs)
-    return min(names, key=lambda k: (costs[k], -names.index(k)))
+    return min(names, key=lambda k: (costs[k], names.index(k)))
 
 
 def keep_best(recs, start, coords, candidates: dict, mode, chans, options, dt, bar, workers):
@@ -319,9 +324,9 @@ def not_improved_flags(kept: str, costs: dict) -> list[str]:
     if kept == "time":
         return []
     worse = ", ".join(f"{k} {v:.6g}" for k, v in costs.items() if k != kept)
-    what = "could not improve on its start" if kept == "start" else "the time stage did not improve on the " \
-        "frequency stage"
-    return [f"the fit {what}: the result is the {kept} (time-domain cost {costs[kept]:.6g}; {worse})"]
+    what = "the fit could not improve on its start" if kept == "start" else \
+        "the time stage did not improve on the frequency stage"
+    return [f"{what}: the result is the {kept} (time-domain cost {costs[kept]:.6g}; {worse})"]
 
 
 __all__ = ["DIFF_STEP", "MAX_RK4_SUBSTEPS", "MIN_COHERENCE", "StageResult", "channel_weights", "default_workers",
