@@ -35,8 +35,8 @@ START, END = "<!-- utfsm-table:start -->", "<!-- utfsm-table:end -->"
 
 
 def baselines(records: dict) -> dict:
-    from servohydraulics.lab import baselines as b
-    from servohydraulics.lab import nrmse_demeaned_pct, nrmse_pct
+    from servohydraulics.identification import baselines as b
+    from servohydraulics.identification import nrmse_demeaned_pct, nrmse_pct
 
     out = {}
     for name, rec in records.items():
@@ -52,8 +52,8 @@ def baselines(records: dict) -> dict:
 
 def identify_and_predict(records: dict, out: Path) -> tuple[list, dict]:
     import servohydraulics as sh
-    from servohydraulics.lab import compare, simulate_record
-    from servohydraulics.lab.fitting import fit_options
+    from servohydraulics.identification import compare, simulate_record
+    from servohydraulics.identification.fit import fit_options
 
     rows, times = [], {}
     for train, test in PAIRS:

@@ -29,7 +29,7 @@ Always printed as well (about 30 s, no identification):
 
 ``--band`` identifies each record again (generic start, default keys) on the
 part of it whose command frequency stays below the held-out command's band
-(``lab.frf.command_band``: 99 % of its energy below it): the record cut at the first
+(``identification.frf.command_band``: 99 % of its energy below it): the record cut at the first
 time the command's dominant frequency (STFT peak, 2048-sample Hann windows,
 75 % overlap) exceeds it (the chirps at 44-47 s for the sweeps' 14.7 Hz; the
 sweeps are not cut for the chirps' 20.1 Hz), and prints the held-out NRMSE; at
@@ -58,8 +58,8 @@ def best_shift(sim: np.ndarray, meas: np.ndarray, idx: np.ndarray, span: int = 6
 def main() -> int:
     sys.path.insert(0, str(ROOT / "python"))
     import servohydraulics as sh
-    from servohydraulics import lab
-    from servohydraulics.lab.fitting import fit_options
+    from servohydraulics import identification as lab
+    from servohydraulics.identification.fit import fit_options
 
     if not DATA.is_dir():
         print(f"UTFSM records not found in {DATA}", file=sys.stderr)
@@ -67,7 +67,7 @@ def main() -> int:
     for train, test in PAIRS:
         rec = sh.read_record(DATA / f"{test}.csv")
         rig = sh.load_rig(ROOT / "evaluation" / "utfsm_rigs" / f"identified_from_{train}.toml")
-        sim = lab.simulate_record(rig, rec, "displacement", options=fit_options(rig, [rec], "displacement"))["force"]
+        sim = lab.simulate_record(rig, rec, "displacement", options=fit_options(rig, [rec], "displacement")).force
         meas = np.asarray(rec.force, dtype=float)
         g = float(sim @ meas / (sim @ sim))
         stretches = np.array_split(np.arange(2000, meas.size - 2000), 6)
@@ -88,7 +88,7 @@ FREQUENCIES = np.array([2.0, 3.0, 4.0, 6.0, 8.0, 10.0, 12.0, 14.0])
 
 
 def campaigns(sh, lab) -> None:
-    from servohydraulics.lab import baselines
+    from servohydraulics.identification import baselines
 
     print("force / measured displacement, June chirp vs May sweep (H1, 4096-point segments) at "
           + ", ".join(f"{f:g}" for f in FREQUENCIES) + " Hz:")
@@ -125,7 +125,7 @@ def rig_spencer(rig, baselines):
 
 
 def measured_motion(sh, lab) -> None:
-    from servohydraulics.lab import baselines
+    from servohydraulics.identification import baselines
 
     print("each committed rig's damper (+ m a) driven by the MEASURED displacement (as the thesis' model is):")
     for train, test in PAIRS:
@@ -154,8 +154,8 @@ def cut_below(rec, f_max: float):
 
 
 def band(sh, lab, fit_options) -> None:
-    from servohydraulics.lab import keys
-    from servohydraulics.lab.frf import command_band
+    from servohydraulics.identification import coordinates as keys
+    from servohydraulics.identification.frf import command_band
 
     default = keys.LOOP_KEYS["displacement"] + keys.SPECIMEN_KEYS["mr_damper"]
     extra = ("measurement_delay_force", "mr_n", "mr_k0")
@@ -179,7 +179,7 @@ def band(sh, lab, fit_options) -> None:
 
 def started_rig(record, start: dict):
     """The generic rig scaled from ``record`` with the MR damper's start, then the ``start`` keys."""
-    from servohydraulics.lab import generic
+    from servohydraulics.identification import generic
 
     rig = generic.generic_rig(record)
     generic.mr_damper_start(rig, record)
@@ -190,7 +190,8 @@ def started_rig(record, start: dict):
 
 
 def extra_keys(sh, lab, fit_options) -> None:
-    from servohydraulics.lab import baselines, keys
+    from servohydraulics.identification import baselines
+    from servohydraulics.identification import coordinates as keys
 
     train, test = (sh.read_record(DATA / f"{n}.csv") for n in ("chirp20Hz_1A", "sweep15Hz_1A"))
     default = keys.LOOP_KEYS["displacement"] + keys.SPECIMEN_KEYS["mr_damper"]

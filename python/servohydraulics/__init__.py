@@ -54,11 +54,12 @@ from .simulate import make_plant, simulate, solver_options  # noqa: E402
 __version__ = "0.1.0"
 
 #: Lazily imported submodules (first attribute access imports them).
-_SUBMODULES = ("analysis", "identify", "excitations", "parameter_sweep", "plots", "diagnosis", "paper")
+_SUBMODULES = ("analysis", "identification", "excitations", "parameter_sweep", "plots", "diagnosis", "paper")
 
 #: Lazily resolved names: name -> (module, attribute).
 _LAZY = {
     "linearize": (".analysis", "linearize"),
+    "identify": (".identification", "identify"),
     "sweep": (".parameter_sweep", "sweep"),
     "summary_run": (".parameter_sweep", "summary_run"),
     "diagnose": (".diagnosis", "diagnose"),

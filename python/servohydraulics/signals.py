@@ -1,9 +1,11 @@
-"""Deprecated alias: the signal analysis moved to :mod:`servohydraulics.identify`
-(``fourier_ratio``, ``identify_free_vibration``, ``FreeVibration``); this module
-will be removed in the next release."""
+"""Deprecated alias: the signal analysis moved to :mod:`servohydraulics.identification`
+(``frf.dft_ratio``, ``identify_free_vibration``, ``FreeVibration``); this module
+will be removed in 0.3.0."""
 
 import warnings as _warnings
 
-_warnings.warn("signals is deprecated; import servohydraulics.identify", DeprecationWarning, stacklevel=2)
+_warnings.warn("signals is deprecated and will be removed in 0.3.0; import servohydraulics.identification",
+               DeprecationWarning, stacklevel=2)
 
-from .identify import FreeVibration, fourier_ratio, identify_free_vibration  # noqa: F401
+from .identification._compat import fourier_ratio  # noqa: E402, F401
+from .identification.paper import FreeVibration, identify_free_vibration  # noqa: E402, F401

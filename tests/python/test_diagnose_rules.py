@@ -79,7 +79,7 @@ def test_candidate_log_keys() -> None:
 
 def test_ar1_coefficient_of_an_ar1_process() -> None:
     """The diagnosis's AR(1) coefficient is identify's lag-1 autocorrelation, clipped to [0, 0.999]."""
-    from servohydraulics.identify import ar1_coefficient, ar1_effective_n, lag1_autocorrelation
+    from servohydraulics.identification.stats import ar1_coefficient, ar1_effective_n, lag1_autocorrelation
 
     rng = np.random.default_rng(5)
     phi, n = 0.6, 200_000

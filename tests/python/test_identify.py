@@ -7,7 +7,7 @@ import pytest
 
 import servohydraulics as sh
 from servohydraulics import analysis as an
-from servohydraulics import identify as idf
+from servohydraulics.identification import paper as idf
 
 
 def free_record(seed: int, sigma: float = 5e-5, duration: float = 5.0, dt: float = 2e-3):
@@ -42,17 +42,25 @@ def test_free_vibration_paper_values():
 
 
 def test_autocorrelated_noise_widens_interval():
-    """AR(1) noise: the effective sample size shrinks and the interval widens."""
+    """AR(1) noise (phi = 0.95, about 60 effective samples of 2,500): the residual's lag-1
+    autocorrelation is reported and the HAC intervals cover c and F_c in at least 8 of 10
+    records.  (Newey-West under-covers a little at this persistence: 8 and 9 of these 10;
+    the white-noise rule s^2 (J'J)^-1 would be about sqrt(n / n_eff) = 6 times too narrow.)"""
     rig, t, x0 = free_record(0, sigma=0.0)
-    rng = np.random.default_rng(3)
-    e = np.zeros(t.size)
-    w = 3e-5 * rng.standard_normal(t.size)
-    for i in range(1, t.size):
-        e[i] = 0.95 * e[i - 1] + w[i]
-    est = idf.identify_damping_friction(t, x0 + e, rig)
-    assert est.rho1 > 0.8 and est.n_eff < 0.2 * est.n
-    lo, hi = est.interval("c")
-    assert lo <= rig.c <= hi
+    hits_c = hits_f = 0
+    for seed in range(3, 13):
+        rng = np.random.default_rng(seed)
+        e = np.zeros(t.size)
+        w = 3e-5 * rng.standard_normal(t.size)
+        for i in range(1, t.size):
+            e[i] = 0.95 * e[i - 1] + w[i]
+        est = idf.identify_damping_friction(t, x0 + e, rig)
+        assert est.rho1 > 0.8 and est.n_eff < 0.2 * est.n
+        lo, hi = est.interval("c")
+        hits_c += lo <= rig.c <= hi
+        lo, hi = est.interval("F_c")
+        hits_f += lo <= rig.F_c <= hi
+    assert hits_c >= 8 and hits_f >= 8, (hits_c, hits_f)
 
 
 def test_forced_vibration_with_measured_force():

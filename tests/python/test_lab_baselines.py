@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from servohydraulics.lab import baselines as b
+from servohydraulics.identification import baselines as b
 
 
 def test_spencer_without_hysteresis_is_its_linear_closed_form():

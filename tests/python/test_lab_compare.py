@@ -9,7 +9,7 @@ import pytest
 from scipy import signal
 
 import servohydraulics as sh
-from servohydraulics import lab
+from servohydraulics import identification as lab
 
 DT = 1e-3
 

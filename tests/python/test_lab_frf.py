@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from servohydraulics.lab import baselines, frf
+from servohydraulics.identification import baselines, frf
 
 
 def test_h1_matches_a_known_digital_filter():

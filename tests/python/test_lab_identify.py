@@ -11,8 +11,9 @@ import pytest
 from scipy import signal
 
 import servohydraulics as sh
-from servohydraulics import lab
-from servohydraulics.lab import generic, keys
+from servohydraulics import identification as lab
+from servohydraulics.identification import coordinates as keys
+from servohydraulics.identification import generic
 from servohydraulics.rig import rig_to_dict
 
 DT = 1e-3
@@ -154,18 +155,18 @@ def test_time_blocks():
     """Displacement control with both channels: loop keys on the displacement, then the
     specimen's on the force; otherwise one block of every key and channel."""
     ks = ("G_p", "f_v", "mr_alpha_a", "m")
-    (a1, c1), (a2, c2) = lab.identification.time_blocks(ks, ("displacement", "force"), "displacement")
+    (a1, c1), (a2, c2) = lab.records.time_blocks(ks, ("displacement", "force"), "displacement")
     assert list(a1) == [True, True, False, False] and c1 == ("displacement",)
     assert list(a2) == [False, False, True, True] and c2 == ("force",)
     for chans, mode in ((("displacement",), "displacement"), (("displacement", "force"), "force")):
-        (a, c), = lab.identification.time_blocks(ks, chans, mode)
+        (a, c), = lab.records.time_blocks(ks, chans, mode)
         assert a.all() and c == chans
 
 
 def test_threaded_jacobian_equals_serial_and_the_derivative():
     """Forward differences on 2 threads equal the serial ones bit for bit, and a smooth
     function's derivative to the step's order (backward at an upper bound)."""
-    from servohydraulics.lab.fitting import DIFF_STEP, forward_jacobian
+    from servohydraulics.identification.fit import DIFF_STEP, forward_jacobian
 
     t = np.linspace(0.0, 1.0, 50)
 
@@ -227,12 +228,14 @@ def test_bad_arguments():
         lab.identify(rec, rig=rig, mode="free", progress=False)
 
 
-def test_identify_module_stays_a_module_and_is_callable():
-    from servohydraulics import identify as idf
-    from servohydraulics.identify import identify_first_order
+def test_identify_is_a_plain_function():
+    """``sh.identify`` is the function of the identification package (no callable module); the
+    rig dict still carries the structure's keys."""
+    import types
 
-    assert callable(sh.identify) and idf is sh.identify
-    assert idf.identify_first_order is identify_first_order
+    from servohydraulics import identification
+
+    assert isinstance(sh.identify, types.FunctionType) and sh.identify is identification.identify
     assert "k" in rig_to_dict(truth_rig())["structure"]
 
 
@@ -269,7 +272,7 @@ def test_thesis_parameters_in_si_drive_the_core_like_the_baseline(current):
     """The thesis' Spencer parameters (N, mm, s) converted by ``spencer_rig_keys`` into the
     core's MR element: its specimen force in a displacement-controlled run equals the
     independent NumPy baseline driven by the same displacement, within 1 % of the force's std."""
-    from servohydraulics.lab import baselines as b
+    from servohydraulics.identification import baselines as b
 
     r = truth_rig()
     r.k, r.c = 1.0, 0.0

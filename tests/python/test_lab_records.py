@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import servohydraulics as sh
-from servohydraulics.lab import run
+from servohydraulics.identification import run
 
 
 def _write(path, header, rows):
@@ -55,12 +55,12 @@ def test_controller_sample_defaults_to_the_record_and_can_be_finer():
     u = 0.002 * np.sin(2 * np.pi * 1.5 * t) * np.minimum(t / 0.2, 1)
     rec = _record(rig, u, dt)
     sim = run.simulate_record(rig, rec, "displacement", x0=0.0)
-    np.testing.assert_array_equal(sim["displacement"], rec.displacement)
+    np.testing.assert_array_equal(sim.displacement, rec.displacement)
     fine = run.simulate_record(rig, rec, "displacement", dt=dt / 2, x0=0.0)
     t2 = np.arange(2 * u.size - 1) * dt / 2
     by_hand = sh.simulate(rig, "displacement", command=np.interp(t2, t, u), dt=dt / 2)
-    np.testing.assert_array_equal(fine["displacement"], by_hand.displacement[::2])
+    np.testing.assert_array_equal(fine.displacement, by_hand.displacement[::2])
     coarse = run.simulate_record(rig, rec, "displacement", dt=2 * dt, x0=0.0)
-    assert coarse["displacement"].size == u.size
+    assert coarse.displacement.size == u.size
     with pytest.raises(ValueError, match="invalid dt"):
         run.simulate_record(rig, rec, "displacement", dt=0.7 * dt)

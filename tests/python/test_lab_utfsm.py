@@ -14,9 +14,9 @@ import pytest
 from shared_data import shared_path
 
 import servohydraulics as sh
-from servohydraulics import lab
-from servohydraulics.lab import baselines as b
-from servohydraulics.lab.fitting import fit_options
+from servohydraulics import identification as lab
+from servohydraulics.identification import baselines as b
+from servohydraulics.identification.fit import fit_options
 
 FOLDER = "real-data/utfsm-mts-mrdamper"
 
@@ -90,13 +90,13 @@ KNOWN_LOSSES = {("chirp20Hz_0A", "sweep15Hz_0A", "force"):
                 "the measured June 1 A force lags the May one by 3-7.5 deg at 2-14 Hz (evaluation/utfsm_losses.py)"}
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def held_out(train: str, test: str) -> tuple[dict, dict]:
     """(ours, thesis) NRMSE [%] per channel on the held-out record."""
     rec = record(test)
     rig = sh.load_rig(RIGS / f"identified_from_{train}.toml")
     sim = lab.simulate_record(rig, rec, "displacement", options=fit_options(rig, [rec], "displacement"))
-    ours = {ch: lab.nrmse_pct(sim[ch], rec.channels[ch]) for ch in ("displacement", "force")}
+    ours = {ch: lab.nrmse_pct(sim.channels[ch], rec.channels[ch]) for ch in ("displacement", "force")}
     thesis = {"displacement": lab.nrmse_pct(b.thesis_displacement(rec.time, rec.command), rec.displacement),
               "force": lab.nrmse_pct(b.thesis_mr_force(rec.displacement, rec.dt, CURRENT[test.split("_")[1]]),
                                      rec.force)}

@@ -9,7 +9,8 @@ import pytest
 import servohydraulics as sh
 from servohydraulics import _core
 from servohydraulics import excitations as ex
-from servohydraulics.identify import fourier_ratio, identify_free_vibration
+from servohydraulics.identification.frf import dft_ratio
+from servohydraulics.identification.paper import identify_free_vibration
 
 DT = 5e-4
 SWEEP = 20.0  # [s]: 0-10 Hz at 0.5 Hz/s
@@ -33,7 +34,8 @@ def natural_frequency(rig: sh.Rig) -> float:
 def eft_frf(rig, amplitude, **kw):
     P = ex.sine_sweep(amplitude, duration=SWEEP)
     res = sh.run_eft(rig, effective_force=P, **kw)
-    f, H = fourier_ratio(res.force, P, DT)
+    est = dft_ratio(P[: res.force.size], res.force, DT, min_level=0.0, from_rest=False)
+    f, H = est.frequency, np.abs(est.response)
     band = (f > 0.3) & (f < 10.0)
     return f[band], H[band], res
 

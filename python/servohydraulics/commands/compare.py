@@ -7,7 +7,7 @@ import argparse
 
 
 def _run(args: argparse.Namespace) -> int:
-    from ..lab import compare
+    from ..identification import compare
     from ..records import read_record
     from ..rig import load_rig
     from ..simulate import solver_options

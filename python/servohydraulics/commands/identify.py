@@ -7,7 +7,7 @@ import argparse
 
 
 def _run(args: argparse.Namespace) -> int:
-    from ..lab import identify
+    from ..identification import identify
 
     fit = [k.strip() for k in args.fit.split(",") if k.strip()] if args.fit else None
     ident = identify(args.records, rig=args.rig, fit=fit, mode=args.mode, specimen=args.specimen, dt=args.dt,

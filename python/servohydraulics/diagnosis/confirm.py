@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from ..identification.fit import best
 from . import engine
 from .effects import Context
 from .types import Case, Fit, Refit
@@ -78,12 +79,12 @@ def fit_space(space, z0: np.ndarray, cases: list[Case], x0s, stats: dict, base_t
     alone, never a gain, and never a loss beyond it)."""
     absent = _absent_z(space)
     tr = engine.fit(space, cases, z0, tau, "train", x0s)
-    z_tr = tr.z if _cost(space, tr.z, cases, tr.x0, tau, "train") <= _cost(space, absent, cases, x0s, tau, "train") \
-        else absent
+    z_tr = {"absent": absent, "train": tr.z}[best({"train": _cost(space, tr.z, cases, tr.x0, tau, "train"),
+                                                    "absent": _cost(space, absent, cases, x0s, tau, "train")})]
     x0_tr = tr.x0 if z_tr is tr.z else np.asarray(x0s, float)
     held, held_lr = _heldout(space, z_tr, x0_tr, cases, base_test, tau)
-    start = z_tr if _cost(space, z_tr, cases, x0s, tau, "all") <= _cost(space, absent, cases, x0s, tau, "all") \
-        else absent
+    start = {"absent": absent, "train": z_tr}[best({"train": _cost(space, z_tr, cases, x0s, tau, "all"),
+                                                     "absent": _cost(space, absent, cases, x0s, tau, "all")})]
     res = engine.fit(space, cases, start, tau, "all", x0s, max_nfev=12)
     z, x0 = res.z, res.x0
     rig_c, tau_c = space.rig_and_tau(z, tau)

@@ -24,19 +24,29 @@ from typing import Callable
 
 import numpy as np
 
+from ..identification.coordinates import units
 from ..rig import Rig
 
 
 @dataclass(frozen=True)
 class Param:
-    """One fitted parameter of a candidate."""
+    """One fitted parameter of a candidate.  A rig key's unit comes from the core's parameter
+    table (``sh.PARAMETERS``); only a parameter that is no rig key (a yield displacement, a
+    flow-curve shape) states its own."""
 
-    key: str  #: rig attribute (or "tau" for the command delay)
-    unit: str
+    key: str  #: rig attribute, or the name of a derived parameter
     rig_key: str  #: "section.key" in a rig file, or a note for non-rig parameters
     reciprocal: bool = False  #: fitted as 1/value, so that "absent" (an infinite value) is 0
     #: its 95 % interval is tested against "absent" (False for shape parameters that mean nothing on their own)
     tests_absent: bool = True
+    unit: str = ""  #: SI unit; "" for a rig key: its unit in ``PARAMETERS``
+
+    def __post_init__(self) -> None:
+        if not self.unit:
+            table = units()
+            if self.key not in table:
+                raise ValueError(f"invalid Param key = {self.key!r}: not a rig key, so it must state its unit")
+            object.__setattr__(self, "unit", table[self.key])
 
 
 @dataclass
@@ -435,10 +445,6 @@ def _spool_exercised(ctx: Context) -> str | None:
     return None
 
 
-def _actuator_only(ctx: Context) -> str | None:
-    return None
-
-
 # --- structural signatures: d(residual of m a + c v + f_s(x) + F_c sgn v - F)/d(theta) -----
 
 def _sig_coulomb(rig: Rig, s: dict) -> np.ndarray:
@@ -458,14 +464,10 @@ def _sig_stiffness(rig: Rig, s: dict) -> np.ndarray:
     return s["displacement"]
 
 
-def _sig_mass(rig: Rig, s: dict) -> np.ndarray:
-    return s["acceleration"]
-
-
 #: the candidate effects, in the order screened and reported (a table: one ``Candidate`` each)
 CANDIDATES: tuple[Candidate, ...] = (
     Candidate(
-        "coulomb_friction", (Param("F_c", "N", "structure.F_c"),),
+        "coulomb_friction", (Param("F_c", "structure.F_c"),),
         "Coulomb friction F_c sgn(v) in the structure, Eq (5) (effects.coulomb_friction on)",
         absent=_coulomb_absent,
         bounds=lambda ctx: (_a(0.0), _a(_friction_max(ctx))),
@@ -477,8 +479,8 @@ CANDIDATES: tuple[Candidate, ...] = (
     ),
     Candidate(
         "lugre_friction",
-        (Param("sigma_0", "N/m", "structure.sigma_0 (effects.lugre_friction on)", reciprocal=True),
-         Param("F_c", "N", "structure.F_c")),
+        (Param("sigma_0", "structure.sigma_0 (effects.lugre_friction on)", reciprocal=True),
+         Param("F_c", "structure.F_c")),
         "friction with presliding (LuGre: bristle stiffness sigma_0, sliding level F_c; Canudas de Wit et al. "
         "1995): below the presliding displacement F_c / sigma_0 friction acts as a spring, then as Coulomb "
         "friction (added: seal friction in small-amplitude tests)",
@@ -492,9 +494,11 @@ CANDIDATES: tuple[Candidate, ...] = (
     ),
     Candidate(
         "bouc_wen_hysteresis",
-        (Param("x_y", "m", "specimen.bw_beta = bw_gamma = 1 / (2 x_y), bw_A = 1, bw_n = 1 (the yield displacement)",
+        (Param("x_y", unit="m",
+               rig_key="specimen.bw_beta = bw_gamma = 1 / (2 x_y), bw_A = 1, bw_n = 1 (the yield displacement)",
                tests_absent=False),
-         Param("F_y", "N", "specimen.bw_k = F_y / x_y (effects.bouc_wen_hysteresis on; the yield force)")),
+         Param("F_y", unit="N",
+               rig_key="specimen.bw_k = F_y / x_y (effects.bouc_wen_hysteresis on; the yield force)")),
         "a hysteretic specimen force in parallel with the structure (Bouc-Wen, n = 1, beta = gamma): elastic "
         "with stiffness F_y / x_y below the yield displacement x_y, then saturating at the yield force F_y; "
         "unloading is elastic (Coulomb friction is its limit x_y -> 0)",
@@ -514,8 +518,10 @@ CANDIDATES: tuple[Candidate, ...] = (
     ),
     Candidate(
         "mr_damper",
-        (Param("alpha", "N/m", "specimen.mr_alpha_a (+ mr_alpha_b mr_voltage): the damper's Bouc-Wen force level"),
-         Param("c0", "N s/m", "specimen.mr_c0_a (+ mr_c0_b mr_voltage): the damper's viscous coefficient")),
+        (Param("alpha", unit="N/m",
+               rig_key="specimen.mr_alpha_a (+ mr_alpha_b mr_voltage): the damper's Bouc-Wen force level"),
+         Param("c0", unit="N s/m",
+               rig_key="specimen.mr_c0_a (+ mr_c0_b mr_voltage): the damper's viscous coefficient")),
         "the MR damper element's field-dependent force (Spencer et al. 1997): its hysteretic level alpha and "
         "viscous coefficient c0 at the record's current (the rest of the damper as in the model)",
         absent=_mr_absent,
@@ -527,7 +533,7 @@ CANDIDATES: tuple[Candidate, ...] = (
                  "does not",
     ),
     Candidate(
-        "viscous_damping", (Param("c", "N s/m", "structure.c"),),
+        "viscous_damping", (Param("c", "structure.c"),),
         "error in the viscous damping c of Eq (5)",
         absent=lambda ctx: _a(ctx.rig.c),
         bounds=lambda ctx: (_a(0.0), _a(max(20 * ctx.rig.c, 0.2 * _critical_damping(ctx)))),
@@ -537,7 +543,7 @@ CANDIDATES: tuple[Candidate, ...] = (
         separate="repeat at two amplitudes: viscous damping gives the same decay ratio at every amplitude",
     ),
     Candidate(
-        "spring_softening", (Param("k_2", "N/m", "structure.k_2"),),
+        "spring_softening", (Param("k_2", "structure.k_2"),),
         "stiffness k_2 beyond +-x_contact (effects.spring_softening on; x_contact kept)",
         absent=_softening_absent,
         bounds=lambda ctx: (_a(0.02 * ctx.rig.k), _a(2.0 * ctx.rig.k)),
@@ -547,7 +553,7 @@ CANDIDATES: tuple[Candidate, ...] = (
         separate="a slow test with the amplitude stepped across x_contact: the stiffness changes only beyond it",
     ),
     Candidate(
-        "load_pressure", (Param("p_s", "Pa", "actuator.p_s (effects.load_pressure on)", reciprocal=True),),
+        "load_pressure", (Param("p_s", "actuator.p_s (effects.load_pressure on)", reciprocal=True),),
         "the load-pressure square-root term of Eq (3) with supply pressure p_s",
         absent=_load_pressure_absent,
         bounds=lambda ctx: (_a(max(1.02 * ctx.peak_pressure, 1e5)), _a(1e9)),
@@ -559,8 +565,10 @@ CANDIDATES: tuple[Candidate, ...] = (
     ),
     Candidate(
         "flow_gain_nonlinearity",
-        (Param("g_1", "-", "servovalve.flow_curve (table built from g_1 and x_k; effects.flow_nonlinearity on)"),
-         Param("x_k", "-", "servovalve.flow_curve: the knee (linear below it)", tests_absent=False)),
+        (Param("g_1", unit="-",
+               rig_key="servovalve.flow_curve (table built from g_1 and x_k; effects.flow_nonlinearity on)"),
+         Param("x_k", unit="-",
+               rig_key="servovalve.flow_curve: the knee (linear below it)", tests_absent=False)),
         "flow gain falling with spool opening (the Fig 4a curve): linear up to the knee x_k, then bending "
         "to the full-opening flow ratio g(1) = g_1 = Q(x_v = 1) / K_v",
         absent=_flow_absent,
@@ -572,7 +580,7 @@ CANDIDATES: tuple[Candidate, ...] = (
                  "load pressure does not",
     ),
     Candidate(
-        "command_delay", (Param("command_delay", "s", "delays.command_delay (a value < 0 is no rig parameter: the "
+        "command_delay", (Param("command_delay", "delays.command_delay (a value < 0 is no rig parameter: the "
                                                       "record's response rows lead its command)"),),
         "a pure delay of the command before the loop (controller, DSP or communication latency): the core's "
         "[delays] command_delay; down to -2 samples: a record whose response rows lead the command (acquisition "
@@ -587,7 +595,7 @@ CANDIDATES: tuple[Candidate, ...] = (
                  "itself: little extra lag well below the loop's crossover, an amplitude peak near it",
     ),
     Candidate(
-        "loop_delay", (Param("loop_delay", "s", "delays.loop_delay (effects.loop_delay on; Pade order "
+        "loop_delay", (Param("loop_delay", "delays.loop_delay (effects.loop_delay on; Pade order "
                                                 "delays.loop_delay_order)"),),
         "a transport delay inside the analog loop, on the valve drive (slow valve amplifier, long cable run): "
         "the core's Pade-approximated effects.loop_delay",
@@ -604,7 +612,7 @@ CANDIDATES: tuple[Candidate, ...] = (
     ),
     Candidate(
         "servovalve_dynamics",
-        (Param("f_v", "Hz", "servovalve.f_v", reciprocal=True), Param("zeta_v", "-", "servovalve.zeta_v")),
+        (Param("f_v", "servovalve.f_v", reciprocal=True), Param("zeta_v", "servovalve.zeta_v")),
         "the servovalve's second-order dynamics, Eq (2) (natural frequency, damping)",
         absent=lambda ctx: _a(ctx.rig.f_v, ctx.rig.zeta_v) if ctx.rig.effects.servovalve_dynamics
         else _a(math.inf, ctx.rig.zeta_v),
@@ -615,7 +623,7 @@ CANDIDATES: tuple[Candidate, ...] = (
                  "from a pure delay",
     ),
     Candidate(
-        "leakage", (Param("C_l", "m^3/(s Pa)", "actuator.C_l"),),
+        "leakage", (Param("C_l", "actuator.C_l"),),
         "leakage / flow-pressure coefficient C_l of Eq (4)",
         absent=lambda ctx: _a(ctx.rig.C_l),
         bounds=lambda ctx: (_a(0.0), _a(max(50 * ctx.rig.C_l, 1e-9))),
@@ -625,7 +633,7 @@ CANDIDATES: tuple[Candidate, ...] = (
         separate="hold a static force: leakage needs a steady spool offset (drive) to hold pressure",
     ),
     Candidate(
-        "piston_mass", (Param("m_p", "kg", "structure.m_p (effects.piston_mass on)"),),
+        "piston_mass", (Param("m_p", "structure.m_p (effects.piston_mass on)"),),
         "mass moving between the load cell and the structure (piston, fixtures)",
         absent=_piston_absent,
         bounds=lambda ctx: (_a(0.0), _a(0.3 * ctx.rig.m)),
@@ -637,7 +645,7 @@ CANDIDATES: tuple[Candidate, ...] = (
                  "frequency as the extra mass does, but leaves F = p A",
     ),
     Candidate(
-        "spool_saturation", (Param("x_v_max", "-", "servovalve.x_v_max (effects.spool_saturation on)"),),
+        "spool_saturation", (Param("x_v_max", "servovalve.x_v_max (effects.spool_saturation on)"),),
         "spool travel limited to +-x_v_max (end stops)",
         absent=_spool_absent,
         bounds=lambda ctx: (_a(max(0.01 * ctx.peak_spool, 1e-4)), _a(max(SPOOL_ABSENT_MARGIN * ctx.peak_spool, 2e-4))),
@@ -648,7 +656,7 @@ CANDIDATES: tuple[Candidate, ...] = (
         separate="a fast ramp: saturation caps the velocity at a constant, a flow curve only bends it",
     ),
     Candidate(
-        "stiffness_error", (Param("k", "N/m", "structure.k (k_2 scaled with it)"),),
+        "stiffness_error", (Param("k", "structure.k (k_2 scaled with it)"),),
         "error in the initial stiffness k of Eq (5) (added: a mis-identified specimen)",
         absent=lambda ctx: _a(ctx.rig.k),
         bounds=lambda ctx: (_a(0.3 * ctx.rig.k), _a(3.0 * ctx.rig.k)),
@@ -657,7 +665,7 @@ CANDIDATES: tuple[Candidate, ...] = (
         separate="a quasi-static test: the stiffness is the force-displacement slope",
     ),
     Candidate(
-        "compressibility", (Param("K_a", "m^5/N", "actuator.K_a"),),
+        "compressibility", (Param("K_a", "actuator.K_a"),),
         "oil compressibility K_a = V_t/(4 beta_e) of Eq (4) (added: entrained air, hoses)",
         absent=lambda ctx: _a(ctx.rig.K_a),
         bounds=_compressibility_bounds,

@@ -1,6 +1,11 @@
 """Numerics of the diagnosis: records as cases, simulation with the record's own
 command, normalised residuals, noise floor, screening by signatures, fitting by
-simulation error, and the statistics (effective sample size, BIC, intervals).
+simulation error, BIC and intervals.
+
+The parts shared with ``sh.identify`` come from :mod:`servohydraulics.identification`:
+the record simulation (``run.simulate_command``), the fitting coordinates
+(``coordinates.Coordinates``, reciprocal where "absent" is infinite) and the
+statistics (``stats``: AR(1) effective samples and the one HAC covariance rule).
 """
 
 from __future__ import annotations
@@ -15,9 +20,12 @@ from scipy.optimize import least_squares
 from scipy.signal import savgol_filter
 
 from .. import _core
-from ..identify import ar1_coefficient, ar1_effective_n
+from ..identification.coordinates import Coordinates
+from ..identification.run import simulate_command
+from ..identification.stats import LEVEL, ar1_coefficient, ar1_effective_n, quantile
+from ..identification.stats import covariance as hac_covariance
 from ..rig import Rig
-from ..simulate import MODES, SimulationError, simulate, solver_options
+from ..simulate import MODES, SimulationError, solver_options
 from .effects import INTERACT_SPAN, Candidate, Context, split_delay
 from .types import Case, FitResult, Screening, Sim
 
@@ -119,24 +127,14 @@ def refine_x0(rig: Rig, cases: list[Case], tau: float) -> tuple[float, ...]:
 
 # --- simulation ---------------------------------------------------------------------
 
-def delayed(u: np.ndarray, dt: float, tau: float) -> np.ndarray:
-    """The command delayed by tau [s]: integer + fractional samples by linear
-    interpolation, holding the first value before the record starts."""
-    if tau == 0.0:
-        return u
-    k = np.arange(u.size) - tau / dt  # tau < 0 advances it (holding the last value past the end)
-    return np.interp(k, np.arange(u.size), u, left=u[0], right=u[-1])
-
-
 def simulate_case(rig: Rig, case: Case, tau: float, x0: float) -> Sim:
     """The model's channels for the record's command delayed by ``tau`` [s]
     from the initial displacement ``x0`` [m] (None if the run fails).
     The default error-controlled pair (dopri5, CVODE for its stiff samples); CVODE alone if
     that run fails."""
-    u = delayed(case.u, case.dt, tau)
     for opts in (solver_options(), solver_options(method="cvode")):
         try:
-            r = simulate(rig, case.mode, u, case.dt, x0=float(x0), options=opts)
+            r = simulate_command(rig, case.mode, case.u, case.dt, float(x0), opts, delay=tau)
         except (SimulationError, ValueError):
             continue
         return {c: r.channels[c] for c in SIM_CHANNELS}
@@ -231,6 +229,7 @@ class Space:
         self.n_main = len(self.params)
         rec = [p.reciprocal for p in self.params] + [False] * len(self.interacting)
         self.rec = np.array(rec, bool)
+        self.coords = Coordinates.absolute([p.key for p in self.params] + [k for k, _ in self.interacting], self.rec)
         lo, hi = c.bounds(self.ctx)
         lo, hi = np.asarray(lo, float)[self.main_idx], np.asarray(hi, float)[self.main_idx]
         cur = np.array([getattr(self.ctx.rig, k) for k, _ in self.interacting], float)
@@ -248,10 +247,10 @@ class Space:
         self.tests_absent = np.array([p.tests_absent for p in self.params] + [False] * len(self.interacting), bool)
 
     def to_internal(self, ext: np.ndarray) -> np.ndarray:
-        return _to_internal(self.rec, ext)
+        return self.coords.z(ext)
 
     def to_external(self, z: np.ndarray) -> np.ndarray:
-        return _to_external(self.rec, z)
+        return self.coords.values(z)
 
     def own_parameters(self, ext_main: np.ndarray) -> np.ndarray:
         """Every own parameter of the candidate (external units): the fitted
@@ -271,20 +270,6 @@ class Space:
             for (key, _), v in zip(self.interacting, ext[self.n_main:]):
                 setattr(rig, key, float(v))
         return rig, tau
-
-
-def _to_internal(rec: np.ndarray, ext: np.ndarray) -> np.ndarray:
-    """External units -> fitting coordinates (1/value where ``rec``)."""
-    ext = np.asarray(ext, float)
-    with np.errstate(divide="ignore", over="ignore"):
-        return np.where(rec, np.where(np.isinf(ext), 0.0, 1.0 / np.where(ext == 0, np.inf, ext)), ext)
-
-
-def _to_external(rec: np.ndarray, z: np.ndarray) -> np.ndarray:
-    """Fitting coordinates -> external units (a reciprocal <= 0 is an infinite value)."""
-    z = np.asarray(z, float)
-    with np.errstate(divide="ignore", over="ignore"):
-        return np.where(rec, np.where(z <= 0, np.inf, 1.0 / np.where(z <= 0, 1.0, z)), z)
 
 
 #: candidates whose ``apply`` also rescales another effect's rig key (stiffness_error scales k_2 with k):
@@ -330,6 +315,7 @@ class JointSpace:
 
         self.params = tuple(prm for sp in self.spaces for prm in sp.params)
         self.rec = cat("rec").astype(bool)
+        self.coords = Coordinates.absolute([p.key for p in self.params] + [k for k, _ in self.interacting], self.rec)
         self.lo, self.hi, self.absent, self.probe, self.scale = (cat(a) for a in ("lo", "hi", "absent", "probe",
                                                                                   "scale"))
         self.tests_absent = cat("tests_absent").astype(bool)
@@ -349,10 +335,10 @@ class JointSpace:
         return None
 
     def to_internal(self, ext: np.ndarray) -> np.ndarray:
-        return _to_internal(self.rec, ext)
+        return self.coords.z(ext)
 
     def to_external(self, z: np.ndarray) -> np.ndarray:
-        return _to_external(self.rec, z)
+        return self.coords.values(z)
 
     def rig_and_tau(self, z: np.ndarray, base_tau: float) -> tuple[Rig, float]:
         """The model with every effect at its block of ``z``, the re-fitted
@@ -475,60 +461,22 @@ def series_lengths(cases: list[Case], which: str = "all") -> list[int]:
     return out
 
 
-def bartlett_bandwidth(e: np.ndarray) -> int:
-    """Newey-West lag truncation for a series from the AR(1) plug-in rule of
-    Andrews (1991) for the Bartlett kernel: 1.1447 (alpha n)^(1/3), alpha =
-    4 rho^2 / ((1 - rho)^2 (1 + rho)^2), rho the lag-1 autocorrelation; at most n/2."""
-    n = e.size
-    rho = ar1_coefficient(e)
-    alpha = 4 * rho ** 2 / ((1 - rho) ** 2 * (1 + rho) ** 2)
-    return int(min(max(math.ceil(1.1447 * (alpha * n) ** (1 / 3)), 1), n // 2))
-
-
 def covariance(space: Space, res: FitResult, lengths: list[int]) -> np.ndarray:
-    """HAC (Newey-West) sandwich covariance of the least-squares estimate in
-    fitting coordinates: (J'J)^-1 Omega (J'J)^-1, Omega the long-run covariance
-    of the scores J_t r_t with Bartlett weights, summed over the (record,
-    channel) series (no lag crosses two series), bandwidth per series from
-    ``bartlett_bandwidth``.  J is the fit's finite-difference Jacobian of the
-    normalised residuals r.  A parameter the residuals do not depend on gets an
-    infinite variance."""
-    J = res.jac
-    r = res.fun
-    n, p = J.shape
-    scale = np.concatenate([space.scale, res.nuisance_scale])[:p]
-    D = np.maximum(np.abs(scale), 1e-300)  # column scaling: parameters differ by 10 orders of magnitude
-    Js = J * D
-    omega = np.zeros((p, p))
-    a = 0
-    for m in lengths:
-        S = Js[a:a + m] * r[a:a + m, None]
-        L = bartlett_bandwidth(r[a:a + m])
-        nfft = 1 << int(math.ceil(math.log2(2 * m)))
-        F = np.fft.rfft(S, n=nfft, axis=0)
-        # C[l, i, j] = sum_t S[t + l, i] S[t, j], every lag at once
-        C = np.fft.irfft(F[:, :, None] * np.conj(F[:, None, :]), n=nfft, axis=0)[: L + 1]
-        w = 1.0 - np.arange(1, L + 1) / (L + 1)
-        G = np.einsum("l,lij->ij", w, C[1:])
-        omega += C[0] + G + G.T
-        a += m
-    try:
-        B = np.linalg.pinv(Js.T @ Js, rcond=1e-12)
-        cov = D[:, None] * (B @ omega @ B) * D[None, :]
-    except np.linalg.LinAlgError:
-        cov = np.full((p, p), np.inf)
-    zero_col = np.linalg.norm(J, axis=0) == 0
-    cov[zero_col, :] = np.inf
-    cov[:, zero_col] = np.inf
-    q = space.scale.size  # the candidate's block (nuisance initial states marginalised out)
-    return cov[:q, :q]
+    """The covariance of the candidate's parameters in fitting coordinates: the HAC sandwich of
+    ``identification.stats.covariance`` (the rule ``sh.identify`` uses) over the parameters and
+    the records' initial displacements (scaled by ``space.scale`` and their standard deviations),
+    the initial displacements then marginalised out.  A parameter the data do not determine has
+    an infinite variance."""
+    scale = np.concatenate([space.scale, res.nuisance_scale])[: res.jac.shape[1]]
+    return hac_covariance(res.jac, res.fun, scale, lengths).block(space.scale.size).matrix
 
 
 def intervals(space: Space, res: FitResult, lengths: list[int]) -> tuple[np.ndarray, np.ndarray]:
     """95 % intervals (fitting coordinates) from the HAC sandwich ``covariance``."""
     sd = np.sqrt(np.maximum(np.diag(covariance(space, res, lengths)), 0.0))
     z = res.z[: sd.size]
-    return z - 1.96 * sd, z + 1.96 * sd
+    q = quantile(LEVEL)
+    return z - q * sd, z + q * sd
 
 
 def joint_excludes_absent(space: Space, res: FitResult, lengths: list[int], tested: np.ndarray) -> tuple[bool, float]:

@@ -17,14 +17,14 @@ from typing import Any
 
 import numpy as np
 
-from ..records import read_record
+from ..identification.records import as_records
 from ..rig import Rig, rig_to_dict
 from ..simulate import MODES
 from . import engine
 from .confirm import confirm, param_report
-from .effects import LIBRARY, Context, check_names, nested, separating_experiment, split_delay
+from .effects import LIBRARY, Context, check_names, nested, separating_experiment
 from .joint import joint_refit
-from .types import Accepted, Case, CandidateLog, Fit, JointRefit, Round, Screening, Sim
+from .types import Accepted, CandidateLog, Case, Fit, JointRefit, Round, Screening, Sim
 
 #: acceptance thresholds (documented in docs/diagnose.md)
 DELTA_BIC_MIN = 10.0  #: "very strong" evidence on the Kass-Raftery scale
@@ -92,15 +92,6 @@ class Diagnosis:
         from .report import write_outputs
 
         return write_outputs(self, Path(out))
-
-
-def _as_records(records) -> list:
-    if isinstance(records, (str, Path)) or hasattr(records, "channels"):
-        records = [records]
-    out = [r if hasattr(r, "channels") else read_record(r) for r in records]
-    if not out:
-        raise ValueError("invalid records = []: give at least one record")
-    return out
 
 
 def _progress(total: int, enabled: bool, desc: str):
@@ -241,7 +232,7 @@ def _prepare(records, rig: Rig, mode: str, candidates: Sequence[str] | None, kee
     if mode not in MODES:
         raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(MODES)}")
     names = check_names(candidates) if candidates is not None else list(LIBRARY)
-    recs = _as_records(records)
+    recs = as_records(records)
     rig.validate()
     cases: list[Case] = []
     for i, r in enumerate(recs):

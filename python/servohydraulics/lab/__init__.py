@@ -1,21 +1,26 @@
-"""Lab records: identify a rig from its own records, compare a rig with a record,
-and the thesis baselines of the UTFSM records (docs/lab-records.md).
+"""Deprecated alias of :mod:`servohydraulics.identification` (removed in 0.3.0).
 
-* :func:`identify` (``sh.identify``): two-stage identification of rig keys.
-* :func:`compare`: a record's command through a rig, NRMSE and FRF per channel.
-* :func:`generic_rig`: a documented start scaled from a record.
-* :mod:`.baselines`: the thesis' linear G(s) and its Spencer Bouc-Wen MR-damper model.
-* :func:`h1`: the H1 frequency response with coherence.
-"""
+``servohydraulics.lab`` and its modules (``lab.baselines``, ``lab.compare``, ``lab.figures``,
+``lab.fitting``, ``lab.frf``, ``lab.generic``, ``lab.identification``, ``lab.keys``,
+``lab.report``, ``lab.run``) are the modules of the identification package under their
+old names."""
 
-from .baselines import thesis_displacement, thesis_mr_force, thesis_mr_parameters
-from .compare import Comparison, compare
-from .frf import FrequencyResponse, h1
-from .generic import generic_rig
-from .identification import Identification, identify
-from .keys import LOOP_KEYS, SPECIMEN_KEYS
-from .run import nrmse_demeaned_pct, nrmse_pct, simulate_record
+import importlib as _importlib
+import sys as _sys
+import warnings as _warnings
 
-__all__ = ["LOOP_KEYS", "SPECIMEN_KEYS", "Comparison", "FrequencyResponse", "Identification", "compare",
-           "generic_rig", "h1", "identify", "nrmse_demeaned_pct", "nrmse_pct", "simulate_record",
-           "thesis_displacement", "thesis_mr_force", "thesis_mr_parameters"]
+_warnings.warn("servohydraulics.lab is deprecated and will be removed in 0.3.0; use servohydraulics.identification",
+               DeprecationWarning, stacklevel=2)
+
+#: old module name -> its module in the identification package
+_MOVED = {"baselines": "baselines", "compare": "compare", "figures": "figures", "fitting": "fit", "frf": "frf",
+          "generic": "generic", "identification": "records", "keys": "coordinates", "report": "report",
+          "run": "run"}
+
+for _old, _new in _MOVED.items():
+    _module = _importlib.import_module(f"servohydraulics.identification.{_new}")
+    _sys.modules[f"{__name__}.{_old}"] = _module
+    globals()[_old] = _module
+
+from ..identification import *  # noqa: E402, F403 (every name of the package under its old one)
+from ..identification import __all__  # noqa: E402, F401

@@ -19,17 +19,19 @@ import servohydraulics as sh  # public names, looked up at call time
 from .. import _core
 from .. import analysis as an
 from .. import excitations as ex
-from ..identify import (
+from ..identification.frf import dft_ratio
+from ..identification.paper import (
     FirstOrderEstimate,
+    FreeVibration,
     FrictionEstimate,
-    frequency_response,
     identify_damping_friction,
     identify_first_order,
+    identify_free_vibration,
     linear_chirp,
     simulate_structure,
 )
 from ..rig import Rig
-from ..identify import FreeVibration, fourier_ratio, identify_free_vibration
+from ..timegrid import uniform_dt
 
 TWO_PI = 2.0 * math.pi
 _EFT = _core.EftConfig()
@@ -197,7 +199,8 @@ def fig3a_direct_eft(rig: Rig, quick: bool = False) -> DirectEft:
     lin = an.linear_analysis_rig(rig)
     t, u = linear_chirp(20.0 if quick else 40.0, DT, 0.1, 10.0, SWEEP_F, tail=2.0)
     res = sh.simulate(rig, "force", u, DT)
-    f, h, ok = frequency_response(t, u, res.force)
+    est = dft_ratio(u, res.force, uniform_dt(t, "invalid time", min_rows=10))
+    f, h, ok = est.frequency, est.response, est.excited
     band = ok & (f > 0.3) & (f < 5.0)
     ff = np.linspace(0.3, 5.0, 2000)
     g_fu = an.G_fu(lin)
@@ -271,7 +274,8 @@ def eft_sweep(rig: Rig, amplitude: float, duration: float = SWEEP_DURATION, **kw
     """``run_eft`` on ``excitations.sine_sweep(amplitude)`` (keywords go to run_eft)."""
     P = ex.sine_sweep(amplitude, duration=duration, dt=DT)
     res = sh.run_eft(rig, effective_force=P, dt=DT, raise_on_failure=False, **kw)
-    f, H = fourier_ratio(res.force, P, DT)
+    est = dft_ratio(P[: res.force.size], res.force, DT, min_level=0.0, from_rest=False)
+    f, H = est.frequency, np.abs(est.response)
     b = (f > 0.3) & (f < 10.0)
     return EftSweep(frequency=f[b], ratio=H[b], effective_force=P, result=res)
 
@@ -384,7 +388,8 @@ def fig5_displacement_sweeps(rig: Rig, quick: bool = False) -> DisplacementSweep
     fo = identify_first_order(t, u, res.displacement)
     t2, u2 = linear_chirp(dur * 0.6, DT, 0.1, 6.0, SWEEP_X, tail=2.0)
     res2 = sh.simulate(rig, "displacement", lead(u2, T_AMP), DT)
-    f2, h2, ok2 = frequency_response(t2, u2, res2.displacement)
+    est = dft_ratio(u2, res2.displacement, uniform_dt(t2, "invalid time", min_rows=10))
+    f2, h2, ok2 = est.frequency, est.response, est.excited
     sel = ok2 & (f2 >= 0.2) & (f2 <= 5.0)
     g_lead = an.phase_lead(T_AMP) * an.G_xu(an.linear_analysis_rig(rig)) * an.zoh_delay(DT)
     peak_lin = float(np.max(np.abs(np.asarray(g_lead(1j * TWO_PI * np.linspace(0.2, 5.0, 400))))))

@@ -117,7 +117,7 @@ def frf_points(measured: FrequencyResponse, simulated: FrequencyResponse, freque
 
 
 def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, options=None,
-            frequencies=None, simulated: dict | None = None) -> Comparison:
+            frequencies=None, simulated: Response | None = None) -> Comparison:
     """Simulates the record's command through the rig and compares (see the module docstring).
 
     Args:
@@ -126,7 +126,7 @@ def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, opti
         dt: controller sample time [s] (default: the record's).
         options: solver options (default: CVODE BDF).
         frequencies: FRF points [Hz] (default ``FREQUENCIES`` up to the command's band).
-        simulated: channels already simulated on the record's time axis (skips the run).
+        simulated: the record already simulated (``run.simulate_record``; skips the run).
     """
     if mode not in ("displacement", "force"):
         raise ValueError(f"invalid mode = {mode!r}: a record compares in 'displacement' or 'force' control")
@@ -139,7 +139,7 @@ def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, opti
     out = Comparison(name=record_name(record), mode=mode, time=np.asarray(record.time), measured={}, simulated={},
                      frf_measured={}, frf_simulated={}, frequencies=freq, f_max=f_max)
     for ch in chans:
-        m, s = np.asarray(record.channels[ch], dtype=float), np.asarray(sim[ch], dtype=float)
+        m, s = np.asarray(record.channels[ch], dtype=float), np.asarray(sim.channels[ch], dtype=float)
         out.measured[ch], out.simulated[ch] = m, s
         out.frf_measured[ch], out.frf_simulated[ch] = h1(u, m, record.dt), h1(u, s, record.dt)
         out.channels[ch] = {"nrmse_pct": nrmse_pct(s, m), "nrmse_demeaned_pct": nrmse_demeaned_pct(s, m),

@@ -12,10 +12,15 @@
   channel), minimised by ``scipy.optimize.least_squares`` (trust region
   reflective, Jacobian by forward differences of 0.1 % steps in the fitting
   coordinates, its columns on two threads) over the active keys.
-  ``identification.py`` runs it block by block (loop keys on the
+  ``records.py`` runs it block by block (loop keys on the
   displacement, force keys on the force) in displacement control.
+* :func:`keep_best`: the start and the stages compared by the time-domain cost
+  (:func:`time_costs`), the best kept, so that identification never ends worse
+  than it starts (``sh.diagnose`` keeps the same invariant for its candidate
+  fits).  ``records.identify`` runs the time stage from stage 1 and, when that ends
+  worse than the start, once more from the start.
 
-Both work in :class:`~servohydraulics.lab.keys.Coordinates` (log space for
+Both work in :class:`~servohydraulics.identification.coordinates.Coordinates` (log space for
 positive keys).
 """
 
@@ -29,8 +34,8 @@ from scipy.optimize import least_squares
 from ..response import Response, SimulationError
 from ..rig import Error, Rig
 from ..simulate import make_plant, solver_options
+from .coordinates import Coordinates
 from .frf import FrequencyResponse, command_band, h1
-from .keys import Coordinates
 from .run import initial_displacement, simulate_record
 
 MIN_COHERENCE = 0.9
@@ -172,7 +177,7 @@ def time_residual(rig: Rig, records: list[Response], mode: str, channels: tuple[
             sim = None
         for ch in channels:
             m = np.asarray(rec.channels[ch], dtype=float)
-            s = sim[ch] if sim is not None and np.all(np.isfinite(sim[ch])) else None
+            s = sim.channels[ch] if sim is not None and np.all(np.isfinite(sim.channels[ch])) else None
             w = 1.0 if weights is None else weights[ch]
             out.append(np.full(m.size, FAILED) if s is None else w * (s - m) / np.std(m))
     return np.concatenate(out)
@@ -281,6 +286,50 @@ def jacobian_at(records: list[Response], rig: Rig, coords: Coordinates, z: np.nd
     return StageResult(np.asarray(z, dtype=float), float(f0 @ f0) / 2, 1 + z.size, f0, J)
 
 
+def time_costs(recs, start, coords, candidates: dict, mode, chans, options, dt) -> dict[str, float]:
+    """The time-domain cost of each candidate (name -> z): half the sum of squares of
+    (sim - measured) / std(measured) over every record and channel, i.e. of the NRMSEs the
+    comparison reports (no channel weights, so that every candidate is judged alike)."""
+    out = {}
+    for name, z in candidates.items():
+        try:
+            r = time_residual(coords.apply(start, z), recs, mode, chans, options, dt)
+        except ValueError:  # the candidate is no valid rig
+            out[name] = float("inf")
+            continue
+        out[name] = float(r @ r) / 2
+    return out
+
+
+def best(costs: dict) -> str:
+    """The candidate of least cost; a tie keeps the earlier one (a stage that leaves the cost
+    where it was did not improve on it)."""
+    names = list(costs)
+    return min(names, key=lambda k: (costs[k], names.index(k)))
+
+
+def keep_best(recs, start, coords, candidates: dict, mode, chans, options, dt, bar, workers):
+    """The best of the start and the stages' results (``candidates``: name -> z, in order) by
+    :func:`time_costs`; returns (the name kept, the costs, the channel weights there (1 / rms of
+    each channel's residual), the residual and Jacobian over every key there)."""
+    costs = time_costs(recs, start, coords, candidates, mode, chans, options, dt)
+    kept = best(costs)
+    weights = channel_weights(coords.apply(start, candidates[kept]), recs, mode, chans, options, dt)
+    final = jacobian_at(recs, start, coords, candidates[kept], mode, chans, options, dt, weights, workers, bar)
+    return kept, costs, weights, final
+
+
+def not_improved_flags(kept: str, costs: dict) -> list[str]:
+    """Says so when the fit could not improve on its start (or the time stage on the frequency stage)."""
+    if kept == "time":
+        return []
+    worse = ", ".join(f"{k} {v:.6g}" for k, v in costs.items() if k != kept)
+    what = "the fit could not improve on its start" if kept == "start" else \
+        "the time stage did not improve on the frequency stage"
+    return [f"{what}: the result is the {kept} (time-domain cost {costs[kept]:.6g}; {worse})"]
+
+
 __all__ = ["DIFF_STEP", "MAX_RK4_SUBSTEPS", "MIN_COHERENCE", "StageResult", "channel_weights", "default_workers",
            "fit_frequency", "fit_options", "fit_time", "forward_jacobian", "frequency_targets", "jacobian_at",
+           "best", "keep_best", "not_improved_flags", "time_costs",
            "linear_response", "records_peak_velocity", "time_residual"]

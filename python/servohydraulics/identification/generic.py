@@ -134,5 +134,5 @@ def generic_rig(record: Response) -> Rig:
     return r
 
 
-__all__ = ["BETA_E", "P_SUPPLY", "bingham_fit", "bouc_wen_start", "generic_rig", "mr_damper_start", "record_scales", "specimen_start",
-           "specimen_kc"]
+__all__ = ["BETA_E", "P_SUPPLY", "bingham_fit", "bouc_wen_start", "generic_rig", "mr_damper_start", "record_scales",
+           "specimen_kc", "specimen_start"]

@@ -15,20 +15,22 @@ def identification_markdown(ident) -> str:
         else "the given rig"
     lines = [f"# Identified rig ({ident.mode} control)", "",
              f"Start: {start}. Stage 1 (frequency response, linearised model) then stage 2 (time domain, "
-             f"nonlinear simulation).  Intervals: {int(100 * d['level'])} %, from the Jacobian at the optimum "
-             f"and the residual variance, inflated for autocorrelated residuals (lag-1 rho = {ident.rho1:.3f}, "
-             f"effective samples {ident.n_eff:.0f}).", "",
-             "| key | unit | start | stage 1 | identified | 95 % interval |", "|---|---|---|---|---|---|"]
+             f"nonlinear simulation); the result is the {ident.kept} (the best by the time-domain cost).  "
+             f"Intervals: {int(100 * d['level'])} %, the HAC sandwich at the result (autocorrelated residuals: "
+             f"lag-1 rho = {ident.rho1:.3f}, AR(1) effective samples {ident.n_eff:.0f}); a key the records do not "
+             "determine, or at a bound, has its whole range.", "",
+             "| key | unit | start | stage 1 | identified | status | 95 % interval |", "|---|---|---|---|---|---|---|"]
     for k, p in d["parameters"].items():
         lo, hi = p["interval"]
         lines.append(f"| `{k}` | {p['unit']} | {_v(p['start'])} | {_v(p['stage1'])} | {_v(p['value'])} | "
-                     f"[{lo:.5g}, {hi:.5g}] |")
+                     f"{p['status']} | [{lo:.5g}, {hi:.5g}] |")
     for k, v in d["derived"].items():
         lines.append(f"\nDerived: `{k}` = {v:.5g}")
     lines += ["", "## Correlations", "", "| | " + " | ".join(ident.keys) + " |",
               "|---" * (len(ident.keys) + 1) + "|"]
     for i, k in enumerate(ident.keys):
-        lines.append(f"| `{k}` | " + " | ".join(f"{c:+.2f}" for c in np.asarray(ident.correlation)[i]) + " |")
+        lines.append(f"| `{k}` | " + " | ".join("-" if np.isnan(c) else f"{c:+.2f}"
+                                                 for c in np.asarray(ident.correlation)[i]) + " |")
     lines += ["", "## What the data cannot separate", ""]
     lines += [f"- {f}" for f in ident.flags] or ["- nothing: every key is determined and no pair has |corr| > 0.95"]
     lines += ["", "## Records (NRMSE = 100 rms(sim - measured) / std(measured), %)", "",

@@ -4,14 +4,19 @@
 to one or more records in two stages (``fitting.py``: the frequency response
 on the linearised model, then the time domain on the nonlinear simulation)
 and returns an :class:`Identification`: the identified rig, each key's value,
-95 % interval and the correlation matrix (from the Jacobian at the optimum and
-the residual variance, inflated for autocorrelated residuals by the AR(1)
-effective sample size, as ``identify.identify_damping_friction`` does), the
-pairs the data cannot separate, and the comparison of every record before and
-after.  ``Identification.write(out)`` writes ``rig_identified.toml``,
+status, 95 % interval and the correlation matrix (the HAC sandwich of
+:mod:`.stats` at the optimum, the rule ``sh.diagnose`` uses too), the pairs the
+data cannot separate, and the comparison of every record before and after.
+
+The result is never worse than the start: the start, the frequency stage and the
+time stage are compared by the time-domain cost and the best is kept (a fit that
+cannot improve on its start says so in ``flags``).  A key the records do not
+determine, or one that ends at a bound of its coordinates (or collapses towards
+zero), has status ``"not identified"`` / ``"at bound"`` and an interval over its
+whole range, never a falsely precise one.  ``Identification.write(out)`` writes ``rig_identified.toml``,
 ``identification.json``, ``report.md`` and per-record overlay and FRF plots.
 
-Without a start rig, :func:`~servohydraulics.lab.generic.generic_rig` scales
+Without a start rig, :func:`~servohydraulics.identification.generic.generic_rig` scales
 one from the first record.
 """
 
@@ -25,20 +30,28 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from scipy.stats import norm
 
-from ..identify import ar1_coefficient, ar1_effective_n
 from ..atomic import write_text, write_with
 from ..records import read_record
 from ..response import Response
 from ..rig import Rig, load_rig, save_rig
 from .compare import Comparison, channels_of, compare, write_json
-from .fitting import StageResult, channel_weights, fit_frequency, fit_time, fit_options, jacobian_at
+from .coordinates import FORCE_KEYS, LOOP_KEYS, Coordinates, check_keys, specimen_keys, use_specimen
+from .fit import (
+    StageResult,
+    best,
+    channel_weights,
+    fit_frequency,
+    fit_options,
+    fit_time,
+    keep_best,
+    not_improved_flags,
+    time_costs,
+)
 from .generic import generic_rig, specimen_start
-from .keys import FORCE_KEYS, LOOP_KEYS, Coordinates, check_keys, specimen_keys, use_specimen
 from .run import simulate_record
+from .stats import LEVEL, ar1_coefficient, ar1_effective_n, covariance, quantile
 
-LEVEL = 0.95
 MAX_CORRELATION = 0.95  #: |corr| above which two keys are reported as not separable
 
 
@@ -53,8 +66,8 @@ class Identification:
     values: dict  #: key -> identified value
     start_values: dict  #: key -> start value
     stage1_values: dict  #: key -> value after the frequency-domain stage (None: not fitted there)
-    intervals: dict  #: key -> (low, high), 95 %
-    std: dict  #: key -> standard error (linearised)
+    intervals: dict  #: key -> (low, high), 95 % (the key's whole range unless its status is "identified")
+    std: dict  #: key -> standard error (linearised; inf unless identified)
     correlation: np.ndarray = field(repr=False)
     flags: list = field(default_factory=list)  #: what the data cannot separate or determine
     before: list = field(default_factory=list, repr=False)  #: Comparison per record, start rig
@@ -66,6 +79,9 @@ class Identification:
     runtime_s: dict = field(default_factory=dict)
     weights: dict = field(default_factory=dict)  #: channel -> weight of its normalised residual
     integrator: str = "rk4"
+    status: dict = field(default_factory=dict)  #: key -> "identified", "not identified" or "at bound"
+    costs: dict = field(default_factory=dict)  #: time-domain cost of the start and of each stage
+    kept: str = "time"  #: which of "start", "frequency", "time" the result is
 
     def to_dict(self) -> dict[str, Any]:
         units = _units()
@@ -73,10 +89,12 @@ class Identification:
             "mode": self.mode, "generic_start": self.generic_start, "level": LEVEL,
             "parameters": {k: {"value": self.values[k], "unit": units.get(k, "?"), "start": self.start_values[k],
                                "stage1": self.stage1_values[k], "std": self.std[k],
+                               "status": self.status.get(k, "identified"),
                                "interval": list(self.intervals[k])} for k in self.keys},
             "correlation": {"keys": list(self.keys), "matrix": np.round(self.correlation, 4).tolist()},
-            "derived": derived(self.rig, self.mode), "flags": self.flags, "channel_weights": self.weights, "integrator": self.integrator, "n_eff": self.n_eff, "rho1": self.rho1, "nfev": self.nfev,
-            "runtime_s": self.runtime_s,
+            "derived": derived(self.rig, self.mode), "flags": self.flags, "channel_weights": self.weights,
+            "integrator": self.integrator, "n_eff": self.n_eff, "rho1": self.rho1, "nfev": self.nfev,
+            "runtime_s": self.runtime_s, "costs": self.costs, "kept": self.kept,
             "records": [{"record": b.name, "before": {c: b.channels[c]["nrmse_pct"] for c in b.channels},
                          "after": {c: a.channels[c]["nrmse_pct"] for c in a.channels}}
                         for b, a in zip(self.before, self.after)],
@@ -119,11 +137,12 @@ def _units() -> dict[str, str]:
     return {p.key: p.unit for p in PARAMETERS}
 
 
-def as_records(records) -> list[Response]:
-    """Responses from Responses or record paths (a single one is accepted)."""
-    if isinstance(records, (str, Path, Response)):
+def as_records(records) -> list:
+    """Records from records (anything with ``channels``: a Response) or record paths (a single
+    one is accepted); the paths read by ``read_record``."""
+    if isinstance(records, (str, Path)) or hasattr(records, "channels"):
         records = [records]
-    out = [r if isinstance(r, Response) else read_record(r) for r in records]
+    out = [r if hasattr(r, "channels") else read_record(r) for r in records]
     if not out:
         raise ValueError("invalid records = []: give at least one record")
     return out
@@ -137,23 +156,48 @@ def _start_rig(rig, records: list[Response]) -> tuple[Rig, bool]:
     return copy.copy(rig), False
 
 
-def uncertainty(stage: StageResult, coords: Coordinates) -> tuple[np.ndarray, np.ndarray, float, float]:
-    """(covariance of z, correlation, n_eff, rho1) from the Jacobian at the optimum."""
-    r, J = stage.fun, stage.jac
-    n, p = r.size, J.shape[1]
-    s2 = float(r @ r) / max(n - p, 1)
-    rho = ar1_coefficient(r)
-    n_eff = ar1_effective_n(n, rho)
-    cov = s2 * (n - p) / max(n_eff - p, 1.0) * np.linalg.pinv(J.T @ J)
-    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        corr = np.where(np.outer(sd, sd) > 0, cov / np.outer(sd, sd), 0.0)
-    return cov, corr, n_eff, rho
+#: a log-coordinate key below this fraction of its start has collapsed towards zero
+COLLAPSED = 1e-6
 
 
-def separability_flags(keys, values: dict, intervals: dict, corr: np.ndarray) -> list[str]:
-    """Pairs with |corr| > 0.95 and keys whose 95 % interval is wider than the value."""
-    flags = []
+def key_status(coords: Coordinates, z: np.ndarray, identified: np.ndarray) -> list[str]:
+    """Per key: "at bound" (within 1e-6 of a bound of its coordinates, or a log key below
+    ``COLLAPSED`` times its start), else "not identified" (``stats.covariance``), else "identified"."""
+    lo, hi = coords.bounds()
+    tol = 1e-6 * np.maximum(1.0, np.abs(z))
+    at = (np.isfinite(lo) & (z - lo <= tol)) | (np.isfinite(hi) & (hi - z <= tol))
+    at |= np.asarray(coords.log) & (z < np.log(COLLAPSED))
+    return ["at bound" if a else ("identified" if ok else "not identified") for a, ok in zip(at, identified)]
+
+
+def uncertainty(stage: StageResult, coords: Coordinates, lengths: list[int]) -> dict[str, Any]:
+    """The HAC covariance (``stats.covariance``) of the fit in its coordinates and, per key, its
+    status, standard error and 95 % interval in the key's unit; plus the correlation matrix and
+    the AR(1) summary of the residual (lag-1 rho, effective samples)."""
+    cov = covariance(stage.jac, stage.fun, None, lengths)
+    status = key_status(coords, stage.z, cov.identified)
+    zq, sd_z = quantile(LEVEL), cov.sd
+    intervals, std = {}, {}
+    for i, k in enumerate(coords.keys):
+        if status[i] == "identified":
+            intervals[k] = coords.interval(stage.z[i], sd_z[i], i, zq)
+            std[k] = coords.value_sd(i, stage.z[i], sd_z[i])
+        else:  # no falsely precise interval: the key's whole range
+            intervals[k] = coords.interval(stage.z[i], np.inf, i, zq)
+            std[k] = float("inf")
+    rho = ar1_coefficient(stage.fun)
+    return {"status": dict(zip(coords.keys, status)), "intervals": intervals, "std": std,
+            "correlation": cov.correlation, "rho1": rho, "n_eff": ar1_effective_n(stage.fun.size, rho)}
+
+
+def separability_flags(keys, values: dict, intervals: dict, corr: np.ndarray, status: dict | None = None) -> list[str]:
+    """Keys the records do not determine or that ended at a bound, pairs with |corr| > 0.95 and
+    keys whose 95 % interval is wider than the value."""
+    status = status or {}
+    flags = [f"{k} is {status[k]}: the records do not determine it (its interval is its whole range)"
+             if status[k] == "not identified" else
+             f"{k} is at a bound of its range (or collapsed towards zero) at {values[k]:.4g}: not identified, "
+             "its interval is its whole range" for k in keys if status.get(k, "identified") != "identified"]
     for i, a in enumerate(keys):
         for j in range(i + 1, len(keys)):
             if abs(corr[i, j]) > MAX_CORRELATION:
@@ -161,7 +205,7 @@ def separability_flags(keys, values: dict, intervals: dict, corr: np.ndarray) ->
                              f"{corr[i, j]:+.3f})")
     for k in keys:
         lo, hi = intervals[k]
-        if hi - lo > abs(values[k]):
+        if status.get(k, "identified") == "identified" and hi - lo > abs(values[k]):
             flags.append(f"{k} is poorly determined: its 95 % interval [{lo:.4g}, {hi:.4g}] is wider than its "
                          f"value {values[k]:.4g}")
     return flags
@@ -180,8 +224,7 @@ def time_blocks(keys: tuple[str, ...], channels: tuple[str, ...], mode: str) -> 
 
 
 def _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar, workers):
-    """Stage 2 block by block (:func:`time_blocks`), then the residual and Jacobian of every
-    key on every channel at the result (weights 1 / rms of each channel's residual there)."""
+    """Stage 2 block by block (:func:`time_blocks`); returns the stage's z and its evaluations."""
     z = np.array(z1, dtype=float)
     nfev = 0
     blocks = time_blocks(coords.keys, chans, mode)
@@ -190,9 +233,41 @@ def _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar
             if len(blocks) == 1 else None
         s = fit_time(recs, start, coords, z, mode, block_chans, options, dt, max_nfev, bar, w, active, workers)
         z, nfev = s.z, nfev + s.nfev
-    weights = channel_weights(coords.apply(start, z), recs, mode, chans, options, dt)
-    final = jacobian_at(recs, start, coords, z, mode, chans, options, dt, weights, workers, bar)
-    return StageResult(z, final.cost, nfev, final.fun, final.jac), weights
+    return z, nfev
+
+
+def _setup(records, rig, fit, mode: str, specimen: str, channels) -> tuple[list, Rig, bool, tuple, tuple]:
+    """(records, start rig, generic start?, keys, channels), validated."""
+    if mode not in LOOP_KEYS:
+        raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(LOOP_KEYS)}")
+    recs = as_records(records)
+    spec = specimen_keys(specimen)
+    start, generic = _start_rig(rig, recs)
+    if generic:
+        specimen_start(start, recs[0], specimen)
+    use_specimen(start, specimen)
+    keys = check_keys(start, fit if fit is not None else LOOP_KEYS[mode] + spec)
+    chans = tuple(channels) if channels is not None else channels_of(recs[0], mode)
+    for r in recs:
+        missing = [c for c in chans if c not in channels_of(r, mode)]
+        if missing:
+            raise ValueError(f"record {r.path or '?'}: channel(s) {missing} absent or constant")
+    return recs, start, generic, keys, chans
+
+
+def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options, dt, max_nfev, progress, workers):
+    """Stage 2 from stage 1's z1 (again from the start when that ends worse than the start), then
+    ``fit.keep_best`` of the start and the stages; returns keep_best's result and the evaluations."""
+    from tqdm.auto import tqdm
+
+    with tqdm(desc="identify (simulations)", unit="sim", disable=not progress, leave=False) as bar:
+        stages = {"start": np.zeros(len(coords.keys)), "frequency": z1} if frequency_stage else {"start": z1}
+        stages["time"], nfev = _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar, workers)
+        if frequency_stage and best(time_costs(recs, start, coords, stages, mode, chans, options, dt)) != "time":
+            stages["time"], n2 = _time_stage(recs, start, coords, stages["start"], mode, chans, options, dt,
+                                             max_nfev, bar, workers)
+            nfev += n2
+        return (*keep_best(recs, start, coords, stages, mode, chans, options, dt, bar, workers), nfev)
 
 
 def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | None = None,
@@ -215,21 +290,8 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         progress: a tqdm bar over the simulations.
         workers: threads for the Jacobian's columns (default: up to 2).
     """
-    if mode not in LOOP_KEYS:
-        raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(LOOP_KEYS)}")
     t_start = time.perf_counter()
-    recs = as_records(records)
-    spec = specimen_keys(specimen)
-    start, generic = _start_rig(rig, recs)
-    if generic:
-        specimen_start(start, recs[0], specimen)
-    use_specimen(start, specimen)
-    keys = check_keys(start, fit if fit is not None else LOOP_KEYS[mode] + spec)
-    chans = tuple(channels) if channels is not None else channels_of(recs[0], mode)
-    for r in recs:
-        missing = [c for c in chans if c not in channels_of(r, mode)]
-        if missing:
-            raise ValueError(f"record {r.path or '?'}: channel(s) {missing} absent or constant")
+    recs, start, generic, keys, chans = _setup(records, rig, fit, mode, specimen, channels)
     coords = Coordinates.about(start, keys)
     runtime: dict[str, float] = {}
     z1, stage1_keys, nfev = np.zeros(len(keys)), [], {}
@@ -239,20 +301,14 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         z1, nfev["frequency"], runtime["frequency"] = s1.z, s1.nfev, time.perf_counter() - t0
     options = fit_options(coords.apply(start, z1), recs, mode)
     t0 = time.perf_counter()
-    from tqdm.auto import tqdm
-
-    with tqdm(desc="identify (simulations)", unit="sim", disable=not progress, leave=False) as bar:
-        s2, weights = _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar, workers)
-    nfev["time"], runtime["time"] = s2.nfev, time.perf_counter() - t0
-    cov, corr, n_eff, rho = uncertainty(s2, coords)
-    zq = float(norm.ppf(0.5 + LEVEL / 2))
-    sd_z = np.sqrt(np.maximum(np.diag(cov), 0.0))
-    vals = coords.values(s2.z)
-    values = {k: float(v) for k, v in zip(keys, vals)}
-    intervals = {k: coords.interval(s2.z[i], sd_z[i], i, zq) for i, k in enumerate(keys)}
-    std = {k: float(sd_z[i] * (abs(vals[i]) if coords.log[i] else coords.scale[i])) for i, k in enumerate(keys)}
+    kept, costs, weights, final, nfev["time"] = _time_stages(recs, start, coords, z1, frequency_stage, mode, chans,
+                                                             options, dt, max_nfev, progress, workers)
+    runtime["time"] = time.perf_counter() - t0
+    lengths = [r.time.size for r in recs for _ in chans]
+    u = uncertainty(final, coords, lengths)
+    values = {k: float(v) for k, v in zip(keys, coords.values(final.z))}
     s1_vals = coords.values(z1)
-    out_rig = coords.apply(start, s2.z)
+    out_rig = coords.apply(start, final.z)
     t0 = time.perf_counter()
     before = [compare(r, start, mode, simulated=simulate_record(start, r, mode, dt=dt, options=options))
               for r in recs]
@@ -264,9 +320,13 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         rig=out_rig, start=start, mode=mode, keys=keys, values=values,
         start_values={k: float(v) for k, v in zip(keys, coords.start)},
         stage1_values={k: (float(s1_vals[i]) if k in stage1_keys else None) for i, k in enumerate(keys)},
-        intervals=intervals, std=std, correlation=corr,
-        flags=separability_flags(keys, values, intervals, corr), before=before, after=after,
-        generic_start=generic, weights=weights, integrator=options.method.name.lower(), n_eff=float(n_eff), rho1=float(rho), nfev=nfev, runtime_s=runtime)
+        intervals=u["intervals"], std=u["std"], correlation=u["correlation"],
+        flags=not_improved_flags(kept, costs) + separability_flags(keys, values, u["intervals"], u["correlation"],
+                                                                   u["status"]),
+        before=before, after=after, generic_start=generic, weights=weights, integrator=options.method.name.lower(),
+        n_eff=float(u["n_eff"]), rho1=float(u["rho1"]), nfev=nfev, runtime_s=runtime, status=u["status"],
+        costs=costs, kept=kept)
 
 
-__all__ = ["Comparison", "Identification", "as_records", "identify", "separability_flags", "uncertainty"]
+__all__ = ["Comparison", "Identification", "as_records", "identify", "key_status", "separability_flags",
+           "uncertainty"]

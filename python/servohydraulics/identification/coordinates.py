@@ -1,4 +1,5 @@
-"""Which rig keys identification fits, and in which coordinates.
+"""Which rig keys identification fits, and in which coordinates (the one
+:class:`Coordinates` of the package: log, linear or reciprocal per key).
 
 One table per concern, easy to edit when the core gains fields:
 
@@ -66,16 +67,20 @@ def _bounds() -> dict[str, str]:
     return {p["key"]: p.get("bound", "") for p in _core.RIG_PARAMETERS}
 
 
+def units() -> dict[str, str]:
+    """Rig key -> SI unit, from the core's parameter table (``sh.PARAMETERS``)."""
+    return {p["key"]: p["unit"] for p in _core.RIG_PARAMETERS}
+
+
+#: the kinds of coordinate a key can be fitted in
+KINDS = ("log", "linear", "reciprocal")
+
+
 def specimen_keys(specimen: str) -> tuple[str, ...]:
-    """The specimen's fitted keys; ValueError if unknown or if ``Rig`` lacks its fields."""
+    """The specimen's fitted keys; ValueError if unknown."""
     if specimen not in SPECIMEN_KEYS:
         raise ValueError(f"invalid specimen = {specimen!r}: expected one of {sorted(SPECIMEN_KEYS)}")
-    keys = SPECIMEN_KEYS[specimen]
-    missing = [k for k in keys if not hasattr(Rig, k)]
-    if missing:
-        raise ValueError(f"specimen = {specimen!r} is not available yet: needs the specimen elements of issue 12 "
-                         f"(Rig has no field(s) {missing})")
-    return keys
+    return SPECIMEN_KEYS[specimen]
 
 
 def use_specimen(rig: Rig, specimen: str) -> None:
@@ -102,28 +107,62 @@ def check_keys(rig: Rig, keys) -> tuple[str, ...]:
 
 @dataclass(frozen=True)
 class Coordinates:
-    """Fitting coordinates z of the keys about a start: z = log(value / start) for a
-    positive start of a key that cannot be negative (relative steps, no sign change),
-    else z = (value - start) / scale with scale = max(|start|, 1e-12).  z = 0 is the start."""
+    """Fitting coordinates z of parameters, one kind per key (``KINDS``):
+
+    * ``"log"``: z = log(value / start), for a positive key that cannot be negative
+      (relative steps, no sign change);
+    * ``"linear"``: z = (value - start) / scale;
+    * ``"reciprocal"``: z = 1 / value (a value <= 0 in z is an infinite value), for a
+      parameter whose "absent" is infinite (a valve bandwidth, a supply pressure): absent
+      is z = 0, inside the range.
+
+    ``about(rig, keys)`` (``sh.identify``) puts z = 0 at the rig's values, log or linear;
+    ``absolute(keys, reciprocal)`` (``sh.diagnose``) fits the values themselves or their
+    reciprocals."""
 
     keys: tuple[str, ...]
     start: np.ndarray
-    log: np.ndarray
+    kind: tuple[str, ...]
     scale: np.ndarray
+
+    def __post_init__(self) -> None:
+        bad = [k for k in self.kind if k not in KINDS]
+        if bad or len(self.kind) != len(self.keys):
+            raise ValueError(f"invalid coordinate kinds = {self.kind}: one of {KINDS} per key {self.keys}")
 
     @classmethod
     def about(cls, rig: Rig, keys) -> Coordinates:
         start = np.array([float(np.clip(getattr(rig, k), *RANGES.get(k, (-np.inf, np.inf)))) for k in keys])
-        log = np.array([s > 0 and k not in SIGNED_KEYS for k, s in zip(keys, start)])
-        return cls(tuple(keys), start, log, np.maximum(np.abs(start), 1e-12))
+        kind = tuple("log" if s > 0 and k not in SIGNED_KEYS else "linear" for k, s in zip(keys, start))
+        return cls(tuple(keys), start, kind, np.maximum(np.abs(start), 1e-12))
+
+    @classmethod
+    def absolute(cls, keys, reciprocal) -> Coordinates:
+        """z = value, or z = 1 / value where ``reciprocal``."""
+        n = len(keys)
+        return cls(tuple(keys), np.zeros(n), tuple("reciprocal" if r else "linear" for r in reciprocal), np.ones(n))
+
+    @property
+    def log(self) -> np.ndarray:
+        return np.array([k == "log" for k in self.kind], dtype=bool)
+
+    @property
+    def reciprocal(self) -> np.ndarray:
+        return np.array([k == "reciprocal" for k in self.kind], dtype=bool)
 
     def values(self, z: np.ndarray) -> np.ndarray:
-        return np.where(self.log, self.start * np.exp(np.where(self.log, z, 0.0)), self.start + z * self.scale)
+        z = np.asarray(z, dtype=float)
+        log, rec = self.log, self.reciprocal
+        with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+            out = np.where(log, self.start * np.exp(np.where(log, z, 0.0)), self.start + z * self.scale)
+            return np.where(rec, np.where(z <= 0, np.inf, 1.0 / np.where(z <= 0, 1.0, z)), out)
 
     def z(self, values: np.ndarray) -> np.ndarray:
         v = np.asarray(values, dtype=float)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(self.log, np.log(np.where(self.log, v / self.start, 1.0)), (v - self.start) / self.scale)
+        log, rec = self.log, self.reciprocal
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            out = np.where(log, np.log(np.where(log, v / self.start, 1.0)), (v - self.start) / self.scale)
+            return np.where(rec, np.where(np.isinf(v), 0.0, 1.0 / np.where(v == 0, np.inf, v)), out)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Linear keys bounded below by 0 where the core's table says >= 0 or > 0."""
@@ -148,15 +187,25 @@ class Coordinates:
         return r
 
     def interval(self, z: float, sd: float, i: int, level_z: float) -> tuple[float, float]:
-        """Interval of key i from z +- level_z sd (log keys: asymmetric in the value)."""
+        """Interval of key i from z +- level_z sd (log and reciprocal keys: asymmetric in the value;
+        an infinite sd: the key's whole range)."""
         a, b = self.values_at(i, z - level_z * sd), self.values_at(i, z + level_z * sd)
         return (min(a, b), max(a, b))
 
+    def value_sd(self, i: int, z: float, sd: float) -> float:
+        """Standard error of key i in its unit from sd in z (linearised)."""
+        v = self.values_at(i, z)
+        return float(sd * {"log": abs(v), "reciprocal": v * v, "linear": self.scale[i]}[self.kind[i]])
+
     def values_at(self, i: int, z: float) -> float:
-        if self.log[i]:
+        if not math.isfinite(z) and self.kind[i] != "reciprocal":  # an infinite sd: the end of the range
+            return (0.0 if z < 0 else math.inf) if self.kind[i] == "log" else math.copysign(math.inf, z)
+        if self.kind[i] == "log":
             return float(self.start[i]) * math.exp(min(max(z, -745.0), 709.0))  # a huge sd: 0 or inf
+        if self.kind[i] == "reciprocal":
+            return math.inf if z <= 0 else 1.0 / z
         return float(self.start[i] + z * self.scale[i])
 
 
-__all__ = ["FORCE_KEYS", "LOOP_KEYS", "RANGES", "MR_DAMPER_FIELDS", "SIGNED_KEYS", "SPECIMEN_EFFECT", "SPECIMEN_KEYS", "Coordinates",
-           "check_keys", "specimen_keys", "use_specimen"]
+__all__ = ["FORCE_KEYS", "KINDS", "LOOP_KEYS", "MR_DAMPER_FIELDS", "RANGES", "SIGNED_KEYS", "SPECIMEN_EFFECT",
+           "SPECIMEN_KEYS", "Coordinates", "check_keys", "specimen_keys", "units", "use_specimen"]

@@ -1,0 +1,105 @@
+"""The one record-simulation helper: a command through a rig, as a ``Response``
+on the command's own time axis (``sh.identify``, ``compare``, ``sh.diagnose`` and
+the paper-era fits all simulate through :func:`simulate_command`).
+
+The controller sample is the record's dt unless told otherwise.  A controller
+``dt`` that divides the record's sample time (an integer ratio n) gets the
+command linearly interpolated onto its grid and every n-th output kept; a
+controller n times slower gets every n-th command sample and its outputs
+linearly interpolated back onto the record's times.  A command ``delay`` [s]
+shifts the command by whole and fractional samples (linear interpolation,
+holding the first value before the record starts).  :func:`simulate_record`
+starts at rest at the record's initial displacement (the median of its first 20
+samples, which averages the sensor noise).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..response import Response, SimulationError
+from ..rig import Rig
+from ..simulate import simulate
+
+#: the channels a record and a simulation share, compared in this order
+CHANNELS = ("displacement", "force")
+
+
+def initial_displacement(record: Response, samples: int = 20) -> float:
+    """The record's initial displacement [m]: the median of its first samples."""
+    return float(np.median(np.asarray(record.displacement)[:samples]))
+
+
+def _ratio(record_dt: float, dt: float) -> tuple[int, bool]:
+    """(n, faster): the controller runs n times faster (True) or slower than the record."""
+    for a, b, faster in ((record_dt, dt, True), (dt, record_dt, False)):
+        n = a / b
+        if abs(n - round(n)) <= 1e-6 * n and round(n) >= 1:
+            return int(round(n)), faster
+    raise ValueError(f"invalid dt = {dt!r}: the controller sample must divide the record's {record_dt!r} s "
+                     "or be an integer multiple of it")
+
+
+def delayed(u: np.ndarray, dt: float, tau: float) -> np.ndarray:
+    """The command delayed by tau [s]: integer + fractional samples by linear
+    interpolation, holding the first value before the record starts (tau < 0
+    advances it, holding the last value past the end)."""
+    if tau == 0.0:
+        return u
+    k = np.arange(u.size) - tau / dt
+    return np.interp(k, np.arange(u.size), u, left=u[0], right=u[-1])
+
+
+def simulate_command(rig: Rig, mode: str, command: np.ndarray, record_dt: float, x0: float = 0.0, options=None,
+                     dt: float | None = None, delay: float = 0.0) -> Response:
+    """The command (sampled at ``record_dt`` [s], delayed by ``delay`` [s]) through the rig with a
+    controller sample ``dt`` (default ``record_dt``), from rest at ``x0`` [m]: a ``Response`` of
+    kind ``"plant"`` with every plant channel on the command's time axis (``time`` from 0).
+
+    Raises SimulationError (the solver's message, with the time) when the run fails."""
+    u = delayed(np.asarray(command, dtype=float), record_dt, float(delay))
+    n, faster = (1, True) if dt is None else _ratio(record_dt, float(dt))
+    tr = np.arange(u.size) * record_dt
+    if faster:
+        uc = u if n == 1 else np.interp(np.arange((u.size - 1) * n + 1) * (record_dt / n), tr, u)
+        res = simulate(rig, mode=mode, command=uc, dt=record_dt / n, x0=x0, options=options)
+        data = {k: np.asarray(v)[::n] for k, v in res.channels.items() if k != "time"}
+    else:
+        uc = u[::n]
+        res = simulate(rig, mode=mode, command=uc, dt=record_dt * n, x0=x0, options=options)
+        ts = np.arange(uc.size) * record_dt * n
+        data = {k: np.interp(tr, ts, np.asarray(v, dtype=float)) for k, v in res.channels.items()
+                if k not in ("time", "flags", "internal_steps", "rhs_evals")}
+    data["time"] = tr
+    data["command"] = u
+    return Response(data, kind="plant", mode=mode, dt=record_dt, rig=rig, work=res.work)
+
+
+def simulate_record(rig: Rig, record: Response, mode: str, dt: float | None = None, options=None,
+                    x0: float | None = None, delay: float = 0.0) -> Response:
+    """:func:`simulate_command` of the record's command from its initial displacement (``x0``
+    overrides it)."""
+    start = initial_displacement(record) if x0 is None else float(x0)
+    return simulate_command(rig, mode, record.command, record.dt, start, options, dt, delay)
+
+
+def nrmse_pct(simulated: np.ndarray, measured: np.ndarray) -> float:
+    """100 rms(sim - measured) / std(measured) [%] (the issue's definition)."""
+    m = np.asarray(measured, dtype=float)
+    sd = float(np.std(m))
+    if not sd > 0 or not math.isfinite(sd):
+        raise ValueError("invalid measured channel: constant, its NRMSE is undefined")
+    return 100.0 * float(np.sqrt(np.mean((np.asarray(simulated, dtype=float) - m) ** 2))) / sd
+
+
+def nrmse_demeaned_pct(simulated: np.ndarray, measured: np.ndarray) -> float:
+    """100 std(sim - measured) / std(measured) [%]: the error with its mean (a
+    static offset) removed, the figure the UTFSM README quotes."""
+    m = np.asarray(measured, dtype=float)
+    return 100.0 * float(np.std(np.asarray(simulated, dtype=float) - m)) / float(np.std(m))
+
+
+__all__ = ["CHANNELS", "SimulationError", "delayed", "initial_displacement", "nrmse_demeaned_pct", "nrmse_pct",
+           "simulate_command", "simulate_record"]
