@@ -223,16 +223,28 @@ def time_blocks(keys: tuple[str, ...], channels: tuple[str, ...], mode: str) -> 
     return [(np.ones(len(keys), dtype=bool), channels)]
 
 
+#: block sweeps of the time stage at most, and the move (in the fitting coordinates) below which
+#: a sweep has converged: the loop keys fitted on the displacement with a wrong specimen
+#: compensate for its force (the load does change the tracking), so the blocks are swept again
+#: with the specimen's new keys until neither moves (block coordinate descent)
+MAX_SWEEPS, SWEEP_TOL = 4, 2e-3
+
+
 def _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar, workers):
-    """Stage 2 block by block (:func:`time_blocks`); returns the stage's z and its evaluations."""
+    """Stage 2 block by block (:func:`time_blocks`), the blocks swept until the keys stop moving
+    (``MAX_SWEEPS``, ``SWEEP_TOL``); returns the stage's z and its evaluations."""
     z = np.array(z1, dtype=float)
     nfev = 0
     blocks = time_blocks(coords.keys, chans, mode)
-    for active, block_chans in blocks:
-        w = channel_weights(coords.apply(start, z), recs, mode, block_chans, options, dt) \
-            if len(blocks) == 1 else None
-        s = fit_time(recs, start, coords, z, mode, block_chans, options, dt, max_nfev, bar, w, active, workers)
-        z, nfev = s.z, nfev + s.nfev
+    for _ in range(MAX_SWEEPS if len(blocks) > 1 else 1):
+        z_sweep = z.copy()
+        for active, block_chans in blocks:
+            w = channel_weights(coords.apply(start, z), recs, mode, block_chans, options, dt) \
+                if len(blocks) == 1 else None
+            s = fit_time(recs, start, coords, z, mode, block_chans, options, dt, max_nfev, bar, w, active, workers)
+            z, nfev = s.z, nfev + s.nfev
+        if np.max(np.abs(z - z_sweep)) < SWEEP_TOL:
+            break
     return z, nfev
 
 
