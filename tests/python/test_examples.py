@@ -26,6 +26,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import servohydraulics as sh
@@ -186,3 +187,34 @@ def test_python_sweep_examples_run():
     s = parse(out.replace(" ", "\n"))
     assert s["runs"] == 4
     assert s["min"] <= s["rms_tracking_error_mm_mean"] <= s["max"]
+
+
+def _building_first_floor_amplitude(frequency: float, acceleration: float) -> float:
+    """Steady-state first-floor amplitude [m] of the example's shear building under a sine a_g."""
+    from servohydraulics import rths
+
+    case, w = rths.shear_building(), 2 * math.pi * frequency
+    x = np.linalg.solve(case.K - w * w * case.M + 1j * w * case.C, -case.M @ np.ones(3) * acceleration)
+    return float(abs(x[0]))
+
+
+def test_cpp_user_controller_equals_the_builtin_and_tracks_the_building(cpp_examples):
+    """examples/07_user_controller.cpp: a user's C++ TrackingController (PI + lead written
+    out) gives the built-in sample controller's commands exactly, and the specimen follows
+    the building's steady-state first-floor response (frequency-response oracle)."""
+    s = parse(_run([str(cpp_examples / "07_user_controller"), "10"], timeout=60).stdout)
+    assert s["ok"] == 1 and s["samples"] == 40960 and s["max_command_difference_m"] == 0.0
+    assert s["steady_peak_displacement_mm"] == pytest.approx(1e3 * _building_first_floor_amplitude(2.0, 1.0), rel=0.02)
+    assert 0 < s["pilead_step_us_median"] <= s["pilead_step_us_p99"]
+    res = subprocess.run([str(cpp_examples / "07_user_controller"), "-1"], capture_output=True, text=True, timeout=30)
+    assert res.returncode == 2 and "invalid seconds" in res.stderr
+
+
+def test_python_user_controller_equals_the_builtin():
+    """examples/07_user_controller.py: PI + lead in pure Python (the core's converters)
+    gives the built-in sample controller's commands and J exactly."""
+    s = parse(run_example("07_user_controller.py"))
+    assert s["builtin_ok"] == s["python_ok"] == 1 and s["same_J"] == 1 and s["max_command_difference_m"] == 0.0
+    J = {k[len("python_"):]: v for k, v in s.items() if k.startswith("python_J")}
+    assert len(J) == 9 and all(s[f"builtin_{k}"] == v for k, v in J.items())
+    assert 0 < J["J1_delay_ms"] <= 12.0 and J["J2_rms_tracking_error_pct"] < 20.0
