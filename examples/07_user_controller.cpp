@@ -1,7 +1,7 @@
 // Your own tracking controller in C++: the PI + phase lead of
 // examples/07_user_controller.py moved to C++ (docs/rths-benchmark.md, "Bring your
-// own controller": when a Python controller is too slow).  It derives the core's
-// interface
+// own controller": when a Python controller is too slow).  PiLead (pi_lead.hpp)
+// derives the core's interface
 //
 //   class rths::TrackingController {
 //     virtual void reset() noexcept = 0;
@@ -9,16 +9,18 @@
 //   };
 //
 // (TrackingInput: desired [m], desired_velocity [m/s], desired_acceleration [m/s^2],
-// measured [m], measured_force [N]), and plugs into the RTHS loop as the built-ins do.
-// Construct once; reset() and command() must not allocate or throw.
+// measured [m], measured_force [N]) and plugs into the RTHS loop as the built-ins do.
+// Construct once; reset() and command() must not allocate or throw.  To use it from
+// Python instead, see examples/07_user_controller_module.cpp.
 //
 // The run: the benchmark's control plant as the experimental substructure under a
 // 3-storey shear building (6, 5, 4 MN/m storeys, 1000 kg floors, 5 % Rayleigh
 // damping; NOT one of the benchmark's cases) shaken by a 2 Hz sine, once with the
 // built-in SampleController and once with PiLead.  PiLead is the same algorithm, so
 // the commands agree (max_command_difference_m, expected 0); after the start-up
-// transient the specimen follows the building's first floor (steady_peak_displacement_mm:
-// its peak over the last 2 s, against the building's steady-state 2 Hz response).  The per-sample wall times (the whole sample: plant,
+// transient the specimen follows the building's first floor
+// (steady_peak_displacement_mm: its peak over the last 2 s, against the building's
+// steady-state 2 Hz response).  The per-sample wall times (the whole sample: plant,
 // substructure, controller) are printed for both.
 //
 //   07_user_controller [seconds=10]
@@ -31,45 +33,8 @@
 
 #include <Eigen/Dense>
 
+#include "pi_lead.hpp"
 #include "servohydraulics/rths/loop.hpp"
-
-namespace rths = servohydraulics::rths;
-
-//! PI on the tracking error + phase lead on the reference, with the benchmark's 18-bit converters.
-class PiLead final : public rths::TrackingController {
- public:
-  explicit PiLead(double dt = 1.0 / 4096.0, double Kp = 2.0, double Ki = 95.0, double lead_b1 = 50.83163360273612,
-                  double lead_b0 = 8570.397339444286, double lead_a0 = 8570.397339444286)
-      : lead_(tustin(lead_b1, lead_b0, 1.0, lead_a0, dt)), pi_(tustin(Kp, Ki, 1.0, 0.0, dt)) {}
-
-  void reset() noexcept override { r1_ = yl1_ = e1_ = yc1_ = 0.0; }
-
-  double command(const rths::TrackingInput& in) noexcept override {
-    const double r = ad_(in.desired);
-    const double yl = -lead_.d1 * yl1_ + lead_.n0 * r + lead_.n1 * r1_;  // phase lead on the reference
-    r1_ = r;
-    yl1_ = yl;
-    const double e = ad_(da_(yl) - in.measured);  // tracking error
-    const double yc = -pi_.d1 * yc1_ + pi_.n0 * e + pi_.n1 * e1_;  // PI
-    e1_ = e;
-    yc1_ = yc;
-    return da_(yc);
-  }
-
- private:
-  struct Coefficients {
-    double n0, n1, d1;
-  };
-  //! (b1 s + b0) / (a1 s + a0) by Tustin at h: y_k = -d1 y_k-1 + n0 u_k + n1 u_k-1.
-  static Coefficients tustin(double b1, double b0, double a1, double a0, double h) {
-    const double c = 2.0 / h, D = a1 * c + a0;
-    return {(b1 * c + b0) / D, (b0 - b1 * c) / D, (a0 - a1 * c) / D};
-  }
-  Coefficients lead_, pi_;
-  rths::Converter ad_ = rths::benchmark_converter(rths::Converter::Kind::AnalogToDigital);
-  rths::Converter da_ = rths::benchmark_converter(rths::Converter::Kind::DigitalToAnalog);
-  double r1_ = 0.0, yl1_ = 0.0, e1_ = 0.0, yc1_ = 0.0;
-};
 
 namespace {
 
