@@ -229,8 +229,6 @@ def test_cpp_user_controller_as_a_python_module(cpp_examples, tmp_path):
 
     import pybind11
 
-    from servohydraulics import rths
-
     prefix = cpp_examples.parent / "prefix"
     lib = next(prefix.glob("lib*/libservohydraulics.a"))
     so = tmp_path / f"my_controllers{sysconfig.get_config_var('EXT_SUFFIX')}"
