@@ -132,14 +132,32 @@ class PythonControllerCalls {
 };
 
 //! Trampoline: a Python subclass of TrackingController overrides reset() and command(...).
+//! reset() also caches the class's command function; command() then calls it with the
+//! instance (borrowed: the instance owns this object), skipping pybind11's per-call override
+//! lookup.  An override that is not a plain method of the class is looked up on every call.
 class PyTrackingController : public rths::TrackingController, public PythonControllerCalls {
  public:
   using rths::TrackingController::TrackingController;
   void reset() noexcept override {
-    reset_call([&] { override_of("reset")(); });
+    reset_call([&] {
+      command_ = py::object();
+      self_ = py::handle();
+      override_of("reset")();
+      const py::function f = override_of("command");
+      if (py::hasattr(f, "__func__") && py::hasattr(f, "__self__")) {
+        const py::object self = f.attr("__self__"), func = f.attr("__func__");
+        if (py::getattr(py::type::handle_of(self), "command", py::none()).is(func)) {
+          command_ = func;
+          self_ = self;  // borrowed: it owns this C++ object, so it outlives every call
+        }
+      }
+    });
   }
   double command(const rths::TrackingInput& in) noexcept override {
     return command_call([&] {
+      if (command_)
+        return command_(self_, in.desired, in.desired_velocity, in.desired_acceleration, in.measured,
+                        in.measured_force);
       return override_of("command")(in.desired, in.desired_velocity, in.desired_acceleration, in.measured,
                                     in.measured_force);
     });
@@ -151,6 +169,8 @@ class PyTrackingController : public rths::TrackingController, public PythonContr
     if (!f) throw py::type_error(std::string("a TrackingController subclass must define ") + name + "()");
     return f;
   }
+  py::object command_;
+  py::handle self_;
 };
 
 //! Any Python object with reset() and command(...) as a TrackingController.

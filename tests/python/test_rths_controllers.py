@@ -267,3 +267,25 @@ def test_cli_controller_errors_exit_2_naming_the_value(tmp_path, monkeypatch, ca
                                               "--quiet", "--out", str(tmp_path / "o")]) == 2
                                         and capsys.readouterr().err)
     assert not (tmp_path / "o").exists()  # refused before any run or file
+
+
+def test_subclass_command_is_found_as_python_finds_it_and_the_object_is_freed(short):
+    """The trampoline caches the class's command at reset(): an instance attribute that
+    replaces it still wins (as in Python), and the controller is freed after the run (no
+    reference cycle through the cache)."""
+    import gc
+    import weakref
+
+    case, rec = short
+    ref = _trial(case, rec, "sample")
+    sub = DelegatingSubclass()
+    inner = sub.inner
+    sub.command = lambda *args: 0.0  # an instance attribute: no command from the class
+    t = _trial(case, rec, sub)
+    assert t.J != ref.J and np.all(t.signals["command"] == 0.0)
+    del sub.command
+    assert _trial(case, rec, sub).J == ref.J
+    probe = weakref.ref(sub)
+    del sub
+    gc.collect()
+    assert probe() is None and inner is not None
