@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import textwrap
 
 import numpy as np
@@ -198,6 +199,7 @@ def test_run_case_with_an_object_runs_the_perturbed_trials_in_process(short):
     assert a["perturbed"]["criteria_mean"]["J2_rms_tracking_error_pct"] == a["perturbed"]["J_mean"][1]
     cols = list(a["table"].columns)
     assert all(n in cols for n in rths.J_NAMES) and "J1" not in cols
+    assert set(a["table"]["controller"]) == {f"{__name__}:Delegating"}
     np.testing.assert_array_equal(a["table"][list(rths.J_NAMES)].to_numpy(), b["table"][list(rths.J_NAMES)].to_numpy())
     df = a["trial"].to_pandas()
     assert list(df.columns[:9]) == list(rths.J_NAMES) and df["J1_delay_ms"].iloc[0] == a["nominal"]["J"][0]
@@ -224,16 +226,31 @@ def test_cli_controller_module_class(tmp_path, monkeypatch, capsys):
             def command(self, desired, desired_velocity, desired_acceleration, measured, measured_force):
                 return self.inner.command(desired, desired_velocity, desired_acceleration, measured, measured_force)
     ''', "my_ctrl_ok")
+    monkeypatch.setenv("PYTHONPATH", f"{tmp_path}:{os.environ.get('PYTHONPATH', '')}")  # for the workers
     outs = {}
     for spec in ("sample", f"{mod}:MyController"):
         out = tmp_path / spec.replace(":", "_")
-        assert main(["rths-benchmark", "--cases", "1", "--controller", spec, "--quiet", "--out", str(out)]) == 0
+        assert main(["rths-benchmark", "--cases", "1", "--controller", spec, "--perturbed", "2", "--workers", "2",
+                     "--quiet", "--out", str(out)]) == 0
         outs[spec] = json.loads((out / "results.json").read_text())
     mine = outs[f"{mod}:MyController"]
     assert mine["meta"]["controller"] == f"{mod}:MyController"
     assert mine["meta"]["controller_description"] == "Delegates to the benchmark's sample controller."
     assert mine["cases"]["1"]["nominal"]["J"] == outs["sample"]["cases"]["1"]["nominal"]["J"]
     assert mine["cases"]["1"]["nominal"]["criteria"] == outs["sample"]["cases"]["1"]["nominal"]["criteria"]
+    # the perturbed trials: each worker process imported the module and built its own
+    assert mine["cases"]["1"]["perturbed"] == outs["sample"]["cases"]["1"]["perturbed"]
+    assert mine["meta"]["perturbed_stable"] == {"1": 2}
+
+
+def test_run_benchmark_with_an_object_runs_in_process():
+    """run_benchmark with a controller object (a TrackingController subclass: not
+    picklable) and perturbed trials: no process pool, the built-in's figures."""
+    from servohydraulics.rths.report import run_benchmark
+
+    a = run_benchmark(None, cases="1", controller=DelegatingSubclass(), perturbed=2, progress=False)["results"]
+    b = run_benchmark(None, cases="1", controller="sample", perturbed=2, workers=2, progress=False)["results"]
+    assert a["cases"] == b["cases"] and a["meta"]["controller"] == f"{__name__}:DelegatingSubclass"
 
 
 def test_cli_controller_errors_exit_2_naming_the_value(tmp_path, monkeypatch, capsys):

@@ -387,6 +387,8 @@ def run_case(case: BenchmarkCase, record: Record, controller: Any = "sample", pe
             if own is not None:
                 own.shutdown(wait=True)
         df = df.drop(columns=["case", "record", "csi_derivative_block", "noise"])
+        if not isinstance(controller, str):
+            df["controller"] = controller_label(controller)[0]  # its name, not the object
         if "error" in df.columns and df["error"].notna().any():
             raise RuntimeError(f"perturbed trial failed: {df['error'].dropna().iloc[0]}")
         Js = df[list(J_NAMES)].to_numpy(dtype=float)

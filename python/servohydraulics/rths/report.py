@@ -78,7 +78,9 @@ def run_benchmark(data: str | Path | None = None, record: str = "elcentro", case
         meta["label"] = ("EMBEDDED DEFAULT: reference structure rebuilt from the published parameters, driven by the "
                          "benchmark's chirp (no published results).")
     trials, tables = {}, {}
-    executor = ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1) if perturbed > 0 else None
+    # a controller object cannot go to worker processes: run_case then runs its trials here, one after another
+    parallel = perturbed > 0 and isinstance(controller, str)
+    executor = ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1) if parallel else None
     bar = None
     if progress:
         from tqdm.auto import tqdm
