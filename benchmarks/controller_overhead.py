@@ -31,13 +31,13 @@ R = rths.core
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _example_pilead():
-    """examples/07_user_controller.py's PiLead: PI + lead in pure Python (the core's converters)."""
+def _example():
+    """examples/07_user_controller.py: PiLead (PI + lead in pure Python, the core's converters), Delegating."""
     path = ROOT / "examples" / "07_user_controller.py"
     spec = importlib.util.spec_from_file_location("user_controller_example", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    return module.PiLead
+    return module
 
 
 class NoOp:
@@ -48,19 +48,6 @@ class NoOp:
 
     def command(self, desired, desired_velocity, desired_acceleration, measured, measured_force):
         return 0.0
-
-
-class Delegating:
-    """Python, duck-typed, delegates to the built-in sample controller."""
-
-    def __init__(self):
-        self.inner = rths.make_controller("sample")
-
-    def reset(self):
-        self.inner.reset()
-
-    def command(self, desired, desired_velocity, desired_acceleration, measured, measured_force):
-        return self.inner.command(desired, desired_velocity, desired_acceleration, measured, measured_force)
 
 
 class DelegatingSubclass(rths.TrackingController):
@@ -78,12 +65,12 @@ class DelegatingSubclass(rths.TrackingController):
 
 
 def controllers() -> dict[str, object]:
-    pilead = _example_pilead()
+    example = _example()
     out: dict[str, object] = {f"C++ built-in `{n}`": n for n in rths.CONTROLLERS}
     out["Python no-op (returns 0)"] = NoOp
-    out["Python, delegating to the built-in `sample` (duck-typed)"] = Delegating
+    out["Python, delegating to the built-in `sample` (duck-typed)"] = example.Delegating
     out["Python, delegating to the built-in `sample` (TrackingController subclass)"] = DelegatingSubclass
-    out["Python PI + phase lead (examples/07_user_controller.py)"] = pilead
+    out["Python PI + phase lead (examples/07_user_controller.py)"] = example.PiLead
     return out
 
 

@@ -15,7 +15,7 @@ next sample.  From the command line:
 
     PYTHONPATH=examples servohydraulics rths-benchmark --controller 07_user_controller:PiLead ...
 
-(a module name must be importable: copy the class into e.g. my_controller.py).
+``Delegating`` below wraps a built-in: the published case-1 row, bit for bit.
 examples/07_user_controller.cpp is the same controller in C++, for when Python is too slow.
 
     python3 examples/07_user_controller.py [DATA]   # DATA: the benchmark files (case 1, El Centro x 0.4);
@@ -65,6 +65,19 @@ class PiLead:
         yc = -d1 * self.yc1 + n0 * e + n1 * self.e1  # PI
         self.e1, self.yc1 = e, yc
         return self.da(yc)
+
+
+class Delegating:
+    """Delegates to a built-in controller (wrap or extend one: rths.make_controller returns it)."""
+
+    def __init__(self, name: str = "sample"):
+        self.inner = rths.make_controller(name)
+
+    def reset(self) -> None:
+        self.inner.reset()
+
+    def command(self, desired, desired_velocity, desired_acceleration, measured, measured_force) -> float:
+        return self.inner.command(desired, desired_velocity, desired_acceleration, measured, measured_force)
 
 
 def main(data: str | None = None) -> None:

@@ -12,6 +12,7 @@ import json
 import math
 import os
 import textwrap
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -212,30 +213,22 @@ def _module(tmp_path, body: str, name: str = "my_ctrl"):
 
 def test_cli_controller_module_class(tmp_path, monkeypatch, capsys):
     """--controller module:Class: the module from PYTHONPATH, the class built with no
-    arguments; delegating to the built-in sample controller it writes the built-in's J."""
-    monkeypatch.syspath_prepend(str(tmp_path))
-    mod = _module(tmp_path, '''
-        from servohydraulics import rths
-
-        class MyController:
-            """Delegates to the benchmark's sample controller."""
-            def __init__(self):
-                self.inner = rths.make_controller("sample")
-            def reset(self):
-                self.inner.reset()
-            def command(self, desired, desired_velocity, desired_acceleration, measured, measured_force):
-                return self.inner.command(desired, desired_velocity, desired_acceleration, measured, measured_force)
-    ''', "my_ctrl_ok")
-    monkeypatch.setenv("PYTHONPATH", f"{tmp_path}:{os.environ.get('PYTHONPATH', '')}")  # for the workers
+    arguments, as the example's docstring says (PYTHONPATH=examples, 07_user_controller:
+    Delegating); delegating to the built-in sample controller it writes the built-in's J,
+    in the nominal trial and in the perturbed trials of the worker processes."""
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    monkeypatch.syspath_prepend(str(examples))
+    monkeypatch.setenv("PYTHONPATH", f"{examples}:{os.environ.get('PYTHONPATH', '')}")  # for the workers
+    mod = "07_user_controller"
     outs = {}
-    for spec in ("sample", f"{mod}:MyController"):
+    for spec in ("sample", f"{mod}:Delegating"):
         out = tmp_path / spec.replace(":", "_")
         assert main(["rths-benchmark", "--cases", "1", "--controller", spec, "--perturbed", "2", "--workers", "2",
                      "--quiet", "--out", str(out)]) == 0
         outs[spec] = json.loads((out / "results.json").read_text())
-    mine = outs[f"{mod}:MyController"]
-    assert mine["meta"]["controller"] == f"{mod}:MyController"
-    assert mine["meta"]["controller_description"] == "Delegates to the benchmark's sample controller."
+    mine = outs[f"{mod}:Delegating"]
+    assert mine["meta"]["controller"] == f"{mod}:Delegating"
+    assert mine["meta"]["controller_description"].startswith("Delegates to a built-in controller")
     assert mine["cases"]["1"]["nominal"]["J"] == outs["sample"]["cases"]["1"]["nominal"]["J"]
     assert mine["cases"]["1"]["nominal"]["criteria"] == outs["sample"]["cases"]["1"]["nominal"]["criteria"]
     # the perturbed trials: each worker process imported the module and built its own
