@@ -109,6 +109,11 @@ def test_builtins_are_objects_of_the_interface():
         a.reset()
         assert [a.command(*args) for _ in range(5)] == seq
         assert all(math.isfinite(u) for u in seq) and seq[0] != 0.0
+    # designed on another plant: the model-based feedforward follows the plant's coefficients
+    stiff = rths.nominal_plant()
+    stiff.k_e *= 2.0
+    u = [rths.make_controller("model", plant=p).command(*args) for p in (rths.nominal_plant(), stiff)]
+    assert u[0] != u[1]
 
 
 def test_delegating_class_reproduces_the_published_case1_row():
