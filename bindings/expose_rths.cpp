@@ -281,17 +281,25 @@ void expose_rths(py::module_& m) {
   // Python controllers (tracking_trampoline.hpp): subclass TrackingController, or wrap any object.
   py::class_<TrackingController, bindings::PyTrackingController>(r, "TrackingController")
       .def(py::init<>())
-      .def("reset", [](TrackingController& c) { bindings::require_idle(&c, "TrackingController.reset"); c.reset(); })
+      .def("reset", [](TrackingController& c) {
+        bindings::require_idle(&c, "TrackingController.reset");
+        c.reset();
+        bindings::raise_controller_error(c, std::nan(""));
+      })
       .def("command", [](TrackingController& c, double d, double dv, double da, double xm, double fm) {
         bindings::require_idle(&c, "TrackingController.command");
-        return c.command(TrackingInput{d, dv, da, xm, fm});
+        const double u = c.command(TrackingInput{d, dv, da, xm, fm});
+        bindings::raise_controller_error(c, std::nan(""));
+        return u;
       }, py::arg("desired"), py::arg("desired_velocity") = 0.0, py::arg("desired_acceleration") = 0.0,
          py::arg("measured") = 0.0, py::arg("measured_force") = 0.0,
          "The command [m] from the desired displacement [m], velocity [m/s] and acceleration [m/s^2] and the "
          "measured displacement [m] and force [N].")
       .def("command", [](TrackingController& c, const TrackingInput& in) {
         bindings::require_idle(&c, "TrackingController.command");
-        return c.command(in);
+        const double u = c.command(in);
+        bindings::raise_controller_error(c, std::nan(""));
+        return u;
       }, py::arg("input"));
   py::class_<bindings::PythonTrackingController, TrackingController>(
       r, "PythonController", "any object with reset() and command(...) as a tracking controller")

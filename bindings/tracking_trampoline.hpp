@@ -41,15 +41,15 @@ class PythonControllerCalls {
 
   //! Re-raises the stored error (GIL held): RuntimeError("<who>.<method>() raised at sample k
   //! (t = k dt s): <Type>: <message>") from the original, with attributes sample and time.
-  [[noreturn]] void raise_stored_error(const std::string& who, double dt) const {
+  [[noreturn]] void raise_stored_error(const std::string& who, double dt) const {  // dt NaN: no time
     const py::object exc = error_;
     const bool plain = PyObject_IsInstance(exc.ptr(), PyExc_Exception) == 1;
     const double t = static_cast<double>(failed_sample_) * dt;
     std::string msg;
     if (plain) {  // every Python call before the error indicator is set
       const std::string text = py::str(exc).cast<std::string>();
-      msg = who + "." + method_ + "() raised at sample " + std::to_string(failed_sample_) + " (t = " +
-            py::str(py::float_(t)).cast<std::string>() + " s): " +
+      const std::string when = std::isfinite(t) ? " (t = " + py::str(py::float_(t)).cast<std::string>() + " s)" : "";
+      msg = who + "." + method_ + "() raised at sample " + std::to_string(failed_sample_) + when + ": " +
             py::str(py::type::handle_of(exc).attr("__name__")).cast<std::string>() +
             (text.empty() ? "" : ": " + text);
     }
@@ -203,7 +203,8 @@ class PythonTrackingController final : public rths::TrackingController, public P
   py::object obj_, reset_, command_;
 };
 
-//! After a run (GIL held): re-raises what a Python controller raised during it, if anything.
+//! After a run (GIL held): re-raises what a Python controller raised during it, if anything
+//! (dt: the loop's sample time [s]; NaN outside a loop: the message then gives no time).
 inline void raise_controller_error(const rths::TrackingController& c, double dt) {
   py::object self;
   const PythonControllerCalls* calls = nullptr;

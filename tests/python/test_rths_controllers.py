@@ -304,3 +304,15 @@ def test_subclass_command_is_found_as_python_finds_it_and_the_object_is_freed(sh
     del sub
     gc.collect()
     assert probe() is None and inner is not None
+
+
+def test_calls_from_python_raise_at_once():
+    """Called from Python (not by a loop), a Python controller's error is raised at once,
+    and a TrackingController without overrides says what it lacks."""
+    wrapped = rths.PythonController(Failing(1, ValueError("second call")))
+    assert wrapped.command(1e-3) == 0.0
+    with pytest.raises(RuntimeError, match=r"^Failing\.command\(\) raised at sample 1: ValueError: second call$"):
+        wrapped.command(1e-3)
+    with pytest.raises(RuntimeError, match=r"TrackingController\.reset\(\) raised at sample 0: TypeError: a "
+                                           r"TrackingController subclass must define reset\(\)"):
+        rths.TrackingController().reset()
