@@ -266,13 +266,17 @@ def test_cli_controller_errors_exit_2_naming_the_value(tmp_path, monkeypatch, ca
                 return 0.0
         thing = 3
     ''', "my_ctrl_bad")
+    _module(tmp_path, "import not_installed_xyz\n", "my_ctrl_dep")
     cases = {"no_such_module_xyz:C": "module 'no_such_module_xyz' not found on PYTHONPATH",
              "my_ctrl_bad:Missing": "module 'my_ctrl_bad' (",
              "my_ctrl_bad:NotOne": "not a tracking controller, it lacks command()",
              "my_ctrl_bad:Broken": "Broken() raised RuntimeError: no rig file",
              "my_ctrl_bad:thing": "my_ctrl_bad.thing is a int, not a class",
              "pid": "expected one of ['ats', 'model', 'polynomial', 'sample'] or 'module:Class'",
-             "my_ctrl_bad:": "expected a built-in name"}
+             "my_ctrl_bad:": "expected a built-in name",
+             "my_ctrl_dep:C": "importing module 'my_ctrl_dep' failed: ModuleNotFoundError: No module named "
+                              "'not_installed_xyz'",
+             "no_such_pkg_xyz.sub:C": "module 'no_such_pkg_xyz.sub' not found on PYTHONPATH"}
     for spec, text in cases.items():
         assert main(["rths-benchmark", "--cases", "1", "--controller", spec, "--quiet",
                      "--out", str(tmp_path / "o")]) == 2, spec

@@ -137,7 +137,7 @@ def load_controller(spec: str):
     try:
         module = importlib.import_module(module_name)
     except ModuleNotFoundError as e:
-        if e.name is not None and module_name.startswith(e.name):
+        if e.name == module_name or module_name.startswith(f"{e.name}."):  # not a module it imports
             raise ValueError(f"invalid controller = {spec!r}: module {module_name!r} not found on PYTHONPATH") from e
         raise ValueError(f"invalid controller = {spec!r}: importing module {module_name!r} failed: "
                          f"{type(e).__name__}: {e}") from e
