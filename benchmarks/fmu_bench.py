@@ -141,11 +141,11 @@ def equality(rig, work: Path, n: int) -> dict[str, float]:
     ref = sh.run_eft(rig, ag, dt=DT)
     got = cosimulate(sh.export_fmu(rig, work / "eq_pf.fmu", mode="force"),
                      sh.export_fmu(rig, work / "eq_eft.fmu", kind="eft"), ag)
-    out["eft"] = max(rel(got[c], ref.channels[c]) for c in got if c != "time")
+    out["eft"] = max(rel(got.channels[c], ref.channels[c]) for c in got.channels if c != "time")
     ref = sh.run_rpsd(rig, ag, dt=DT, physical_mass_fraction=0.02)
     got = cosimulate(sh.export_fmu(ref.rig, work / "eq_pd.fmu"),
                      sh.export_fmu(ref.rig, work / "eq_rpsd.fmu", kind="rpsd"), ag)
-    out["rpsd"] = max(rel(got[c], ref.channels[c]) for c in got if c != "time")
+    out["rpsd"] = max(rel(got.channels[c], ref.channels[c]) for c in got.channels if c != "time")
     return out
 
 

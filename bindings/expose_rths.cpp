@@ -11,6 +11,7 @@
 #include <pybind11/stl.h>
 
 #include "busy.hpp"
+#include "tracking_trampoline.hpp"
 #include "servohydraulics/rths/loop.hpp"
 
 namespace py = pybind11;
@@ -116,6 +117,7 @@ py::dict run_loop(RthsLoop& loop, const NumericalSubstructure& num, const Ground
     loop.reset();
     s = loop.run(ag, n, rec);
   }
+  bindings::raise_controller_error(loop.controller(), loop.config().dt);
   if (const auto* p = dynamic_cast<const PythonSubstructure*>(&num); p && !p->error().empty())
     throw std::runtime_error("numerical substructure failed at t = " + std::to_string(s.failure_time) +
                              " s: " + p->error());
@@ -276,12 +278,33 @@ void expose_rths(py::module_& m) {
       .def(py::init([](double d, double dv, double da, double xm, double fm) { return TrackingInput{d, dv, da, xm, fm}; }),
            py::arg("desired"), py::arg("desired_velocity") = 0.0, py::arg("desired_acceleration") = 0.0,
            py::arg("measured") = 0.0, py::arg("measured_force") = 0.0);
-  py::class_<TrackingController>(r, "TrackingController")
-      .def("reset", [](TrackingController& c) { bindings::require_idle(&c, "TrackingController.reset"); c.reset(); })
+  // Python controllers (tracking_trampoline.hpp): subclass TrackingController, or wrap any object.
+  py::class_<TrackingController, bindings::PyTrackingController>(r, "TrackingController")
+      .def(py::init<>())
+      .def("reset", [](TrackingController& c) {
+        bindings::require_idle(&c, "TrackingController.reset");
+        c.reset();
+        bindings::raise_controller_error(c, std::nan(""));
+      })
+      .def("command", [](TrackingController& c, double d, double dv, double da, double xm, double fm) {
+        bindings::require_idle(&c, "TrackingController.command");
+        const double u = c.command(TrackingInput{d, dv, da, xm, fm});
+        bindings::raise_controller_error(c, std::nan(""));
+        return u;
+      }, py::arg("desired"), py::arg("desired_velocity") = 0.0, py::arg("desired_acceleration") = 0.0,
+         py::arg("measured") = 0.0, py::arg("measured_force") = 0.0,
+         "The command [m] from the desired displacement [m], velocity [m/s] and acceleration [m/s^2] and the "
+         "measured displacement [m] and force [N].")
       .def("command", [](TrackingController& c, const TrackingInput& in) {
         bindings::require_idle(&c, "TrackingController.command");
-        return c.command(in);
+        const double u = c.command(in);
+        bindings::raise_controller_error(c, std::nan(""));
+        return u;
       }, py::arg("input"));
+  py::class_<bindings::PythonTrackingController, TrackingController>(
+      r, "PythonController", "any object with reset() and command(...) as a tracking controller")
+      .def(py::init<py::object>(), py::arg("controller"))
+      .def_property_readonly("controller", &bindings::PythonTrackingController::object);
   py::class_<SampleControllerConfig> sc(r, "SampleControllerConfig");
   sc.def(py::init<>()).def_readwrite("lead_b1", &SampleControllerConfig::lead_b1)
       .def_readwrite("lead_b0", &SampleControllerConfig::lead_b0)

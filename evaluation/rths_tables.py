@@ -20,6 +20,7 @@ from pathlib import Path
 
 from servohydraulics.atomic import FileSet
 from servohydraulics.rths.benchmark import CONTROLLERS
+from servohydraulics.rths.evaluation import J_NAMES
 from servohydraulics.rths.report import j_table, run_benchmark
 
 RECORDS = (("elcentro", "El Centro"), ("kobe", "Kobe"), ("morganhill", "Morgan Hill"))
@@ -44,7 +45,7 @@ def section(data: str, record: str, title: str, perturbed: int, seed: int, worke
 
 
 def chirp(data: str, seed: int) -> list[str]:
-    head = "| Controller | Case | " + " | ".join(f"J{i}" for i in range(1, 10)) + " | max f [kN] | PSI |"
+    head = "| Controller | Case | " + " | ".join(J_NAMES) + " | max f [kN] | PSI |"
     lines = ["## Chirp × 0.4 (nominal plant)", "",
              f"`servohydraulics rths-benchmark --data {data} --record chirp --controller NAME --seed {seed} --out OUT`",
              "", head, "|" + " --- |" * 13]

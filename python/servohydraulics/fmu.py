@@ -30,7 +30,8 @@ import numpy as np
 
 from . import _core
 from .loops import eft_config, rpsd_config
-from .rig import Rig, rig_to_dict
+from .response import Response
+from .rig import Rig, load_rig, rig_to_dict
 from .simulate import MODES
 
 KINDS = _core.FMU_KINDS  #: ("plant", "eft", "rpsd"), the FMU model's table (cpp/fmu/model.hpp)
@@ -290,6 +291,10 @@ class _Slave:
         self.fmu.enterInitializationMode()
         self.fmu.exitInitializationMode()
         self.dt = float(self.md.defaultExperiment.stepSize)
+        from .rig import tomllib  # the standard library's, or tomli before Python 3.11
+
+        with open(os.path.join(self.dir, "resources", "fmu.toml"), "rb") as f:
+            self.settings = tomllib.load(f)  # kind, mode, ... (written by export_fmu)
 
     def refs(self, names):
         return [self.vr[n] for n in names]
@@ -300,7 +305,7 @@ class _Slave:
 
 
 def cosimulate(plant, controller, ground_acceleration, external_force=None, restoring_force_error=None,
-               progress: bool = False) -> dict[str, np.ndarray]:
+               progress: bool = False) -> Response:
     """A plant FMU and a controller FMU in closed loop, through fmpy, at the controller rate.
 
     The co-simulation master of docs/fmu.md (Gauss-Seidel): at each t_k the plant's
@@ -311,7 +316,11 @@ def cosimulate(plant, controller, ground_acceleration, external_force=None, rest
     ``sh.run_rpsd`` on the same inputs.  Needs fmpy.
 
     Returns:
-        Arrays by name: ``time``, the plant's channels, the controller's outputs.
+        A :class:`~servohydraulics.response.Response` of ``kind`` ``"eft"`` or ``"rpsd"`` (the
+        controller FMU's), its ``mode`` (force or displacement), ``dt`` and ``rig`` (the plant
+        FMU's, read back from its resources): channels ``time``, the plant's outputs and the
+        controller's outputs, with the units of the library's channel tables.  ValueError if
+        ``controller`` is not a controller FMU or ``plant`` is not a plant FMU.
     """
     from tqdm import tqdm
 
@@ -321,6 +330,12 @@ def cosimulate(plant, controller, ground_acceleration, external_force=None, rest
     with tempfile.TemporaryDirectory(prefix="sh_cosim_") as work:
         p, c = _Slave(plant, work, "plant"), _Slave(controller, work, "controller")
         try:
+            for slave, role, kinds in ((p, "plant", ("plant",)), (c, "controller", CONTROLLER_MODES)):
+                if slave.settings.get("kind") not in kinds:
+                    raise ValueError(f"invalid {role} = {str(plant if role == 'plant' else controller)!r}: an FMU of "
+                                     f"kind {slave.settings.get('kind')!r}, expected {' or '.join(map(repr, kinds))}")
+            kind = c.settings["kind"]
+            rig = load_rig(os.path.join(p.dir, "resources", "rig.toml"))
             if not math.isclose(p.dt, c.dt, rel_tol=1e-12):
                 raise ValueError(f"the plant's dt = {p.dt} s differs from the controller's dt = {c.dt} s")
             sensors = c.refs(f"sensors.{n}" for n in p.outputs)
@@ -342,9 +357,9 @@ def cosimulate(plant, controller, ground_acceleration, external_force=None, rest
         finally:
             p.close()
             c.close()
-    result = {"time": np.arange(ag.size) * p.dt}
-    result.update({n: rows[:, i] for i, n in enumerate(p.outputs + c.outputs)})
-    return result
+    channels = {"time": np.arange(ag.size) * p.dt}
+    channels.update({n: rows[:, i] for i, n in enumerate(p.outputs + c.outputs)})
+    return Response(channels, kind=kind, mode=CONTROLLER_MODES[kind], dt=p.dt, rig=rig)
 
 
 __all__ = ["BINARY", "KINDS", "binary_path", "cosimulate", "export_fmu", "model_description"]

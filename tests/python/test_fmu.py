@@ -232,10 +232,21 @@ def test_eft_fmu_with_plant_fmu_equals_run_eft(rig, fmus):
     n = 800
     ag = 3.0 * np.sin(2 * np.pi * 1.5 * np.arange(n) * DT)
     ref = sh.run_eft(rig, ag, dt=DT)
-    rows = cosimulate(fmus["plant_force"], fmus["eft"], ag)
+    res = cosimulate(fmus["plant_force"], fmus["eft"], ag)
     outputs = ["effective_force", "compensation", "compensation_opening", "command"]
-    assert set(rows) == {"time", *PLANT_OUT, *outputs}
-    _equal(rows, ref, PLANT_OUT + outputs)
+    assert set(res.channels) == {"time", *PLANT_OUT, *outputs}
+    _equal(res.channels, ref, PLANT_OUT + outputs)
+    _same_response(res, ref, outputs)
+
+
+def _same_response(res, ref, outputs):
+    """cosimulate's Response carries what the library's does: kind, mode, dt, units, the rig."""
+    assert isinstance(res, sh.Response) and res.success and res.status == "ok"
+    assert (res.kind, res.mode, res.dt, len(res)) == (ref.kind, ref.mode, ref.dt, len(ref))
+    np.testing.assert_array_equal(res.time, ref.time)
+    assert {n: res.units[n] for n in PLANT_OUT + outputs} == {n: ref.units[n] for n in PLANT_OUT + outputs}
+    assert sh.rig_to_dict(res.rig) == sh.rig_to_dict(ref.rig)
+    assert list(res.to_pandas().columns) == list(res.channels)
 
 
 def test_rpsd_fmu_with_plant_fmu_equals_run_rpsd(rig, tmp_path):
@@ -247,11 +258,17 @@ def test_rpsd_fmu_with_plant_fmu_equals_run_rpsd(rig, tmp_path):
     phys = ref.rig  # the physical rig of the simulated test
     plant = sh.export_fmu(phys, tmp_path / "p.fmu")
     ctrl = sh.export_fmu(phys, tmp_path / "r.fmu", kind="rpsd", **kw)
-    rows = cosimulate(plant, ctrl, ag, external_force=pe)
+    res = cosimulate(plant, ctrl, ag, external_force=pe)
     outputs = ["measured_restoring_force", "restoring_force", "calc_displacement", "calc_velocity",
                "calc_acceleration", "target_displacement", "command"]
-    assert set(rows) == {"time", *PLANT_OUT, *outputs}
-    _equal(rows, ref, PLANT_OUT + outputs)
+    assert set(res.channels) == {"time", *PLANT_OUT, *outputs}
+    _equal(res.channels, ref, PLANT_OUT + outputs)
+    _same_response(res, ref, outputs)
+    with pytest.raises(ValueError, match=r"invalid controller = .*p\.fmu': an FMU of kind 'plant', expected 'eft' or "
+                                         r"'rpsd'"):
+        cosimulate(plant, plant, ag[:10])
+    with pytest.raises(ValueError, match=r"invalid plant = .*r\.fmu': an FMU of kind 'rpsd', expected 'plant'"):
+        cosimulate(ctrl, ctrl, ag[:10])
 
 
 def test_output_reads_do_not_advance_the_controller(rig, fmus, tmp_path):

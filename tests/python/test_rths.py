@@ -183,7 +183,10 @@ def test_cli_embedded_default_is_labelled(tmp_path, capsys):
     assert main(["rths-benchmark", "--cases", "1", "--controller", "model", "--quiet", "--out", str(tmp_path)]) == 0
     res = json.loads((tmp_path / "results.json").read_text())
     nom = res["cases"]["1"]["nominal"]
-    assert set(nom) == {"J", "max_force_N", "max_displacement_m", "PSI"} and len(nom["J"]) == 9
+    assert set(nom) == {"J", "criteria", "max_force_N", "max_displacement_m", "PSI"} and len(nom["J"]) == 9
+    assert list(nom["criteria"]) == list(rths.J_NAMES) == res["meta"]["J_names"]  # the J list, by name
+    assert list(nom["criteria"].values()) == nom["J"] and "J1_delay_ms" in rths.J_NAMES
+    assert "| J1_delay_ms | J2_rms_tracking_error_pct |" in (tmp_path / "report.md").read_text()
     assert res["meta"]["synthetic"] is True
     assert "NOT the benchmark" in (tmp_path / "report.md").read_text()
     assert (tmp_path / "tracking.png").is_file() and (tmp_path / "criteria.png").is_file()

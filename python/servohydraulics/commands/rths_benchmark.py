@@ -23,6 +23,7 @@ def _run(args) -> int:
 
 
 def register(sub) -> None:
+    from ..rths.benchmark import CONTROLLERS
     p = sub.add_parser("rths-benchmark", help="the RTHS benchmark (Silva et al. 2020): J1-J9 and PSI per case")
     p.add_argument("--data", default=None,
                    help="folder with the official files ('RTHS code RT V23/' layout or a flat folder of "
@@ -30,8 +31,12 @@ def register(sub) -> None:
     p.add_argument("--record", default="elcentro", help="elcentro | kobe | morganhill | chirp (default: elcentro; chirp: the benchmark's 0.1-40 Hz "
                         "verification sweep, generated)")
     p.add_argument("--cases", default="1,2,3,4", help="comma-separated cases (default: 1,2,3,4)")
-    p.add_argument("--controller", default="sample", choices=["sample", "polynomial", "ats", "model"],
-                   help="tracking controller (default: the benchmark's sample controller)")
+    p.add_argument("--controller", default="sample", metavar="NAME | module:Class",
+                   help="tracking controller: a built-in (" + ", ".join(CONTROLLERS) + "; default: the benchmark's "
+                        "sample controller) or your own as module:Class, the module imported from PYTHONPATH and the "
+                        "class built with no arguments, with reset() and command(desired, desired_velocity, "
+                        "desired_acceleration, measured, measured_force) -> command [m] "
+                        "(docs/rths-benchmark.md, 'Bring your own controller')")
     p.add_argument("--perturbed", type=int, default=0, help="perturbed plants per case (default: 0)")
     p.add_argument("--seed", type=int, default=0, help="seed of the noise and of the perturbations (default: 0; with "
                         "--noise simulink, seed 0 is the official run's noise realisation)")

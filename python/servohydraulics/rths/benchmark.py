@@ -13,13 +13,13 @@ import numpy as np
 
 from .. import _core
 from .data import DT, EQ_INTENSITY, BenchmarkCase, Record
-from .evaluation import evaluate, psi, reference_response
+from .evaluation import J_NAMES, criteria, evaluate, psi, reference_response
 
 R = _core.rths
 
-__all__ = ["CONTROLLERS", "make_controller", "nominal_plant", "perturbed_plant", "partition", "Trial",
-           "run_trial", "run_case", "trial_seed", "FORCE_LIMIT", "NOISE_GENERATORS", "noise_generator",
-           "polynomial_controller"]
+__all__ = ["CONTROLLERS", "make_controller", "load_controller", "as_controller", "controller_label",
+           "nominal_plant", "perturbed_plant", "partition", "Trial", "run_trial", "run_case", "trial_seed",
+           "FORCE_LIMIT", "NOISE_GENERATORS", "noise_generator", "polynomial_controller"]
 
 FORCE_LIMIT = 8900.0  #: the benchmark's actuator capacity check on max|f| [N] (F4_evaluation.m L60-62)
 STROKE_LIMIT = 7e-3   #: paper limit (not checked by the code) [m]
@@ -108,12 +108,82 @@ CONTROLLERS: dict[str, tuple[Callable, str]] = {
 }
 
 
-def make_controller(name: str, dt: float = DT):
-    """A tracking controller by name, designed on the NOMINAL plant (the
-    designer does not know the perturbed plant)."""
+def make_controller(name: str, dt: float = DT, plant=None):
+    """A tracking controller object: a built-in by name (``sample``, ``polynomial``, ``ats``,
+    ``model``), designed on ``plant`` (None: the NOMINAL plant; the designer does not know the
+    perturbed plant), or a user's class as ``"module:Class"``, imported from PYTHONPATH and
+    built with no arguments (:func:`load_controller`).  The built-ins are
+    ``rths.core.TrackingController`` objects with ``reset()`` and
+    ``command(desired, desired_velocity, desired_acceleration, measured, measured_force)``, the
+    interface a user's controller implements (docs/rths-benchmark.md, "Bring your own controller")."""
+    if isinstance(name, str) and ":" in name:
+        return load_controller(name)
     if name not in CONTROLLERS:
-        raise ValueError(f"invalid controller = {name!r}: expected one of {sorted(CONTROLLERS)}")
-    return CONTROLLERS[name][0](nominal_plant(), dt)
+        raise ValueError(f"invalid controller = {name!r}: expected one of {sorted(CONTROLLERS)} or 'module:Class'")
+    return CONTROLLERS[name][0](plant if plant is not None else nominal_plant(), dt)
+
+
+def load_controller(spec: str):
+    """``"module:Class"``: the module imported from PYTHONPATH, the class built with no
+    arguments, checked to be a tracking controller.  Every failure is a ValueError naming
+    ``spec`` and what failed (module not found, class not found, constructor failure, not a
+    controller)."""
+    import importlib
+
+    module_name, _, class_name = spec.partition(":")
+    if not module_name or not class_name or ":" in class_name:
+        raise ValueError(f"invalid controller = {spec!r}: expected a built-in name {sorted(CONTROLLERS)} "
+                         "or 'module:Class'")
+    try:
+        module = importlib.import_module(module_name)
+    except ModuleNotFoundError as e:
+        if e.name == module_name or module_name.startswith(f"{e.name}."):  # not a module it imports
+            raise ValueError(f"invalid controller = {spec!r}: module {module_name!r} not found on PYTHONPATH") from e
+        raise ValueError(f"invalid controller = {spec!r}: importing module {module_name!r} failed: "
+                         f"{type(e).__name__}: {e}") from e
+    except Exception as e:  # noqa: BLE001 - a user's module: any failure is reported with its type
+        raise ValueError(f"invalid controller = {spec!r}: importing module {module_name!r} failed: "
+                         f"{type(e).__name__}: {e}") from e
+    cls = getattr(module, class_name, None)
+    if cls is None:
+        raise ValueError(f"invalid controller = {spec!r}: module {module_name!r} ({getattr(module, '__file__', '?')}) "
+                         f"has no class {class_name!r}")
+    if not callable(cls):
+        raise ValueError(f"invalid controller = {spec!r}: {module_name}.{class_name} is a "
+                         f"{type(cls).__name__}, not a class")
+    try:
+        obj = cls()
+    except Exception as e:  # noqa: BLE001 - a user's constructor: any failure is reported with its type
+        raise ValueError(f"invalid controller = {spec!r}: {class_name}() raised {type(e).__name__}: {e}") from e
+    try:
+        return as_controller(obj)
+    except TypeError as e:
+        raise ValueError(f"invalid controller = {spec!r}: {e}") from e
+
+
+def as_controller(controller):
+    """The loop's controller for ``controller``: a built-in name or ``"module:Class"``
+    (:func:`make_controller`), a ``rths.core.TrackingController`` (a built-in, or a Python
+    subclass) as it is, or any object with ``reset()`` and ``command(...)`` wrapped in
+    ``rths.core.PythonController`` (TypeError if it lacks either)."""
+    if isinstance(controller, str):
+        return make_controller(controller)
+    if isinstance(controller, R.TrackingController):
+        return controller
+    return R.PythonController(controller)
+
+
+def controller_label(controller) -> tuple[str, str]:
+    """(name, description) of a controller for reports: a built-in's name and citation, or the
+    ``module:Class`` of a user's controller (a spec is built once, so a bad one raises the
+    ValueError of :func:`load_controller`) and the first line of its class's docstring."""
+    if isinstance(controller, str) and controller in CONTROLLERS:
+        return controller, CONTROLLERS[controller][1]
+    obj = make_controller(controller) if isinstance(controller, str) else controller
+    cls = type(obj.controller if isinstance(obj, R.PythonController) else obj)
+    spec = controller if isinstance(controller, str) else f"{cls.__module__}:{cls.__qualname__}"
+    doc = (cls.__doc__ or "").strip().splitlines()
+    return spec, (doc[0].strip() if doc else "user controller")
 
 
 # ----------------------------------------------------------------------------- one trial
@@ -131,8 +201,22 @@ class Trial:
     signals: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
+    def criteria(self) -> dict[str, float]:
+        """J1-J9 by name (``J1_delay_ms``, ``J2_rms_tracking_error_pct``, ...: ``rths.J_NAMES``)."""
+        return criteria(self.J)
+
+    @property
     def capacity_exceeded(self) -> bool:
         return self.max_force_N >= FORCE_LIMIT
+
+    def to_pandas(self):
+        """One row: the criteria by name, the peaks and limits, ``ok``, ``stable``, ``wall_time``."""
+        import pandas as pd
+
+        row = {**self.criteria, "max_force_N": self.max_force_N, "max_displacement_m": self.max_displacement_m,
+               "max_velocity_m_per_s": self.max_velocity_m_per_s, "capacity_exceeded": self.capacity_exceeded,
+               "ok": self.ok, "stable": self.stable, "failure_time": self.failure_time, "wall_time": self.wall_time}
+        return pd.DataFrame([row])
 
     @property
     def stable(self) -> bool:
@@ -160,13 +244,18 @@ def noise_generator(noise: str) -> "R.NoiseGenerator":
     raise ValueError(f"invalid noise = {noise!r}: expected one of {list(NOISE_GENERATORS)}")
 
 
-def run_trial(case: BenchmarkCase, record: Record, controller: str = "sample", plant=None, seed: int = 0,
+def run_trial(case: BenchmarkCase, record: Record, controller: Any = "sample", plant=None, seed: int = 0,
               scale: float = EQ_INTENSITY, scheme: str = "RungeKutta4", reference: np.ndarray | None = None,
               keep_signals: bool = False, timing: bool = False, experimental=None, numerical=None,
               noise: str = "simulink") -> Trial:
     """One vRTHS run on the 4096 Hz grid of the record, then J1-J9.
 
     Args:
+        controller: a built-in name or ``"module:Class"`` (:func:`make_controller`; a new
+            controller per trial), or a controller object: a ``rths.core.TrackingController``
+            or any object with ``reset()`` and ``command(...)`` (docs/rths-benchmark.md, "Bring
+            your own controller"); the loop resets it first.  What a Python controller raises
+            stops the run and is re-raised as a RuntimeError naming the sample and time.
         plant: BenchmarkPlantParameters of the control plant (None: nominal).
         seed: of the sensor noise (one sequence shared by both channels).
         noise: the noise generator: ``"simulink"`` (default), the algorithm of Simulink's
@@ -185,7 +274,7 @@ def run_trial(case: BenchmarkCase, record: Record, controller: str = "sample", p
     plant = plant if plant is not None else nominal_plant()
     exp = experimental if experimental is not None else R.BenchmarkPlant(plant, DT)
     num = _numerical(numerical, case, exp, scheme)
-    ctrl = make_controller(controller)
+    ctrl = as_controller(controller)
     cfg = R.RthsLoopConfig()
     cfg.seed = int(seed) & (2**64 - 1)
     cfg.generator = noise_generator(noise)
@@ -244,32 +333,40 @@ def case_psi(case: BenchmarkCase) -> float:
     return psi(case.M, case.C, case.K, sp.m, sp.c, sp.k)
 
 
-def _perturbed_job(rig, trial: int, case: BenchmarkCase, record: Record, controller: str, seed: int,
+def _perturbed_job(rig, trial: int, case: BenchmarkCase, record: Record, controller: Any, seed: int,
                    scale: float, csi_derivative_block: bool = False, noise: str = "simulink") -> dict[str, Any]:
     """One perturbed trial in a sweep worker (the rig argument of sh.sweep is unused)."""
     plant = perturbed_plant(seed, case.number, trial, csi_derivative_block)
     t = run_trial(case, record, controller, plant=plant, seed=seed, scale=scale,
                   reference=case_reference(case, record, scale), noise=noise)
-    out = {f"J{i + 1}": t.J[i] for i in range(9)}
+    out = t.criteria
     out.update(ok=t.ok, stable=t.stable, max_force_N=t.max_force_N, max_displacement_m=t.max_displacement_m,
                max_velocity_m_per_s=t.max_velocity_m_per_s, wall_time=t.wall_time,
                k_e=plant.k_e, beta1=plant.beta1, beta2=plant.beta2, a3=plant.a3)
     return out
 
 
-def run_case(case: BenchmarkCase, record: Record, controller: str = "sample", perturbed: int = 0, seed: int = 0,
+def run_case(case: BenchmarkCase, record: Record, controller: Any = "sample", perturbed: int = 0, seed: int = 0,
              scale: float = EQ_INTENSITY, executor=None, max_workers: int | None = None,
              progress: bool = True, keep_signals: bool = False,
              csi_derivative_block: bool = False, noise: str = "simulink") -> dict[str, Any]:
     """The nominal trial and ``perturbed`` perturbed trials (through ``sh.sweep``) of one case.
 
-    Returns ``{"nominal": {...}, "perturbed": {...} (if any), "trial": Trial, "table": DataFrame | None}``.
+    ``controller``: a built-in name or ``"module:Class"`` (each trial builds its own, in the
+    worker processes), or a controller object (:func:`run_trial`): the perturbed trials then
+    run one after another in this process (a thread pool of one), unless ``executor`` is given.
+
+    Returns ``{"nominal": {...}, "perturbed": {...} (if any), "trial": Trial, "table": DataFrame | None}``;
+    the criteria by name (``J1_delay_ms``, ...: ``rths.J_NAMES``) in ``nominal["criteria"]``,
+    ``perturbed["criteria_mean"]``/``["criteria_std"]`` and the table's columns.
     """
     noise_generator(noise)  # validates the name before any run
+    if not isinstance(controller, str):
+        as_controller(controller)  # TypeError now, not in a worker, if it is not a controller
     ref = case_reference(case, record, scale)
     nom = run_trial(case, record, controller, plant=nominal_plant(csi_derivative_block), seed=seed, scale=scale,
                     reference=ref, keep_signals=keep_signals, noise=noise)
-    res: dict[str, Any] = {"nominal": {"J": nom.J, "max_force_N": nom.max_force_N,
+    res: dict[str, Any] = {"nominal": {"J": nom.J, "criteria": nom.criteria, "max_force_N": nom.max_force_N,
                                        "max_displacement_m": nom.max_displacement_m,
                                        "max_velocity_m_per_s": nom.max_velocity_m_per_s,
                                        "capacity_exceeded": nom.capacity_exceeded, "ok": nom.ok,
@@ -277,16 +374,28 @@ def run_case(case: BenchmarkCase, record: Record, controller: str = "sample", pe
                            "trial": nom, "table": None}
     if perturbed > 0:
         from ..parameter_sweep import sweep
-        df = sweep(grid={"trial": list(range(1, perturbed + 1))}, run=_perturbed_job,
-                   fixed={"case": case, "record": record, "controller": controller, "seed": seed, "scale": scale,
-                          "csi_derivative_block": bool(csi_derivative_block), "noise": noise},
-                   executor=executor, max_workers=max_workers, progress=progress)
+        own = None
+        if executor is None and not isinstance(controller, str):
+            from concurrent.futures import ThreadPoolExecutor
+            executor = own = ThreadPoolExecutor(max_workers=1)
+        try:
+            df = sweep(grid={"trial": list(range(1, perturbed + 1))}, run=_perturbed_job,
+                       fixed={"case": case, "record": record, "controller": controller, "seed": seed, "scale": scale,
+                              "csi_derivative_block": bool(csi_derivative_block), "noise": noise},
+                       executor=executor, max_workers=max_workers, progress=progress)
+        finally:
+            if own is not None:
+                own.shutdown(wait=True)
         df = df.drop(columns=["case", "record", "csi_derivative_block", "noise"])
+        if not isinstance(controller, str):
+            df["controller"] = controller_label(controller)[0]  # its name, not the object
         if "error" in df.columns and df["error"].notna().any():
             raise RuntimeError(f"perturbed trial failed: {df['error'].dropna().iloc[0]}")
-        Js = df[[f"J{i + 1}" for i in range(9)]].to_numpy(dtype=float)
-        res["perturbed"] = {"J_mean": [float(v) for v in np.mean(Js, axis=0)],
-                            "J_std": [float(v) for v in np.std(Js, axis=0, ddof=1)] if perturbed > 1 else [0.0] * 9,
+        Js = df[list(J_NAMES)].to_numpy(dtype=float)
+        mean = [float(v) for v in np.mean(Js, axis=0)]
+        std = [float(v) for v in np.std(Js, axis=0, ddof=1)] if perturbed > 1 else [0.0] * 9
+        res["perturbed"] = {"J_mean": mean, "J_std": std, "criteria_mean": criteria(mean),
+                            "criteria_std": criteria(std),
                             "runs": int(perturbed), "ran_to_end": int(df["ok"].sum()),
                             "stable": int(df["stable"].sum()),
                             "capacity_exceeded": int((df["max_force_N"] >= FORCE_LIMIT).sum())}

@@ -7,14 +7,30 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import linalg, signal
 
-__all__ = ["J_NAMES", "evaluate", "reference_response", "critical_delay", "psi", "matlab_round"]
+__all__ = ["J_NAMES", "J_LABELS", "criteria", "evaluate", "reference_response", "critical_delay", "psi",
+           "matlab_round"]
 
-#: The criteria in the code's (and Table 3's) order.
-J_NAMES = ("J1 delay [ms]", "J2 RMS tracking [%]", "J3 peak tracking [%]", "J4 RMS floor 1 [%]",
-           "J5 peak floor 1 [%]", "J6 RMS floor 2 [%]", "J7 RMS floor 3 [%]", "J8 peak floor 2 [%]",
-           "J9 peak floor 3 [%]")
+#: The criteria's names in the code's (and Table 3's) order, meaning and unit as BENCHMARK.md 8.1
+#: reads F4_evaluation.m: J1 the tracking delay [ms]; J2/J3 the RMS (std) / peak tracking error of
+#: X_m against y_n(1); J4/J5 of X_m against the reference's 1st floor; J6/J7 the RMS errors of the
+#: 2nd/3rd floors; J8/J9 their peak errors, all in percent of the compared signal's std or peak.
+#: (The code numbers J5-J7 differently from the paper's text: code J5 = paper J7, J6 = J5, J7 = J6.)
+J_NAMES = ("J1_delay_ms", "J2_rms_tracking_error_pct", "J3_peak_tracking_error_pct", "J4_rms_error_floor1_pct",
+           "J5_peak_error_floor1_pct", "J6_rms_error_floor2_pct", "J7_rms_error_floor3_pct",
+           "J8_peak_error_floor2_pct", "J9_peak_error_floor3_pct")
+#: The same criteria as table labels.
+J_LABELS = ("J1 delay [ms]", "J2 RMS tracking [%]", "J3 peak tracking [%]", "J4 RMS floor 1 [%]",
+            "J5 peak floor 1 [%]", "J6 RMS floor 2 [%]", "J7 RMS floor 3 [%]", "J8 peak floor 2 [%]",
+            "J9 peak floor 3 [%]")
+
+
+def criteria(J) -> dict[str, float]:
+    """J1-J9 (a sequence in the code's order) by name (``J_NAMES``)."""
+    values = [float(v) for v in J]
+    if len(values) != len(J_NAMES):
+        raise ValueError(f"invalid J: {len(values)} values, expected {len(J_NAMES)} (J1-J9)")
+    return dict(zip(J_NAMES, values))
 
 
 def matlab_round(x: float) -> float:
@@ -76,6 +92,8 @@ def reference_response(M: np.ndarray, C: np.ndarray, K: np.ndarray, ag: np.ndarr
     """Displacements [m] (N x n) of M x'' + C x' + K x = -M iota a_g from rest, a_g
     sampled every dt and varying linearly in between (first-order hold, as
     ``lsim``), by the exact FOH recurrence in modal coordinates."""
+    from scipy import linalg, signal  # here: importing the benchmark (e.g. the CLI's parser) loads no SciPy
+
     n = M.shape[0]
     MiK, MiC = np.linalg.solve(M, K), np.linalg.solve(M, C)
     A = np.block([[np.zeros((n, n)), np.eye(n)], [-MiK, -MiC]])

@@ -13,9 +13,9 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..atomic import FileSet
-from .benchmark import CONTROLLERS, FORCE_LIMIT, noise_generator, run_case
+from .benchmark import FORCE_LIMIT, controller_label, noise_generator, run_case
 from .data import EQ_INTENSITY, embedded_case, load_case, load_record, synthetic_record
-from .evaluation import J_NAMES
+from .evaluation import J_LABELS, J_NAMES
 
 __all__ = ["run_benchmark", "write_outputs", "j_table"]
 
@@ -37,12 +37,14 @@ def parse_cases(text: str | Sequence[int]) -> list[int]:
 
 
 def run_benchmark(data: str | Path | None = None, record: str = "elcentro", cases: str | Sequence[int] = "1,2,3,4",
-                  controller: str = "sample", perturbed: int = 0, seed: int = 0, scale: float = EQ_INTENSITY,
+                  controller: Any = "sample", perturbed: int = 0, seed: int = 0, scale: float = EQ_INTENSITY,
                   workers: int | None = None, progress: bool = True, csi: str = "exact",
                   noise: str = "simulink") -> dict[str, Any]:
     """Runs the benchmark: per case the nominal trial (signals kept) and
     ``perturbed`` perturbed trials (through ``sh.sweep`` on one process pool).
 
+    ``controller``: a built-in name, ``"module:Class"`` (imported from PYTHONPATH, built with
+    no arguments) or a controller object (``rths.run_case``).
     ``csi``: ``"exact"`` (a2 x', the spec's default) or ``"derivative-block"`` (the code's
     Simulink Derivative block, BENCHMARK.md 2.1).
     ``noise``: ``"simulink"`` (the official SENSORS subsystem's generator; seed 0 is the
@@ -55,8 +57,7 @@ def run_benchmark(data: str | Path | None = None, record: str = "elcentro", case
     noise_generator(noise)
     if csi not in ("exact", "derivative-block"):
         raise ValueError(f"invalid csi = {csi!r}: expected 'exact' or 'derivative-block'")
-    if controller not in CONTROLLERS:
-        raise ValueError(f"invalid controller = {controller!r}: expected one of {sorted(CONTROLLERS)}")
+    controller_name, controller_description = controller_label(controller)  # a bad spec: ValueError here
     if isinstance(perturbed, bool) or int(perturbed) != perturbed or perturbed < 0:
         raise ValueError(f"invalid perturbed = {perturbed!r}: expected an integer >= 0")
     if data is None:
@@ -67,16 +68,19 @@ def run_benchmark(data: str | Path | None = None, record: str = "elcentro", case
         load = lambda n: load_case(data, n)  # noqa: E731
     results: dict[str, Any] = {"cases": {}}
     meta = {"record": rec.name, "record_source": rec.source, "synthetic": rec.synthetic,
-            "controller": controller, "controller_description": CONTROLLERS[controller][1],
+            "controller": controller_name, "controller_description": controller_description,
             "eq_intensity": scale, "seed": seed, "perturbed_runs": int(perturbed), "fs_Hz": 4096,
-            "J_names": list(J_NAMES), "force_limit_N": FORCE_LIMIT, "csi": csi, "noise": noise}
+            "J_names": list(J_NAMES), "J_labels": list(J_LABELS), "force_limit_N": FORCE_LIMIT, "csi": csi,
+            "noise": noise}
     if rec.synthetic:
         meta["label"] = SYNTHETIC_LABEL
     elif data is None:
         meta["label"] = ("EMBEDDED DEFAULT: reference structure rebuilt from the published parameters, driven by the "
                          "benchmark's chirp (no published results).")
     trials, tables = {}, {}
-    executor = ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1) if perturbed > 0 else None
+    # a controller object cannot go to worker processes: run_case then runs its trials here, one after another
+    parallel = perturbed > 0 and isinstance(controller, str)
+    executor = ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1) if parallel else None
     bar = None
     if progress:
         from tqdm.auto import tqdm
@@ -88,12 +92,14 @@ def run_benchmark(data: str | Path | None = None, record: str = "elcentro", case
                            executor=executor, progress=False, keep_signals=True,
                            csi_derivative_block=csi == "derivative-block", noise=noise)
             nom = out["nominal"]
-            entry: dict[str, Any] = {"nominal": {"J": nom["J"], "max_force_N": nom["max_force_N"],
+            entry: dict[str, Any] = {"nominal": {"J": nom["J"], "criteria": nom["criteria"],
+                                                 "max_force_N": nom["max_force_N"],
                                                  "max_displacement_m": nom["max_displacement_m"],
                                                  "PSI": nom["PSI"]}}
             if perturbed > 0:
                 p = out["perturbed"]
-                entry["perturbed"] = {"J_mean": p["J_mean"], "J_std": p["J_std"], "runs": p["runs"]}
+                entry["perturbed"] = {"J_mean": p["J_mean"], "J_std": p["J_std"], "criteria_mean": p["criteria_mean"],
+                                      "criteria_std": p["criteria_std"], "runs": p["runs"]}
                 meta.setdefault("perturbed_stable", {})[str(n)] = p["stable"]
                 meta.setdefault("perturbed_ran_to_end", {})[str(n)] = p["ran_to_end"]
                 meta.setdefault("perturbed_capacity_exceeded", {})[str(n)] = p["capacity_exceeded"]
@@ -118,8 +124,9 @@ def _fmt(v: float, nd: int = 2) -> str:
 
 
 def j_table(results: dict[str, Any]) -> str:
-    """The J table (markdown): one row per case, nominal and (if run) perturbed mean +- std."""
-    head = "| Case | Trial | " + " | ".join(n.split()[0] for n in J_NAMES) + " | max f [kN] | PSI |\n"
+    """The J table (markdown): one row per case, nominal and (if run) perturbed mean +- std;
+    the columns are the criteria's names (``J1_delay_ms``, ...)."""
+    head = "| Case | Trial | " + " | ".join(J_NAMES) + " | max f [kN] | PSI |\n"
     head += "|" + " --- |" * 13 + "\n"
     rows = []
     for n, e in results["cases"].items():
@@ -198,7 +205,8 @@ def _write_all(run: dict[str, Any], out: Path, files: FileSet) -> None:
               f"- noise seed / perturbation seed: {meta['seed']} (noise generator: {noise}{official}); "
               f"perturbed runs per case: {meta['perturbed_runs']}",
               f"- CSI: {meta['csi']} ({'a2 dx/dt' if meta['csi'] == 'exact' else 'the code Derivative block'})",
-              "- J in the official code's order (F4_evaluation.m): J1 [ms], J2-J9 [%]; PSI = log10(tau_cr / ms)", ""]
+              "- J in the official code's order (F4_evaluation.m): J1 [ms], J2-J9 [%]; PSI = log10(tau_cr / ms)",
+              "- criteria: " + "; ".join(f"{n} = {label}" for n, label in zip(J_NAMES, J_LABELS)), ""]
     lines += [j_table(res), ""]
     flagged = [n for n, e in res["cases"].items() if e["nominal"]["max_force_N"] >= FORCE_LIMIT]
     lines += [f"Actuator capacity (max|f| >= {FORCE_LIMIT / 1e3:.1f} kN) exceeded in the nominal trial of case(s): "

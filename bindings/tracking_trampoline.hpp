@@ -1,0 +1,222 @@
+// A tracking controller written in Python, in the C++ loops.
+//
+// Two ways in, one protocol (docs/rths-benchmark.md, "Bring your own controller"):
+//   * a subclass of _core.rths.TrackingController (the pybind11 trampoline PyTrackingController);
+//   * any object with reset() and command(...) (PythonTrackingController wraps it).
+// Both call
+//   reset() -> None
+//   command(desired, desired_velocity, desired_acceleration, measured, measured_force) -> float
+// with the TrackingInput fields as five floats in SI units (m, m/s, m/s^2, m, N) and take the
+// returned command [m] (anything float() accepts).
+//
+// The loop runs without the GIL (bindings/busy.hpp): each call takes it.  reset() and
+// command() are noexcept: a Python exception is stored (with the sample it happened at), the
+// controller returns NaN from then on, so the loop stops at that sample (a non-finite command),
+// and the binding that ran the loop re-raises it (raise_stored_error) as a RuntimeError naming
+// the controller, the method, the sample and its time, caused by the original exception
+// (KeyboardInterrupt and the other non-Exception errors are re-raised as they are).
+#pragma once
+
+#include <Python.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include <pybind11/pybind11.h>
+
+#include "servohydraulics/rths/tracking.hpp"
+
+namespace servohydraulics::bindings {
+
+namespace py = pybind11;
+
+//! The call discipline shared by the two Python controllers: GIL, error capture, sample count.
+class PythonControllerCalls {
+ public:
+  bool failed() const noexcept { return failed_; }
+  long failed_sample() const noexcept { return failed_sample_; }
+  const char* failed_method() const noexcept { return method_; }
+
+  //! Re-raises the stored error (GIL held): RuntimeError("<who>.<method>() raised at sample k
+  //! (t = k dt s): <Type>: <message>") from the original, with attributes sample and time.
+  [[noreturn]] void raise_stored_error(const std::string& who, double dt) const {  // dt NaN: no time
+    const py::object exc = error_;
+    const bool plain = PyObject_IsInstance(exc.ptr(), PyExc_Exception) == 1;
+    const double t = static_cast<double>(failed_sample_) * dt;
+    std::string msg;
+    if (plain) {  // every Python call before the error indicator is set
+      const std::string text = py::str(exc).cast<std::string>();
+      const std::string when = std::isfinite(t) ? " (t = " + py::str(py::float_(t)).cast<std::string>() + " s)" : "";
+      msg = who + "." + method_ + "() raised at sample " + std::to_string(failed_sample_) + when + ": " +
+            py::str(py::type::handle_of(exc).attr("__name__")).cast<std::string>() +
+            (text.empty() ? "" : ": " + text);
+    }
+    PyObject* value = exc.ptr();
+    PyObject* type = reinterpret_cast<PyObject*>(Py_TYPE(value));
+    Py_INCREF(type);
+    Py_INCREF(value);
+    PyErr_Restore(type, value, PyException_GetTraceback(value));
+    if (!plain) throw py::error_already_set();  // KeyboardInterrupt, SystemExit: as they are
+    py::raise_from(PyExc_RuntimeError, msg.c_str());
+    py::error_already_set err;
+    err.value().attr("sample") = failed_sample_;
+    err.value().attr("time") = t;
+    throw err;
+  }
+
+ protected:
+  //! reset() through f (GIL taken here); clears a stored error.
+  template <class F>
+  void reset_call(F&& f) noexcept {
+    py::gil_scoped_acquire gil;
+    error_ = py::object();
+    failed_ = false;
+    failed_sample_ = -1;
+    samples_ = 0;
+    guarded("reset", f);
+  }
+  //! command() through f, which returns the Python result; NaN once anything failed.
+  template <class F>
+  double command_call(F&& f) noexcept {
+    if (failed_) return std::numeric_limits<double>::quiet_NaN();
+    py::gil_scoped_acquire gil;
+    double u = std::numeric_limits<double>::quiet_NaN();
+    guarded("command", [&] { u = to_command(f()); });
+    ++samples_;
+    return failed_ ? std::numeric_limits<double>::quiet_NaN() : u;
+  }
+
+ private:
+  static double to_command(const py::handle& r) {
+    const double u = PyFloat_AsDouble(r.ptr());
+    if (u == -1.0 && PyErr_Occurred()) {
+      PyErr_Clear();
+      throw py::type_error("command() returned " + py::repr(r).cast<std::string>() +
+                           ": expected a float, the actuator command [m]");
+    }
+    return u;
+  }
+  template <class F>
+  void guarded(const char* method, F&& f) noexcept {
+    try {
+      try {
+        f();
+      } catch (py::error_already_set& e) {
+        store(method, e.value());
+      } catch (py::builtin_exception& e) {
+        e.set_error();
+        store(method, py::error_already_set().value());
+      } catch (const std::exception& e) {
+        PyErr_SetString(PyExc_RuntimeError, e.what());
+        store(method, py::error_already_set().value());
+      }
+    } catch (...) {  // storing failed (out of memory): still stop the run
+      PyErr_Clear();
+      failed_ = true;
+      method_ = method;
+      failed_sample_ = samples_;
+    }
+  }
+  void store(const char* method, py::object exc) {
+    error_ = std::move(exc);
+    failed_ = true;
+    method_ = method;
+    failed_sample_ = samples_;
+  }
+  py::object error_;
+  bool failed_ = false;
+  const char* method_ = "command";
+  long samples_ = 0, failed_sample_ = -1;
+};
+
+//! Trampoline: a Python subclass of TrackingController overrides reset() and command(...).
+//! reset() also caches the class's command function; command() then calls it with the
+//! instance (borrowed: the instance owns this object), skipping pybind11's per-call override
+//! lookup.  An override that is not a plain method of the class is looked up on every call.
+class PyTrackingController : public rths::TrackingController, public PythonControllerCalls {
+ public:
+  using rths::TrackingController::TrackingController;
+  void reset() noexcept override {
+    reset_call([&] {
+      command_ = py::object();
+      self_ = py::handle();
+      override_of("reset")();
+      const py::function f = override_of("command");
+      if (py::hasattr(f, "__func__") && py::hasattr(f, "__self__")) {
+        const py::object self = f.attr("__self__"), func = f.attr("__func__");
+        if (py::getattr(py::type::handle_of(self), "command", py::none()).is(func)) {
+          command_ = func;
+          self_ = self;  // borrowed: it owns this C++ object, so it outlives every call
+        }
+      }
+    });
+  }
+  double command(const rths::TrackingInput& in) noexcept override {
+    return command_call([&] {
+      if (command_)
+        return command_(self_, in.desired, in.desired_velocity, in.desired_acceleration, in.measured,
+                        in.measured_force);
+      return override_of("command")(in.desired, in.desired_velocity, in.desired_acceleration, in.measured,
+                                    in.measured_force);
+    });
+  }
+
+ private:
+  py::function override_of(const char* name) const {
+    py::function f = py::get_override(static_cast<const rths::TrackingController*>(this), name);
+    if (!f) throw py::type_error(std::string("a TrackingController subclass must define ") + name + "()");
+    return f;
+  }
+  py::object command_;
+  py::handle self_;
+};
+
+//! Any Python object with reset() and command(...) as a TrackingController.
+class PythonTrackingController final : public rths::TrackingController, public PythonControllerCalls {
+ public:
+  explicit PythonTrackingController(py::object obj) : obj_(std::move(obj)) {
+    std::string missing;
+    for (const char* name : {"reset", "command"})
+      if (!py::hasattr(obj_, name) || !PyCallable_Check(obj_.attr(name).ptr()))
+        missing += std::string(missing.empty() ? "" : ", ") + name + "()";
+    if (!missing.empty())
+      throw py::type_error("invalid controller = " + py::repr(obj_).cast<std::string>() +
+                           ": not a tracking controller, it lacks " + missing +
+                           " (expected reset() and command(desired, desired_velocity, desired_acceleration, "
+                           "measured, measured_force) -> float)");
+    reset_ = obj_.attr("reset");
+    command_ = obj_.attr("command");
+  }
+  void reset() noexcept override {
+    reset_call([&] { reset_(); });
+  }
+  double command(const rths::TrackingInput& in) noexcept override {
+    return command_call([&] {
+      return command_(in.desired, in.desired_velocity, in.desired_acceleration, in.measured, in.measured_force);
+    });
+  }
+  const py::object& object() const noexcept { return obj_; }
+
+ private:
+  py::object obj_, reset_, command_;
+};
+
+//! After a run (GIL held): re-raises what a Python controller raised during it, if anything
+//! (dt: the loop's sample time [s]; NaN outside a loop: the message then gives no time).
+inline void raise_controller_error(const rths::TrackingController& c, double dt) {
+  py::object self;
+  const PythonControllerCalls* calls = nullptr;
+  if (const auto* p = dynamic_cast<const PythonTrackingController*>(&c)) {
+    calls = p;
+    self = p->object();
+  } else if (const auto* q = dynamic_cast<const PyTrackingController*>(&c)) {
+    calls = q;
+    self = py::cast(static_cast<const rths::TrackingController*>(q), py::return_value_policy::reference);
+  }
+  if (calls == nullptr || !calls->failed()) return;
+  calls->raise_stored_error(py::str(py::type::handle_of(self).attr("__qualname__")).cast<std::string>(), dt);
+}
+
+}  // namespace servohydraulics::bindings
