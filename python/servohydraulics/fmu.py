@@ -254,21 +254,18 @@ def export_fmu(rig: Rig, path: str | os.PathLike, kind: str = "plant", mode: str
 
 
 def _write_zip(path: Path, files: dict[str, bytes], binary: Path, arcname: str) -> Path:
+    """The zip, through the package's atomic writer: replaced whole or not at all, with the
+    umask's permissions like every other output."""
+    from .atomic import atomic_path
+
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=path.name, suffix=".part", dir=path.parent)
-    os.close(fd)
-    try:
-        with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
-            for arc, data in files.items():
-                z.writestr(arc, data)
-            info = zipfile.ZipInfo(arcname)
-            info.external_attr = 0o755 << 16
-            info.compress_type = zipfile.ZIP_DEFLATED
-            z.writestr(info, binary.read_bytes())
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+    with atomic_path(path) as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
+        for arc, data in files.items():
+            z.writestr(arc, data)
+        info = zipfile.ZipInfo(arcname)
+        info.external_attr = 0o755 << 16
+        info.compress_type = zipfile.ZIP_DEFLATED
+        z.writestr(info, binary.read_bytes())
     return path
 
 

@@ -5,14 +5,13 @@ from __future__ import annotations
 
 import json
 import math
-import os
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
 
 from ..atomic import FileSet
+from ..workers import check_workers, default_workers, process_pool
 from .benchmark import CONTROLLERS, FORCE_LIMIT, noise_generator, run_case
 from .data import EQ_INTENSITY, embedded_case, load_case, load_record, synthetic_record
 from .evaluation import J_NAMES
@@ -76,7 +75,8 @@ def run_benchmark(data: str | Path | None = None, record: str = "elcentro", case
         meta["label"] = ("EMBEDDED DEFAULT: reference structure rebuilt from the published parameters, driven by the "
                          "benchmark's chirp (no published results).")
     trials, tables = {}, {}
-    executor = ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1) if perturbed > 0 else None
+    workers = default_workers() if workers is None else check_workers(workers)
+    executor = process_pool(workers) if perturbed > 0 else None
     bar = None
     if progress:
         from tqdm.auto import tqdm
