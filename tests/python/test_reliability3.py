@@ -174,3 +174,172 @@ def test_reproduce_to_a_read_only_folder_fails_before_computing(tmp_path, capsys
     assert code == 2
     assert f"error: cannot write {out}: [Errno 13] Permission denied" in err
     assert time.monotonic() - t0 < 2
+
+
+# ----------------------------------------------------------------------------- 8: the FMU exporter
+
+@pytest.mark.parametrize("flags, named", [
+    (["--dt", "0"], "invalid dt = 0.0"), (["--dt", "nan"], "invalid dt = nan"), (["--dt", "inf"], "invalid dt = inf"),
+    (["--dt", "-1"], "invalid dt = -1.0"), (["--dt", "1e-300"], "invalid dt = 1e-300"),
+    (["--kind", "rpsd", "--dt", "5e-16"], "invalid dt = 5e-16"), (["--kind", "eft", "--dt", "nan"], "invalid dt = nan"),
+    (["--x0", "1e300"], "invalid x0 = 1e+300"), (["--x0=-inf"], "invalid x0 = -inf"),
+    (["--name", "a" * 5000], "invalid name = 'aaaa"), (["--name", "a<b&c"], "invalid name = 'a<b&c'"),
+    (["--name", "\x01"], "invalid name = '\\x01'"),
+    (["--set", "foo=1"], "invalid --set 'foo=1': the plant takes no settings"),
+    (["--set", "x"], "invalid --set 'x': expected NAME=VALUE"),
+    (["--kind", "eft", "--set", "foo=1"], "invalid --set 'foo=1': the eft takes one of"),
+    (["--kind", "eft", "--set", "solver_options=2"], "invalid --set 'solver_options=2'"),
+    (["--kind", "eft", "--set", "lead_T=abc"], "invalid lead_T = 'abc'"),
+])
+def test_fmu_export_validates_like_simulate(tmp_path, capsys, flags, named):
+    code, err = _cli(capsys, "fmu", "--out", tmp_path / "f.fmu", *flags)
+    assert code == 2, err
+    assert "error: " + named in err
+    assert "internal error" not in err
+    assert os.listdir(tmp_path) == []
+
+
+def test_export_fmu_api_names_the_bad_argument(tmp_path):
+    rig = sh.zhao2003()
+    with pytest.raises(ValueError, match="invalid setting 'foo' for kind = 'eft'"):
+        sh.export_fmu(rig, tmp_path / "a.fmu", kind="eft", foo=1)
+    with pytest.raises(ValueError, match="invalid dt = 1e-09: the FMU's controller sample time"):
+        sh.export_fmu(rig, tmp_path / "a.fmu", dt=1e-9)
+    assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("mask", [0o022, 0o077, 0o002])
+def test_exported_fmu_follows_the_umask(tmp_path, mask):
+    old = os.umask(mask)
+    try:
+        path = sh.export_fmu(sh.zhao2003(), tmp_path / "p.fmu")
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE(os.stat(path).st_mode) == 0o666 & ~mask
+
+
+class _Fmu:
+    """A plant FMU through fmpy with its log kept; start time and dt chosen by the test."""
+
+    def __init__(self, path, workdir, start: float = 0.0, logs: list[str] | None = None, **reals):
+        pytest.importorskip("fmpy")
+        from fmpy import extract, read_model_description
+        from fmpy.fmi2 import (
+            FMU2Slave,
+            calloc,
+            fmi2CallbackAllocateMemoryTYPE,
+            fmi2CallbackFreeMemoryTYPE,
+            fmi2CallbackFunctions,
+            fmi2CallbackLoggerTYPE,
+            free,
+        )
+
+        self.logs: list[str] = [] if logs is None else logs
+        d = extract(str(path), unzipdir=str(workdir))
+        md = read_model_description(d)
+        self.vr = {v.name: v.valueReference for v in md.modelVariables}
+        cb = fmi2CallbackFunctions()
+        cb.logger = fmi2CallbackLoggerTYPE(lambda env, name, status, cat, msg: self.logs.append(msg.decode()))
+        cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        self._cb = cb
+        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=d, modelIdentifier=md.coSimulation.modelIdentifier,
+                             instanceName="p")
+        self.fmu.instantiate(callbacks=cb)
+        self.fmu.setupExperiment(startTime=start)
+        self.fmu.enterInitializationMode()
+        for k, v in reals.items():
+            self.fmu.setReal([self.vr[k]], [v])
+        self.fmu.exitInitializationMode()
+        self.t = start
+
+    def run(self, u, dt: float) -> dict[str, list[float]]:
+        names = ["displacement", "velocity", "force", "pressure", "spool"]
+        rows = {n: [] for n in names}
+        for v in u:
+            self.fmu.setReal([self.vr["command"]], [float(v)])
+            self.fmu.doStep(currentCommunicationPoint=self.t, communicationStepSize=dt)
+            self.t += dt
+            for n, y in zip(names, self.fmu.getReal([self.vr[n] for n in names])):
+                rows[n].append(y)
+        return rows
+
+    def close(self):
+        self.fmu.terminate()
+        self.fmu.freeInstance()
+
+
+def test_fmu_do_step_is_bounded_in_samples(tmp_path):
+    """A doStep of 1e8 samples (10 s at the smallest dt) is a named error at once, not hours of work;
+    dt = 5e-16 set by the host is refused at initialisation."""
+    from fmpy.fmi1 import FMICallException
+
+    path = sh.export_fmu(sh.zhao2003(), tmp_path / "p.fmu", dt=1e-7)
+    s = _Fmu(path, tmp_path / "a")
+    t0 = time.monotonic()
+    with pytest.raises(FMICallException):
+        s.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=10.0)
+    assert time.monotonic() - t0 < 1.0
+    assert any("invalid communicationStepSize = 10 s" in m and "more than the 10000000" in m for m in s.logs), s.logs
+    s.run([0.001] * 3, 1e-7)  # a bad step size can be retried with a good one
+    s.close()
+    for i, bad in enumerate((5e-16, float("nan"))):
+        logs: list[str] = []
+        with pytest.raises(FMICallException):
+            _Fmu(path, tmp_path / f"b{i}", logs=logs, dt=bad)
+        assert any(f"invalid dt = {bad}" in m for m in logs), logs
+
+
+# ----------------------------------------------------------------------------- 3: start times
+
+@pytest.mark.parametrize("method", ["dopri5", "cvode", "rk4"])
+def test_a_large_start_time_gives_the_response_of_t0_zero(method):
+    import numpy as np
+
+    from servohydraulics.simulate import make_plant
+
+    u = 0.002 * np.sin(2 * np.pi * 5 * np.arange(1000) * 5e-4)
+    ref = None
+    for t0 in (0.0, 1.7e9, 1e10):
+        p = make_plant(sh.zhao2003(), "displacement", 5e-4, sh.solver_options(method))
+        p.reset(0.0, t0)
+        rows = [p.step(v)[1] for v in u]
+        y = np.array([[o.displacement, o.force, o.velocity] for o in rows])
+        assert rows[-1].time == t0 + 1000 * 5e-4 and p.time == rows[-1].time
+        if ref is None:
+            ref = y
+        assert np.array_equal(y, ref), f"t0 = {t0}: {np.max(np.abs(y - ref))}"
+
+
+def test_a_non_finite_start_time_is_a_named_error():
+    p = sh.Plant(sh.zhao2003(), sh.ControlMode.Displacement, 5e-4)
+    for t0 in (float("nan"), float("inf"), -float("inf")):
+        with pytest.raises(ValueError, match=f"invalid t0 = {t0}: the start time must be finite"):
+            p.reset(0.0, t0)
+        with pytest.raises(ValueError, match="invalid t0"):
+            p.reset_state(p.state, t0)
+
+
+@pytest.mark.parametrize("t0", [1.7e9, 1e10])
+def test_plant_fmu_at_a_unix_start_time_equals_t0_zero(tmp_path, t0):
+    import numpy as np
+
+    path = sh.export_fmu(sh.zhao2003(), tmp_path / "p.fmu")
+    u = 0.002 * np.sin(2 * np.pi * 5 * np.arange(400) * 5e-4)
+    rows = {}
+    for start in (0.0, t0):
+        s = _Fmu(path, tmp_path / str(start), start=start)
+        rows[start] = s.run(u, 5e-4)
+        s.close()
+    for n in rows[0.0]:
+        assert rows[t0][n] == rows[0.0][n], n
+
+
+def test_fmu_with_a_nan_start_time_is_refused(tmp_path):
+    from fmpy.fmi1 import FMICallException
+
+    path = sh.export_fmu(sh.zhao2003(), tmp_path / "p.fmu")
+    logs: list[str] = []
+    with pytest.raises(FMICallException):
+        _Fmu(path, tmp_path / "a", start=float("nan"), logs=logs)
+    assert any("invalid startTime = nan: must be finite" in m for m in logs), logs
