@@ -343,3 +343,127 @@ def test_fmu_with_a_nan_start_time_is_refused(tmp_path):
     with pytest.raises(FMICallException):
         _Fmu(path, tmp_path / "a", start=float("nan"), logs=logs)
     assert any("invalid startTime = nan: must be finite" in m for m in logs), logs
+
+
+# ----------------------------------------------------------------------------- 6: benchmark data
+
+def _case_folder(tmp_path: Path, **mats) -> Path:
+    import numpy as np
+    import scipy.io as sio
+
+    from servohydraulics.rths.data import embedded_case
+
+    c = embedded_case(1)
+    d = {"M": c.M, "C": c.C, "K": c.K}
+    d.update(mats)
+    folder = tmp_path / "data"
+    folder.mkdir(exist_ok=True)
+    sio.savemat(folder / "Case_1.mat", {k: v for k, v in d.items() if v is not None})
+    t = np.arange(200) * 0.01
+    sio.savemat(folder / "ElCentroAccelNoScaling.mat", {"ElCentroAccel": np.vstack([t, np.sin(t)])})
+    return folder
+
+
+def _bad_cases():
+    import numpy as np
+
+    from servohydraulics.rths.data import embedded_case
+
+    c = embedded_case(1)
+    asym = c.K.copy()
+    asym[0, 1] *= 1.5
+    nan = c.K.copy()
+    nan[1, 1] = np.nan
+    return [
+        ("negative_mass", {"M": -c.M}, "M must be positive definite"),
+        ("zero_stiffness", {"K": 0 * c.K}, "K must be positive definite"),
+        ("asymmetric_stiffness", {"K": asym}, "K must be symmetric; K[0,1]"),
+        ("complex_mass", {"M": c.M * (1 + 1j)}, "M: complex values"),
+        ("nan_stiffness", {"K": nan}, "K: entry [1, 1] = nan"),
+        ("non_square", {"C": c.C[:2]}, "C must be square"),
+        ("sizes_differ", {"M": np.eye(2) * 1000.0}, "M, C and K must have one size"),
+        ("text", {"K": "stiff"}, "K: not a numeric array"),
+        ("missing_K", {"K": None}, "variable 'K' missing"),
+    ]
+
+
+@pytest.mark.parametrize("name, mats, named", _bad_cases(), ids=[c[0] for c in _bad_cases()])
+def test_a_bad_case_file_is_a_named_error(tmp_path, capsys, name, mats, named):
+    folder = _case_folder(tmp_path, **mats)
+    code, err = _cli(capsys, "rths-benchmark", "--data", folder, "--cases", "1", "--quiet", "--out", tmp_path / "o")
+    assert code == 2, err
+    assert f"error: {folder / 'Case_1.mat'}" in err and named in err
+    assert not (tmp_path / "o").exists()
+
+
+def _record_folder(tmp_path: Path, rec) -> Path:
+    import numpy as np
+    import scipy.io as sio
+
+    folder = _case_folder(tmp_path)
+    sio.savemat(folder / "ElCentroAccelNoScaling.mat", {"ElCentroAccel": np.asarray(rec)})
+    return folder
+
+
+def _bad_records():
+    import numpy as np
+
+    t = np.arange(200) * 0.01
+    a = np.sin(t)
+    shuffled = t.copy()
+    shuffled[[10, 20]] = shuffled[[20, 10]]
+    uneven = t.copy()
+    uneven[50:] += 0.003
+    return [
+        ("shuffled_time", np.vstack([shuffled, a]), "time must be increasing"),
+        ("uneven_time", np.vstack([uneven, a]), "time must be uniform"),
+        ("nan_acceleration", np.vstack([t, np.where(t > 1, np.nan, a)]), "acceleration: entry [101] = nan"),
+        ("three_rows", np.vstack([t, a, a]), "must be 2 rows (time, acceleration)"),
+        ("complex", np.vstack([t, a * 1j]), "complex values"),
+    ]
+
+
+@pytest.mark.parametrize("name, rec, named", _bad_records(), ids=[r[0] for r in _bad_records()])
+def test_a_bad_record_file_is_a_named_error(tmp_path, capsys, name, rec, named):
+    folder = _record_folder(tmp_path, rec)
+    code, err = _cli(capsys, "rths-benchmark", "--data", folder, "--cases", "1", "--quiet", "--out", tmp_path / "o")
+    assert code == 2, err
+    assert f"error: {folder / 'ElCentroAccelNoScaling.mat'}" in err and named in err
+
+
+@pytest.mark.parametrize("content", [b"", b"MATLAB 5.0 MAT-file" + b"\0" * 200, b"\x89PNG\r\n" * 50, b"x" * 3])
+def test_a_malformed_mat_file_names_the_file(tmp_path, capsys, content):
+    folder = _case_folder(tmp_path)
+    (folder / "Case_1.mat").write_bytes(content)
+    code, err = _cli(capsys, "rths-benchmark", "--data", folder, "--cases", "1", "--quiet", "--out", tmp_path / "o")
+    assert code == 2, err
+    assert f"error: {folder / 'Case_1.mat'}: cannot read this MATLAB file" in err
+
+
+def test_malformed_csv_and_json_copies_name_the_file_and_line(tmp_path):
+    from servohydraulics.rths.data import load_case, load_record
+
+    (tmp_path / "elcentro_accel_unscaled.csv").write_text("time,accel\n0,0\n0.02,abc\n")
+    with pytest.raises(ValueError, match=r"elcentro_accel_unscaled.csv: line 3 = '0.02,abc'"):
+        load_record(tmp_path, "elcentro")
+    (tmp_path / "building_cases.json").write_text('{"cases": {"case_1": {"M": [[1]], "C": [[0]]}}}')
+    with pytest.raises(ValueError, match=r"building_cases.json: no cases.case_1 with M, C and K"):
+        load_case(tmp_path, 1)
+    (tmp_path / "building_cases.json").write_text("{not json")
+    with pytest.raises(ValueError, match=r"building_cases.json: cannot read this JSON file"):
+        load_case(tmp_path, 1)
+
+
+@pytest.mark.parametrize("layout", ["mat", "."])
+def test_the_official_data_pass_the_checks(layout):
+    """The official cases and records (both the .mat files and the JSON/CSV copies) are valid."""
+    from shared_data import shared_path
+
+    from servohydraulics.rths.data import RECORDS, load_case, load_record
+
+    folder = shared_path("rths-data") / layout
+    for n in (1, 2, 3, 4):
+        assert load_case(folder, n).M.shape == (3, 3)
+    for name in RECORDS:
+        assert load_record(folder, name).time.size > 1000
+

@@ -74,6 +74,7 @@ def run_benchmark(data: str | Path | None = None, record: str = "elcentro", case
     elif data is None:
         meta["label"] = ("EMBEDDED DEFAULT: reference structure rebuilt from the published parameters, driven by the "
                          "benchmark's chirp (no published results).")
+    loaded = {n: load(n) for n in case_list}  # every case validated before the first run
     trials, tables = {}, {}
     workers = default_workers() if workers is None else check_workers(workers)
     executor = process_pool(workers) if perturbed > 0 else None
@@ -83,7 +84,7 @@ def run_benchmark(data: str | Path | None = None, record: str = "elcentro", case
         bar = tqdm(total=len(case_list) * (1 + int(perturbed)), desc="rths-benchmark", unit="run")
     try:
         for n in case_list:
-            case = load(n)
+            case = loaded[n]
             out = run_case(case, rec, controller, perturbed=int(perturbed), seed=seed, scale=scale,
                            executor=executor, progress=False, keep_signals=True,
                            csi_derivative_block=csi == "derivative-block", noise=noise)
