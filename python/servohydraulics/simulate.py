@@ -87,7 +87,19 @@ def _command_array(command: ArrayLike | None, duration: float | None, dt: float)
         if not math.isfinite(duration) or duration <= 0:
             raise ValueError(f"invalid duration = {duration!r}: must be finite and > 0 [s]")
         return np.zeros(time_axis(duration, dt).size)
-    u = np.asarray(command, dtype=float)
+    try:
+        u = np.asarray(command)
+        if np.iscomplexobj(u):  # a float cast drops the imaginary part (a ComplexWarning at most)
+            bad = np.flatnonzero(np.ravel(u.imag) != 0)
+            if bad.size:
+                raise ValueError(f"invalid command[{bad[0]}] = {np.ravel(u)[bad[0]]}: complex; the command is "
+                                 "real [m or N]")
+            u = u.real
+        u = u.astype(float)
+    except (TypeError, ValueError) as e:
+        if str(e).startswith("invalid command"):
+            raise
+        raise ValueError(f"invalid command: not an array of numbers ({' '.join(str(e).split())})") from None
     if u.ndim != 1:
         raise ValueError(f"invalid command shape = {u.shape}: expected a 1-D array")
     if u.size < 2:

@@ -467,3 +467,51 @@ def test_the_official_data_pass_the_checks(layout):
     for name in RECORDS:
         assert load_record(folder, name).time.size > 1000
 
+
+
+# ----------------------------------------------------------------------------- 10: user mistakes, named
+
+@pytest.fixture
+def record_and_rig(tmp_path, capsys):
+    assert _cli(capsys, "simulate", "--duration", "0.5", "--dt", "0.001", "--frequency", "5",
+                "--out", tmp_path / "rec.csv")[0] == 0
+    sh.save_rig(sh.zhao2003(), tmp_path / "rig.toml")
+    return tmp_path / "rec.csv", tmp_path / "rig.toml"
+
+
+@pytest.mark.parametrize("dt, named", [("0", "invalid dt = 0.0: must be finite and > 0"),
+                                       ("nan", "invalid dt = nan"), ("-0.001", "invalid dt = -0.001"),
+                                       ("1e-9", "invalid dt = 1e-09: 500,000,001 controller samples"),
+                                       ("3e-4", "invalid dt = 0.0003: the controller sample must divide")])
+def test_compare_dt_is_checked_before_any_allocation(record_and_rig, tmp_path, capsys, dt, named):
+    rec, rig = record_and_rig
+    code, err = _cli(capsys, "compare", rec, "--rig", rig, "--mode", "displacement", "--out", tmp_path / "c",
+                     "--dt", dt)
+    assert code == 2 and "error: " + named in err, err
+
+
+@pytest.mark.parametrize("text", ["a = " + "[" * 5000 + "]" * 5000, "a = " + "{x=" * 3000 + "1" + "}" * 3000])
+@pytest.mark.parametrize("command", [["simulate", "--out", "OUT/s.csv"], ["fmu", "--out", "OUT/f.fmu"],
+                                     ["compare", "REC", "--mode", "displacement", "--out", "OUT/c"]])
+def test_deeply_nested_toml_is_a_named_error(record_and_rig, tmp_path, capsys, text, command):
+    deep = tmp_path / "deep.toml"
+    deep.write_text(text)
+    argv = [str(record_and_rig[0]) if a == "REC" else a.replace("OUT", str(tmp_path)) for a in command]
+    code, err = _cli(capsys, *argv, "--rig", deep)
+    assert code == 2, err
+    assert f"error: rig file {deep} is not valid TOML here: arrays or tables nested too deeply" in err
+
+
+@pytest.mark.parametrize("command", [[1e-3, 1e-3 + 1e-6j], [1j] * 5])
+def test_a_complex_command_is_refused_not_truncated(command):
+    with pytest.raises(ValueError, match=r"invalid command\[\d\] = .*j\)?: complex"):
+        sh.simulate(sh.zhao2003(), command=command)
+
+
+def test_a_complex_command_with_zero_imaginary_parts_is_its_real_part():
+    import numpy as np
+
+    u = 1e-3 * np.sin(np.arange(200) * 0.05)
+    a = sh.simulate(sh.zhao2003(), command=u + 0j)
+    b = sh.simulate(sh.zhao2003(), command=u)
+    assert np.array_equal(a.displacement, b.displacement)

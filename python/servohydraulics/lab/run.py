@@ -18,6 +18,7 @@ import numpy as np
 from ..response import Response, SimulationError
 from ..rig import Rig
 from ..simulate import simulate, solver_options
+from ..timegrid import MAX_SAMPLES, positive
 
 #: the channels a record and a simulation share, compared in this order
 CHANNELS = ("displacement", "force")
@@ -30,6 +31,7 @@ def initial_displacement(record: Response, samples: int = 20) -> float:
 
 def _ratio(record_dt: float, dt: float) -> tuple[int, bool]:
     """(n, faster): the controller runs n times faster (True) or slower than the record."""
+    positive("dt", dt)
     for a, b, faster in ((record_dt, dt, True), (dt, record_dt, False)):
         n = a / b
         if abs(n - round(n)) <= 1e-6 * n and round(n) >= 1:
@@ -53,6 +55,9 @@ def simulate_record(rig: Rig, record: Response, mode: str, dt: float | None = No
     n, faster = (1, True) if dt is None else _ratio(rdt, float(dt))
     start = initial_displacement(record) if x0 is None else float(x0)
     if faster:
+        if (u.size - 1) * n + 1 > MAX_SAMPLES:  # simulate's cap, checked before the grid is allocated
+            raise ValueError(f"invalid dt = {dt!r}: {(u.size - 1) * n + 1:,} controller samples for the record's "
+                             f"{u.size:,} at {rdt!r} s, more than the {MAX_SAMPLES:,} allowed")
         t = np.arange((u.size - 1) * n + 1) * (rdt / n)
         uc = np.interp(t, np.arange(u.size) * rdt, u)
         res = simulate(rig, mode=mode, command=uc, dt=rdt / n, x0=start, options=options)
