@@ -79,6 +79,16 @@ def _special(path: Path) -> str | None:
     return None
 
 
+def _followed(link: Path) -> Path:
+    """The file a symbolic link leads to (it may not exist yet); WriteError for a loop."""
+    try:
+        return Path(os.path.realpath(link, strict=True))
+    except FileNotFoundError:  # dangling: the write creates the file it names
+        return Path(os.path.realpath(link))
+    except OSError as e:
+        raise _failure(link, e) from None
+
+
 def _copy_into(tmp: Path, device: Path) -> None:
     """Writes the finished temporary's bytes into a character device and removes the temporary."""
     with open(tmp, "rb") as src, open(device, "wb") as dst:
@@ -123,7 +133,7 @@ class FileSet:
         target = Path(target)
         if target.name in ("", ".", "..") or target.is_dir():
             raise WriteError(target, errno.EISDIR, "it is a directory")
-        real = Path(os.path.realpath(target)) if target.is_symlink() else target  # followed, never replaced
+        real = _followed(target) if target.is_symlink() else target  # followed, never replaced
         kind = _special(real)
         if kind is not None and kind != "character device":
             raise WriteError(target, errno.EINVAL, f"it is a {kind}, not a regular file (refusing to replace it)")

@@ -137,6 +137,14 @@ def test_a_symlink_is_followed_and_kept(tmp_path):
     assert sorted(os.listdir(tmp_path / "runs")) == ["next_record.csv", "record.csv"]
 
 
+def test_a_symlink_loop_is_a_named_error(tmp_path):
+    (tmp_path / "a").symlink_to(tmp_path / "b")
+    (tmp_path / "b").symlink_to(tmp_path / "a")
+    with pytest.raises(atomic.WriteError, match=f"cannot write {tmp_path / 'a'}: .*Too many levels of symbolic"):
+        atomic.write_text(tmp_path / "a", "x")
+    assert (tmp_path / "a").is_symlink() and sorted(os.listdir(tmp_path)) == ["a", "b"]
+
+
 def test_a_file_set_with_a_fifo_touches_nothing(tmp_path):
     os.mkfifo(tmp_path / "b.md")
     (tmp_path / "a.json").write_text("old")
