@@ -5,6 +5,7 @@
 //
 // Every entry point catches every exception: an error is an fmi2 status with a
 // message through the logger callback, never a crash.
+#include <cmath>
 #include <cstring>
 #include <exception>
 #include <memory>
@@ -142,6 +143,8 @@ void fmi2FreeInstance(fmi2Component comp) { delete static_cast<Component*>(comp)
 fmi2Status fmi2SetupExperiment(fmi2Component comp, fmi2Boolean, fmi2Real, fmi2Real start, fmi2Boolean, fmi2Real) {
   return guarded(comp, "fmi2SetupExperiment", [&](Component& c) {
     if (c.phase != Phase::Instantiated) return fail(&c, "fmi2SetupExperiment", "only after fmi2Instantiate");
+    if (!std::isfinite(start))
+      return fail(&c, "fmi2SetupExperiment", "invalid startTime = " + std::to_string(start) + ": must be finite [s]");
     c.start_time = start;
     return fmi2OK;
   });

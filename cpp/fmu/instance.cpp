@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "resources.hpp"
+#include "servohydraulics/error.hpp"
 
 namespace servohydraulics::fmu {
 
@@ -55,6 +56,8 @@ void Instance::build(Slot<C>& slot, const C& controller) {
 
 void Instance::initialize(double start_time) {
   Settings& s = values_.settings;
+  require(std::isfinite(start_time), "startTime", start_time, "the start time must be finite [s]");
+  check_dt(s.dt);  // the host may have set dt
   s.rig.validate();
   s.eft.dt = s.rpsd.dt = s.dt;
   switch (s.kind) {
@@ -156,6 +159,10 @@ std::string Instance::do_step(double t, double h) noexcept {
   if (!(std::fabs(t - now) <= 1e-6 * dt + 1e-12 * std::fabs(now)))
     return format("fmi2DoStep at currentCommunicationPoint = %.17g s, but the FMU is at t = %.17g s", t, now);
   const double samples = h / dt;
+  if (!(samples <= static_cast<double>(kMaxSamplesPerStep) + 0.5))  // also NaN; before lround overflows
+    return format("invalid communicationStepSize = %.17g s: %.3g controller samples of dt = %.17g s, more than "
+                  "the 10000000 one doStep may run (fmu::kMaxSamplesPerStep): split it into shorter steps",
+                  h, samples, dt);
   const long n = std::lround(samples);
   if (!(n >= 1 && std::fabs(samples - static_cast<double>(n)) <= 1e-6))
     return format("invalid communicationStepSize = %.17g s: must be a whole number (>= 1) of controller samples "

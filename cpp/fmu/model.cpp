@@ -7,6 +7,7 @@
 #include <type_traits>
 #include <variant>
 
+#include "servohydraulics/error.hpp"
 #include "servohydraulics/parameters.hpp"
 
 namespace servohydraulics::fmu {
@@ -43,7 +44,13 @@ Kind parse_kind(const std::string& name) { return parse_enum(kKindNames, "kind",
 
 ControlMode parse_mode(const std::string& name) { return parse_enum(kControlModeNames, "mode", name); }
 
+void check_dt(double dt) {
+  require(std::isfinite(dt) && dt >= kMinDt, "dt", dt,
+          "the FMU's controller sample time must be finite and >= 1e-07 s (fmu::kMinDt)");
+}
+
 void resolve_defaults(Settings& s) {
+  check_dt(s.dt);
   s.eft.dt = s.dt;
   s.rpsd.dt = s.dt;
   if (s.kind == Kind::Eft && !s.eft.mass) s.eft.mass = EftController(s.eft, s.rig).mass();

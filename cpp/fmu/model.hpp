@@ -45,8 +45,18 @@ struct Settings {
   EftConfig eft;         //!< EFT controller (its dt is `dt`)
   RpsdConfig rpsd;       //!< RPsD controller (its dt is `dt`)
 };
+//! Bounds of the FMU's timing.  A doStep runs at most kMaxSamplesPerStep
+//! controller samples (seconds of work, not hours: a longer communication step
+//! is an error naming it), and dt is at least kMinDt (a 10 MHz controller;
+//! a smaller dt made an ordinary doStep of a host trillions of samples).
+inline constexpr double kMinDt = 1e-7;               // [s]
+inline constexpr long kMaxSamplesPerStep = 10000000;  // 1.4 h at the paper's 2 kHz
+
+//! Throws Error naming dt unless it is finite and >= kMinDt.
+void check_dt(double dt);
+
 //! Fills the configs' "none = from the rig" fields with the values the core
-//! would use (validates; throws Error), and copies dt into the configs.
+//! would use (validates, dt too; throws Error), and copies dt into the configs.
 void resolve_defaults(Settings& s);
 
 //! The values a variable reads and writes: settings, inputs, outputs.

@@ -86,8 +86,8 @@ struct Plant::Impl {
   Dynamics dyn;
   SolverOptions opt;
   double dt;
-  double t = 0.0;
-  double t0 = 0.0;  // time of the last reset [s]
+  double t = 0.0;   // local time since the last reset [s]: the integrators work in it
+  double t0 = 0.0;  // time of the last reset [s]: only the time channel and statuses add it
   long k = 0;       // samples since then: sample times are t0 + k dt, never an accumulated sum
   State y{};
   Dynamics::Input input{};
@@ -152,12 +152,18 @@ Plant::~Plant() = default;
 Plant::Plant(Plant&&) noexcept = default;
 Plant& Plant::operator=(Plant&&) noexcept = default;
 
-void Plant::reset(double x0, double t0) noexcept { reset_state(impl_->dyn.equilibrium(x0), t0); }
+void Plant::reset(double x0, double t0) {
+  require(std::isfinite(t0), "t0", t0, "the start time must be finite [s]");
+  reset_state(impl_->dyn.equilibrium(x0), t0);
+}
 
-void Plant::reset_state(const State& y0, double t0) noexcept {
+// The integrators run in local time t - t0 from 0: at t0 = 1.7e9 s (a Unix time) a sample of 0.5 ms
+// is 1e-13 of t, so absolute times would leave step sizes and CVODE's stop times a few bits.
+void Plant::reset_state(const State& y0, double t0) {
+  require(std::isfinite(t0), "t0", t0, "the start time must be finite [s]");
   Impl& m = *impl_;
   m.y = y0;
-  m.t = t0;
+  m.t = 0.0;
   m.t0 = t0;
   m.k = 0;
   m.input = {};
@@ -176,7 +182,7 @@ Status Plant::Impl::advance_delayed(double t_next) noexcept {
     input = held(j);
     return advance(input, t_next, 0);
   }
-  const double t_switch = t0 + (static_cast<double>(k) + cmd_delay.frac) * dt;
+  const double t_switch = (static_cast<double>(k) + cmd_delay.frac) * dt;  // local time
   int n1 = 0, n2 = 0;
   if (const auto* rk4 = std::get_if<detail::Rk4Integrator>(&integ)) {
     const int n = rk4->substeps();
@@ -202,19 +208,19 @@ Status Plant::step(double command, Output& out) noexcept {
   if (m.failed) {
     Status st;
     st.code = Status::NotReady;
-    st.t = m.t;
+    st.t = m.t0 + m.t;
     observe(out);
     return st;
   }
   if (!std::isfinite(command)) {
     Status st;
     st.code = Status::NonFinite;
-    st.t = m.t;
+    st.t = m.t0 + m.t;
     m.failed = true;
     observe(out);
     return st;
   }
-  const double t_next = m.t0 + static_cast<double>(m.k + 1) * m.dt;
+  const double t_next = static_cast<double>(m.k + 1) * m.dt;  // local time
   Status st;
   if (!m.cmd_delay.any()) {
     // Zero-order hold: the command is held over the sample, its rate is the last increment / dt.
@@ -227,6 +233,7 @@ Status Plant::step(double command, Output& out) noexcept {
     m.commands.put(m.k, command);
     st = m.advance_delayed(t_next);
   }
+  st.t += m.t0;
   if (st.ok() && !m.state_ok()) {
     st.code = Status::NonFinite;
   }
@@ -242,14 +249,14 @@ Status Plant::step(double command, Output& out) noexcept {
 
 void Plant::observe(Output& out) const noexcept {
   const Impl& m = *impl_;
-  out.time = m.t;
+  out.time = m.t0 + m.t;
   m.dyn.outputs(m.y.data(), m.input, out);
   // Acquisition delays: the measured channels as the controller sees them (docs/specimens.md).
   if (m.disp_delay.any()) out.displacement = m.displacements.delayed(m.k, m.disp_delay);
   if (m.force_delay.any()) out.force = m.forces.delayed(m.k, m.force_delay);
 }
 
-double Plant::time() const noexcept { return impl_->t; }
+double Plant::time() const noexcept { return impl_->t0 + impl_->t; }
 double Plant::dt() const noexcept { return impl_->dt; }
 const State& Plant::state() const noexcept { return impl_->y; }
 const Dynamics& Plant::dynamics() const noexcept { return impl_->dyn; }

@@ -12,12 +12,29 @@ file in one line::
 :class:`FileSet` does the same for several files that belong together (a
 diagnosis: JSON, rig file, report, plots): they are renamed into place only
 after all of them were written.
+
+Targets that are not regular files are not replaced (a rename would swap a
+device node or a link for a regular file, e.g. as root ``--out /dev/null``
+would replace the system's ``/dev/null``):
+
+* a **symbolic link is followed**: the file it points to is replaced, the
+  link stays (it is usually there to name where results go, e.g.
+  ``latest.csv -> runs/7/record.csv``; replacing it would silently detach it);
+  a dangling link creates the file it names;
+* a **character device** (``/dev/null``, a terminal) is **written through**:
+  the finished file's bytes are copied into it (no atomicity to keep there);
+* a FIFO, a socket or a block device is **refused** (``WriteError`` naming it):
+  writing a FIFO blocks until some reader opens it, and a disk is never an
+  output file.
 """
 
 from __future__ import annotations
 
 import errno
 import os
+import shutil
+import stat
+import tempfile
 import uuid
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -49,6 +66,49 @@ def _failure(path: Path, e: OSError) -> WriteError:
     return WriteError(path, e.errno, reason)
 
 
+def _special(path: Path) -> str | None:
+    """What ``path`` is when it exists and is neither a regular file nor a directory, else None."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return None
+    for test, kind in ((stat.S_ISCHR, "character device"), (stat.S_ISFIFO, "FIFO"), (stat.S_ISSOCK, "socket"),
+                       (stat.S_ISBLK, "block device")):
+        if test(mode):
+            return kind
+    return None
+
+
+def _followed(link: Path) -> Path:
+    """The file a symbolic link leads to (it may not exist yet); WriteError for a loop."""
+    try:
+        return Path(os.path.realpath(link, strict=True))
+    except FileNotFoundError:  # dangling: the write creates the file it names
+        return Path(os.path.realpath(link))
+    except OSError as e:
+        raise _failure(link, e) from None
+
+
+def _copy_into(tmp: Path, device: Path) -> None:
+    """Writes the finished temporary's bytes into a character device and removes the temporary."""
+    with open(tmp, "rb") as src, open(device, "wb") as dst:
+        shutil.copyfileobj(src, dst)
+    _remove(tmp)
+
+
+def check_folder(folder: str | Path) -> Path:
+    """Creates ``folder`` (and its parents) and proves a file can be written in it, so a
+    command fails before its computation, not after; WriteError naming the folder otherwise."""
+    folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=folder, prefix=".write_check."):
+            pass
+    except OSError as e:
+        raise _failure(folder, e) from None
+    return folder
+
+
 def _remove(p: Path) -> None:
     try:
         p.unlink()
@@ -67,13 +127,20 @@ class FileSet:
 
     def __init__(self) -> None:
         self._pending: list[tuple[Path, Path]] = []
+        self._through: set[Path] = set()  # temporaries copied into a character device, not renamed
 
     def path(self, target: str | Path) -> Path:
         target = Path(target)
         if target.name in ("", ".", "..") or target.is_dir():
             raise WriteError(target, errno.EISDIR, "it is a directory")
-        tmp = _temporary(target)
-        self._pending.append((tmp, target))
+        real = _followed(target) if target.is_symlink() else target  # followed, never replaced
+        kind = _special(real)
+        if kind is not None and kind != "character device":
+            raise WriteError(target, errno.EINVAL, f"it is a {kind}, not a regular file (refusing to replace it)")
+        tmp = _temporary(real)
+        if kind is not None:
+            self._through.add(tmp)
+        self._pending.append((tmp, real))
         return tmp
 
     def write_text(self, target: str | Path, text: str) -> Path:
@@ -95,7 +162,10 @@ class FileSet:
                     if not tmp.exists():
                         raise FileNotFoundError(2, "it was not written")
                 for tmp, target in self._pending:
-                    os.replace(tmp, target)
+                    if tmp in self._through:
+                        _copy_into(tmp, target)
+                    else:
+                        os.replace(tmp, target)
                 return False
         except OSError as e:
             exc = e
@@ -129,4 +199,4 @@ def write_with(path: str | Path, writer: Callable[[Path], object]) -> Path:
     return Path(path)
 
 
-__all__ = ["FileSet", "WriteError", "atomic_path", "write_text", "write_with"]
+__all__ = ["FileSet", "WriteError", "atomic_path", "check_folder", "write_text", "write_with"]

@@ -35,9 +35,10 @@ def _simulate(args: argparse.Namespace) -> int:
 
 def _reproduce(args: argparse.Namespace) -> int:
     from .paper.reproduce import reproduce
+    from .workers import check_workers
 
-    if args.workers < 1:
-        raise ValueError(f"invalid --workers = {args.workers}: must be >= 1")
+    if args.workers is not None:
+        check_workers(args.workers, "--workers")
     rep = reproduce(out=args.out, quick=args.quick, workers=args.workers)
     print(f"wrote {args.out}/reproduction.md: {rep.agree_count} of {len(rep.rows)} rows agree, "
           f"{len(rep.figures)} figures, {rep.runtime:.1f} s")
@@ -85,7 +86,8 @@ def build_parser() -> argparse.ArgumentParser:
     r = sub.add_parser("reproduce", help="regenerate the paper's figures and reproduction.md (paper vs ours)")
     r.add_argument("--out", default="reproduction", help="output directory (default: reproduction)")
     r.add_argument("--quick", action="store_true", help="shorter sweeps (a faster, coarser table)")
-    r.add_argument("--workers", type=int, default=2, help="parallel processes for the sections (default: 2)")
+    r.add_argument("--workers", type=int, default=None,
+                   help="parallel processes for the sections, 1 .. the processors (default: 2)")
     r.set_defaults(func=_reproduce)
     g = sub.add_parser("diagnose", help="name the effect the model is missing in lab records, fit it, show the gap")
     g.add_argument("records", nargs="+", help="record CSV file(s) of the same rig (time, command, displacement, force)")

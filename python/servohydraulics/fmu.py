@@ -32,11 +32,14 @@ from . import _core
 from .loops import eft_config, rpsd_config
 from .response import Response
 from .rig import Rig, load_rig, rig_to_dict
-from .simulate import MODES
+from .simulate import MODES, check_x0
+from .timegrid import positive
 
 KINDS = _core.FMU_KINDS  #: ("plant", "eft", "rpsd"), the FMU model's table (cpp/fmu/model.hpp)
 #: The binary CMake builds (cpp/fmu) and installs into the package.
 BINARY = "servohydraulics_fmu.so"
+#: Longest modelIdentifier: it names binaries/linux64/<name>.so (file names end at 255 bytes).
+MAX_NAME = 200
 #: The control mode each controller drives.
 CONTROLLER_MODES = {"eft": "force", "rpsd": "displacement"}
 
@@ -180,8 +183,22 @@ def model_description(kind: str, mode: str, name: str, guid: str, dt: float, var
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 
 
+def settings(kind: str) -> list[str]:
+    """The controller settings an FMU of ``kind`` takes (``export_fmu``'s ``**config``; none for the plant)."""
+    import inspect
+
+    if kind == "plant":
+        return []
+    maker = eft_config if kind == "eft" else rpsd_config
+    skip = {"dt", "solver_options", "physical_mass_fraction"}  # dt is its own argument; the others are the loop's
+    return [p for p in inspect.signature(maker).parameters if p not in skip]
+
+
 def _configs(kind: str, dt: float | None, config: dict):
     eft, rpsd = _core.EftConfig(), _core.RpsdConfig()
+    unknown = sorted(set(config) - set(settings(kind)) - {"physical_mass_fraction"})
+    if unknown and kind != "plant":
+        raise ValueError(f"invalid setting {unknown[0]!r} for kind = {kind!r}: expected one of {settings(kind)}")
     if kind == "eft":
         eft = eft_config(dt, **config)
     elif kind == "rpsd":
@@ -206,9 +223,12 @@ def _check(kind: str, mode: str | None, name: str | None) -> tuple[str, str]:
     elif mode not in (None, CONTROLLER_MODES[kind]):
         raise ValueError(f"invalid mode = {mode!r} for kind = {kind!r}: the {kind} controller drives "
                          f"{CONTROLLER_MODES[kind]} control")
-    name = name or f"servohydraulics_{kind}"
-    if not name.isidentifier() or not name.isascii():
+    name = f"servohydraulics_{kind}" if name is None else name
+    if not isinstance(name, str) or not name.isidentifier() or not name.isascii():
         raise ValueError(f"invalid name = {name!r}: the modelIdentifier must be a C identifier")
+    if len(name) > MAX_NAME:
+        raise ValueError(f"invalid name = {name[:40]!r}... ({len(name)} characters): the modelIdentifier names "
+                         f"the binary <name>.so, at most {MAX_NAME} characters")
     return mode or CONTROLLER_MODES[kind], name
 
 
@@ -225,10 +245,12 @@ def export_fmu(rig: Rig, path: str | os.PathLike, kind: str = "plant", mode: str
         mode: the plant's control mode, ``"displacement"`` (command in m),
             ``"force"`` (N) or ``"free"`` (N); the controllers' modes are fixed
             (EFT: force, RPsD: displacement).
-        dt: the controller sample [s] (None: the core's 0.5 ms): every doStep is a whole number of samples.
-        x0: the plant's initial displacement [m] (static equilibrium there).
+        dt: the controller sample [s] (None: the core's 0.5 ms; finite, >= 1e-7 s): every doStep is a
+            whole number of samples, at most 10 million of them.
+        x0: the plant's initial displacement [m] (static equilibrium there; within +-100 m as ``simulate``).
         solver_options: the plant's ODE integrator (``sh.solver_options(...)``).
-        name: the FMU's modelIdentifier (default ``servohydraulics_<kind>``).
+        name: the FMU's modelIdentifier (default ``servohydraulics_<kind>``; a C identifier of at
+            most ``MAX_NAME`` characters).
         **config: the controller's settings, as ``run_eft`` / ``run_rpsd`` take them
             (EFT: compensation, lead_T, alpha, mass, compute_delay; RPsD: m_m, c_m,
             k_m, scheme, restoring_force, amplitude_T, delay_T, alpha,
@@ -239,8 +261,9 @@ def export_fmu(rig: Rig, path: str | os.PathLike, kind: str = "plant", mode: str
         when the package was built without the FMU binary.
     """
     mode, name = _check(kind, mode, name)
-    if not math.isfinite(x0):
-        raise ValueError(f"invalid x0 = {x0!r}: must be finite [m]")
+    x0 = check_x0(x0)  # as simulate checks it
+    if dt is not None:
+        dt = positive("dt", dt)  # and >= _core.FMU_MIN_DT: fmu_variables checks it (cpp/fmu/model.hpp)
     dt, eft, rpsd = _configs(kind, dt, config)
     solver = solver_options or _core.SolverOptions()
     variables = _core.fmu_variables(kind, mode, rig, dt, float(x0), solver, eft, rpsd)
@@ -255,21 +278,18 @@ def export_fmu(rig: Rig, path: str | os.PathLike, kind: str = "plant", mode: str
 
 
 def _write_zip(path: Path, files: dict[str, bytes], binary: Path, arcname: str) -> Path:
+    """The zip, through the package's atomic writer: replaced whole or not at all, with the
+    umask's permissions like every other output."""
+    from .atomic import atomic_path
+
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=path.name, suffix=".part", dir=path.parent)
-    os.close(fd)
-    try:
-        with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
-            for arc, data in files.items():
-                z.writestr(arc, data)
-            info = zipfile.ZipInfo(arcname)
-            info.external_attr = 0o755 << 16
-            info.compress_type = zipfile.ZIP_DEFLATED
-            z.writestr(info, binary.read_bytes())
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+    with atomic_path(path) as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
+        for arc, data in files.items():
+            z.writestr(arc, data)
+        info = zipfile.ZipInfo(arcname)
+        info.external_attr = 0o755 << 16
+        info.compress_type = zipfile.ZIP_DEFLATED
+        z.writestr(info, binary.read_bytes())
     return path
 
 
@@ -362,4 +382,5 @@ def cosimulate(plant, controller, ground_acceleration, external_force=None, rest
     return Response(channels, kind=kind, mode=CONTROLLER_MODES[kind], dt=p.dt, rig=rig)
 
 
-__all__ = ["BINARY", "KINDS", "binary_path", "cosimulate", "export_fmu", "model_description"]
+__all__ = ["BINARY", "KINDS", "MAX_NAME", "binary_path", "cosimulate", "export_fmu", "model_description",
+           "settings"]

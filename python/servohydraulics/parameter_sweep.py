@@ -33,10 +33,9 @@ from __future__ import annotations
 
 import itertools
 import math
-import os
 import time
 from collections.abc import Mapping, Sequence
-from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
+from concurrent.futures import Executor, as_completed
 from typing import Any, Callable
 
 import numpy as np
@@ -47,6 +46,7 @@ from . import _core
 from .excitations import sine
 from .rig import EFFECTS, PARAMETERS, Rig, rig_from_dict, zhao2003
 from .simulate import simulate, solver_options
+from .workers import default_workers, process_pool
 
 _RIG_KEYS = {f"{p.section}.{p.key}" for p in PARAMETERS} | {f"effects.{e}" for e in EFFECTS} | {
     "servovalve.flow_curve.b"}
@@ -189,8 +189,9 @@ def sweep(grid: Mapping[str, Sequence[Any]] | None = None, *,
         fixed: names set for every run (rig keys or keyword arguments).
         executor: any ``concurrent.futures.Executor``, e.g. a
             ``ProcessPoolExecutor`` or a Dask ``client.get_executor()``; the
-            caller owns it.  None: a ``ProcessPoolExecutor(max_workers)``
-            created and shut down here.
+            caller owns it.  None: a process pool of ``max_workers`` (1 ..
+            ``os.cpu_count()``, default all) whose workers die with this
+            process, created and shut down here.
         progress: show a tqdm progress bar.
         keep_records: keep a ``record`` column (only with ``summary_run``
             or a run function that returns one); otherwise it is dropped.
@@ -222,7 +223,7 @@ def sweep(grid: Mapping[str, Sequence[Any]] | None = None, *,
 
     own = executor is None
     if own:
-        executor = ProcessPoolExecutor(max_workers=max_workers or os.cpu_count() or 1)
+        executor = process_pool(default_workers() if max_workers is None else max_workers, "max_workers")
     results: list[dict[str, Any] | None] = [None] * len(jobs)
     try:
         futures = {executor.submit(_job, run, base, rp, kw): i for i, (rp, kw) in enumerate(jobs)}

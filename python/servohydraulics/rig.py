@@ -184,6 +184,9 @@ def load_rig(path: str | Path) -> Rig:
         raise ValueError(f"rig file {path} is not valid TOML: {e}") from None
     except IsADirectoryError:
         raise ValueError(f"rig file {path} is a directory") from None
+    except RecursionError:  # tomllib recurses once per level of nested arrays or tables
+        raise ValueError(f"rig file {path} is not valid TOML here: arrays or tables nested too deeply "
+                         f"(beyond Python's recursion limit of {sys.getrecursionlimit()})") from None
     try:
         return rig_from_dict(data)
     except ValueError as e:

@@ -87,7 +87,19 @@ def _command_array(command: ArrayLike | None, duration: float | None, dt: float)
         if not math.isfinite(duration) or duration <= 0:
             raise ValueError(f"invalid duration = {duration!r}: must be finite and > 0 [s]")
         return np.zeros(time_axis(duration, dt).size)
-    u = np.asarray(command, dtype=float)
+    try:
+        u = np.asarray(command)
+        if np.iscomplexobj(u):  # a float cast drops the imaginary part (a ComplexWarning at most)
+            bad = np.flatnonzero(np.ravel(u.imag) != 0)
+            if bad.size:
+                raise ValueError(f"invalid command[{bad[0]}] = {np.ravel(u)[bad[0]]}: complex; the command is "
+                                 "real [m or N]")
+            u = u.real
+        u = u.astype(float)
+    except (TypeError, ValueError) as e:
+        if str(e).startswith("invalid command"):
+            raise
+        raise ValueError(f"invalid command: not an array of numbers ({' '.join(str(e).split())})") from None
     if u.ndim != 1:
         raise ValueError(f"invalid command shape = {u.shape}: expected a 1-D array")
     if u.size < 2:
@@ -103,14 +115,20 @@ def _command_array(command: ArrayLike | None, duration: float | None, dt: float)
     return u
 
 
+def check_x0(x0: float) -> float:
+    """The initial displacement as a float; ValueError naming it unless finite and within +-MAX_X0 m."""
+    if isinstance(x0, bool) or not isinstance(x0, (int, float)) or not math.isfinite(x0) or abs(x0) > MAX_X0:
+        raise ValueError(f"invalid x0 = {x0!r}: must be finite and within +-{MAX_X0:g} m (the plant's "
+                         "divergence guard)")
+    return float(x0)
+
+
 def make_plant(rig: Rig, mode: str, dt: float = 5e-4, options: _core.SolverOptions | None = None,
                x0: float = 0.0) -> _core.Plant:
     """Constructs and resets a plant (validates everything, raises ValueError)."""
     if mode not in MODES:
         raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(MODES)}")
-    if not math.isfinite(x0) or abs(x0) > MAX_X0:
-        raise ValueError(f"invalid x0 = {x0!r}: must be finite and within +-{MAX_X0:g} m (the plant's "
-                         "divergence guard)")
+    check_x0(x0)
     plant = _core.Plant(rig, MODES[mode], _check_dt(dt), options or solver_options())
     plant.reset(float(x0))
     return plant

@@ -81,3 +81,117 @@ def test_simulate_arguments(tmp_path, mode, dt, duration, amplitude, frequency, 
     else:
         assert not out.exists(), "a failed invocation left its output file"
         assert err.strip().startswith(("servohydraulics simulate: error:", "usage:")), err
+
+
+# ----------------------------------------------------------------------------- fmu export flags (issue 26)
+
+NAMES = st.one_of(st.sampled_from(["plant_1", "a" * 200, "a" * 201, "a" * 5000, "x<y", "a&b", "\x01", "é", "1abc",
+                                   "", "class"]), st.text(max_size=30))
+SETTINGS = st.lists(st.tuples(st.sampled_from(["compensation", "lead_T", "alpha", "mass", "compute_delay", "m_m",
+                                               "scheme", "delay_T", "physical_mass_fraction", "solver_options",
+                                               "name", "foo", ""]),
+                              st.one_of(st.sampled_from(["nonlinear", "1", "nan", "-1", "1e300", "1j", "", "="]),
+                                        st.floats(allow_nan=True).map(repr))), max_size=2)
+
+
+@settings(max_examples=150, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(kind=st.sampled_from(["plant", "eft", "rpsd", "valve"]),
+       mode=st.sampled_from([None, "displacement", "force", "free"]),
+       dt=st.one_of(st.none(), st.sampled_from([5e-4, 1e-3, 1e-7, 5e-16]), FLOATS),
+       x0=st.one_of(st.floats(-0.01, 0.01), FLOATS), name=st.one_of(st.none(), NAMES), sets=SETTINGS)
+@counted(OUTCOMES)
+def test_fmu_export_flags(tmp_path, kind, mode, dt, x0, name, sets):
+    """Every drawn export ends in a valid FMU (its XML parses, its stepSize is the finite dt, the
+    file follows the umask) or one named error and no file."""
+    import os
+    import stat
+    from xml.etree import ElementTree as ET
+    from zipfile import ZipFile
+
+    out = tmp_path / f"{uuid.uuid4().hex[:8]}.fmu"
+    argv = ["fmu", "--kind", kind, f"--x0={x0!r}", "--out", str(out)]
+    argv += ["--mode", mode] if mode else []
+    argv += [f"--dt={dt!r}"] if dt is not None else []
+    argv += [f"--name={name}"] if name is not None else []
+    for key, value in sets:
+        argv += ["--set", f"{key}={value}"]
+    outcome, code, err = run_case(argv)
+    OUTCOMES[outcome] += 1
+    assert outcome in ("ok", "error"), f"{argv}: {err}"
+    assert "Traceback" not in err and "internal error" not in err, err
+    if outcome == "error":
+        assert code == 2 and "error: " in err, err
+        assert not out.exists(), f"{argv}: left a file"
+    else:
+        with ZipFile(out) as z:
+            md = ET.fromstring(z.read("modelDescription.xml"))
+        step = float(md.find("DefaultExperiment").get("stepSize"))
+        assert math.isfinite(step) and step >= 1e-7 and (dt is None or step == dt)
+        assert stat.S_IMODE(os.stat(out).st_mode) == 0o666 & ~_umask()
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")], "temporary left behind"
+
+
+def _umask() -> int:
+    import os
+
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+# ----------------------------------------------------------------------------- rths data folders (issue 26)
+
+@settings(max_examples=150, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(matrix=st.sampled_from(["M", "C", "K"]),
+       change=st.sampled_from(["none", "negate", "zero", "asymmetric", "nan", "inf", "complex", "row", "transpose",
+                               "scale", "missing", "text", "empty"]),
+       record=st.sampled_from(["none", "shuffle", "repeat", "uneven", "nan", "one_row", "three_rows", "reverse",
+                               "missing", "empty_file", "garbage_file"]),
+       scale=st.floats(1e-6, 1e6))
+@counted(OUTCOMES)
+def test_rths_data_folder(tmp_path, matrix, change, record, scale):
+    """A drawn official-layout folder (Case_1.mat, ElCentroAccelNoScaling.mat) with one defect: the
+    loaders return data that hold the benchmark's invariants, or a ValueError naming the file."""
+    import numpy as np
+    import scipy.io as sio
+
+    from servohydraulics.rths.data import embedded_case, load_case, load_record
+
+    c = embedded_case(1)
+    mats = {"M": c.M.copy(), "C": c.C.copy(), "K": c.K.copy()}
+    a = mats[matrix]
+    mats[matrix] = {"none": a, "negate": -a, "zero": 0 * a, "nan": np.where(a == a.max(), np.nan, a),
+                    "inf": np.where(a == a.max(), np.inf, a), "complex": a * (1 + 1e-3j), "row": a[:2],
+                    "transpose": a.T, "scale": a * scale, "text": "abc", "empty": np.zeros((0, 0)),
+                    "asymmetric": a + np.triu(np.full(a.shape, 1e-3 * np.abs(a).max()), 1), "missing": None}[change]
+    sio.savemat(tmp_path / "Case_1.mat", {k: v for k, v in mats.items() if v is not None})
+    t = np.arange(300) * 0.01
+    acc = np.sin(3 * t)
+    rows = {"none": [t, acc], "shuffle": [np.r_[t[:5], t[6], t[5], t[7:]], acc], "repeat": [np.r_[t[:5], t[4:-1]], acc],
+            "uneven": [t + np.where(t > 1, 0.004, 0), acc], "nan": [t, np.where(t > 2, np.nan, acc)],
+            "one_row": [t], "three_rows": [t, acc, acc], "reverse": [t[::-1], acc]}.get(record)
+    path = tmp_path / "ElCentroAccelNoScaling.mat"
+    if rows is not None:
+        sio.savemat(path, {"ElCentroAccel": np.vstack(rows)})
+    elif record == "missing":
+        sio.savemat(path, {"Other": t})
+    else:
+        path.write_bytes(b"" if record == "empty_file" else b"MATLAB 5.0 MAT-file\0" + bytes(range(256)))
+    for load, file in ((lambda: load_case(tmp_path, 1), "Case_1.mat"),
+                       (lambda: load_record(tmp_path, "elcentro"), "ElCentroAccelNoScaling.mat")):
+        try:
+            got = load()
+        except ValueError as e:
+            OUTCOMES["error"] += 1
+            assert str(tmp_path / file) in str(e), f"the message does not name the file: {e}"
+            continue
+        OUTCOMES["ok"] += 1
+        if file == "Case_1.mat":  # a silent wrong answer would break one of these
+            for m in (got.M, got.C, got.K):
+                assert m.dtype == float and m.shape == (3, 3) and np.all(np.isfinite(m)) and np.allclose(m, m.T)
+            assert np.linalg.eigvalsh(got.M).min() > 0 and np.linalg.eigvalsh(got.K).min() > 0
+        else:
+            assert np.all(np.isfinite(got.acceleration)) and np.all(np.diff(got.time) > 0)
+            assert np.allclose(np.diff(got.time), 0.01)

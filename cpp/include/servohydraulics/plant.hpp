@@ -32,10 +32,12 @@ class Plant {
   Plant& operator=(Plant&&) noexcept;
 
   //! Restart at time t0 from the static equilibrium at displacement x0 (in
-  //! Free mode: released from x0 at rest).  Allocates nothing.
-  void reset(double x0 = 0.0, double t0 = 0.0) noexcept;
-  //! Restart from an explicit state.
-  void reset_state(const State& y0, double t0 = 0.0) noexcept;
+  //! Free mode: released from x0 at rest).  Allocates nothing.  The response
+  //! does not depend on t0 (the integrators run in time since the reset); a
+  //! non-finite t0 throws Error naming it.
+  void reset(double x0 = 0.0, double t0 = 0.0);
+  //! Restart from an explicit state (t0 as in reset).
+  void reset_state(const State& y0, double t0 = 0.0);
 
   //! Hold command u for one sample [m in displacement, N in force/free mode]
   //! and integrate to the next sample time t0 + (k + 1) dt (t0 of the last

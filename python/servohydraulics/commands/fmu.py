@@ -13,12 +13,17 @@ def _value(text: str):
     return text
 
 
-def _config(items: list[str]) -> dict:
+def _config(items: list[str], kind: str) -> dict:
+    from ..fmu import settings
+
     out = {}
     for item in items:
         key, sep, value = item.partition("=")
-        if not sep or not key:
-            raise SystemExit(f"invalid --set {item!r}: expected NAME=VALUE, e.g. compensation=nonlinear")
+        if not sep or not key.strip():
+            raise ValueError(f"invalid --set {item!r}: expected NAME=VALUE, e.g. compensation=nonlinear")
+        if key.strip() not in settings(kind):
+            raise ValueError(f"invalid --set {item!r}: the {kind} takes "
+                             + (f"one of {settings(kind)}" if settings(kind) else "no settings"))
         out[key.strip()] = _value(value.strip())
     return out
 
@@ -30,7 +35,7 @@ def _run(args) -> int:
 
     rig = load_rig(args.rig) if args.rig else zhao2003()
     path = export_fmu(rig, args.out, kind=args.kind, mode=args.mode, dt=args.dt, x0=args.x0,
-                      solver_options=solver_options(args.method), name=args.name, **_config(args.set))
+                      solver_options=solver_options(args.method), name=args.name, **_config(args.set, args.kind))
     print(f"wrote {path} ({args.kind}, FMI 2.0 co-simulation, linux64)")
     return 0
 

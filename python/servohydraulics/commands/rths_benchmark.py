@@ -7,6 +7,9 @@ from __future__ import annotations
 def _run(args) -> int:
     from ..rths.data import RECORDS
     from ..rths.report import run_benchmark, write_outputs
+    from ..workers import check_workers
+    if args.workers is not None:
+        check_workers(args.workers, "--workers")  # before anything runs: 100000 was a fork bomb
     if args.data is None:
         motion = "the benchmark's chirp" if args.record == "chirp" else "a synthetic ground motion"
         print("rths-benchmark: no --data: running the EMBEDDED DEFAULT (published structure parameters, "
@@ -43,7 +46,8 @@ def register(sub) -> None:
     p.add_argument("--noise", default="simulink", choices=["simulink", "mersenne"],
                    help="sensor-noise generator: simulink (default; the algorithm of Simulink's Random Number block "
                         "in the official SENSORS subsystem) or mersenne (a 64-bit Mersenne twister)")
-    p.add_argument("--workers", type=int, default=None, help="processes for the perturbed runs (default: all cores)")
+    p.add_argument("--workers", type=int, default=None,
+                   help="processes for the perturbed runs, 1 .. the processors (default: all)")
     p.add_argument("--csi", default="exact", choices=["exact", "derivative-block"],
                    help="control-structure interaction: exact a2 dx/dt (default, the spec's) or the official code's "
                         "Simulink Derivative block")

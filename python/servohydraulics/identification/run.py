@@ -22,6 +22,7 @@ import numpy as np
 from ..response import Response, SimulationError
 from ..rig import Rig
 from ..simulate import simulate
+from ..timegrid import MAX_SAMPLES, positive
 
 #: the channels a record and a simulation share, compared in this order
 CHANNELS = ("displacement", "force")
@@ -34,6 +35,7 @@ def initial_displacement(record: Response, samples: int = 20) -> float:
 
 def _ratio(record_dt: float, dt: float) -> tuple[int, bool]:
     """(n, faster): the controller runs n times faster (True) or slower than the record."""
+    positive("dt", dt)
     for a, b, faster in ((record_dt, dt, True), (dt, record_dt, False)):
         n = a / b
         if abs(n - round(n)) <= 1e-6 * n and round(n) >= 1:
@@ -63,6 +65,9 @@ def simulate_command(rig: Rig, mode: str, command: np.ndarray, record_dt: float,
     n, faster = (1, True) if dt is None else _ratio(record_dt, float(dt))
     tr = np.arange(u.size) * record_dt
     if faster:
+        if (u.size - 1) * n + 1 > MAX_SAMPLES:  # simulate's cap, checked before the grid is allocated
+            raise ValueError(f"invalid dt = {dt!r}: {(u.size - 1) * n + 1:,} controller samples for the record's "
+                             f"{u.size:,} at {record_dt!r} s, more than the {MAX_SAMPLES:,} allowed")
         uc = u if n == 1 else np.interp(np.arange((u.size - 1) * n + 1) * (record_dt / n), tr, u)
         res = simulate(rig, mode=mode, command=uc, dt=record_dt / n, x0=x0, options=options)
         data = {k: np.asarray(v)[::n] for k, v in res.channels.items() if k != "time"}

@@ -18,7 +18,9 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
+from ..atomic import check_folder
 from ..rig import Rig, zhao2003
+from ..workers import check_workers, default_workers, process_pool
 from . import evaluate as ev
 from . import experiments as xp
 from . import figures
@@ -85,13 +87,12 @@ def _check(names: list, workers) -> None:
     for n in names:
         if n not in SECTIONS:
             raise ValueError(f"invalid section = {n!r}: expected one of {list(SECTIONS)}")
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise ValueError(f"invalid workers = {workers!r}: must be an integer >= 1")
+    check_workers(workers)
 
 
 def _run_all(names: list, out: Path, quick: bool, rig: Rig, workers: int, progress: bool) -> dict:
     """Runs the sections, the costliest first, in this process or a pool -> name -> _run_section's tuple."""
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures import as_completed
 
     from tqdm import tqdm
 
@@ -103,7 +104,7 @@ def _run_all(names: list, out: Path, quick: bool, rig: Rig, workers: int, progre
                 results[n] = _run_section(n, out, quick, rig)
                 bar.update()
         else:
-            with ProcessPoolExecutor(max_workers=min(workers, len(names))) as pool:
+            with process_pool(min(workers, len(names))) as pool:
                 futures = {pool.submit(_run_section, n, out, quick, rig): n for n in order}
                 for fut in as_completed(futures):
                     results[futures[fut]] = fut.result()
@@ -113,19 +114,21 @@ def _run_all(names: list, out: Path, quick: bool, rig: Rig, workers: int, progre
 
 
 def reproduce(out: str | Path = "reproduction", quick: bool = False, sections: Sequence[str] | None = None,
-              progress: bool = True, rig: Rig | None = None, workers: int = 2) -> Reproduction:
+              progress: bool = True, rig: Rig | None = None, workers: int | None = None) -> Reproduction:
     """Regenerates every figure and ``reproduction.md`` / ``reproduction.json`` in ``out``.
 
     quick: shorter sweeps in the structure and displacement sections (for tests; the
     test-method sections always use the 20 s sweeps their rows need); sections: subset
     of the section names (default all); rig: default the calibrated preset; workers:
-    processes running independent sections at once (1: all in this process).
+    processes running independent sections at once (1: all in this process; 1 ..
+    os.cpu_count(), default 2 or the machine's processors if fewer).
     """
     t0 = time.perf_counter()
     out = Path(out)
     names = list(SECTIONS) if sections is None else list(sections)
+    workers = default_workers(2) if workers is None else workers
     _check(names, workers)
-    out.mkdir(parents=True, exist_ok=True)
+    check_folder(out)  # a folder that cannot take the outputs fails now, not after the computation
     results = _run_all(names, out, quick, rig if rig is not None else zhao2003(), workers, progress)
     rows, paths, notes = [], [], []
     for n in names:  # the table's order does not depend on which worker finished first

@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["BenchmarkCase", "Record", "RECORDS", "CASES", "load_case", "load_record", "embedded_case",
+           "check_case", "check_record",
            "shear_building", "chirp_record",
            "synthetic_record", "reference_stiffness", "modal_damping", "FS", "DT", "EQ_INTENSITY"]
 
@@ -80,6 +81,85 @@ def _first_file(root: Path, names: list[str]) -> Path | None:
     return None
 
 
+#: Relative asymmetry a structural matrix may have: |A - A^T| <= SYMMETRY_RTOL max|A| (the official
+#: cases are symmetric to 2e-16; a file that is not was not written from a structure).
+SYMMETRY_RTOL = 1e-9
+
+
+def _read_mat(path: Path, names: list[str]) -> dict[str, np.ndarray]:
+    """The named variables of a MATLAB file; ValueError naming the file (and the variable) otherwise."""
+    import scipy.io as sio
+    try:
+        d = sio.loadmat(str(path))
+    except Exception as e:  # noqa: BLE001 - scipy raises many types for a malformed file
+        raise ValueError(f"{path}: cannot read this MATLAB file ({type(e).__name__}: "
+                         f"{' '.join(str(e).split()) or 'malformed'})") from None
+    missing = [n for n in names if n not in d]
+    if missing:
+        have = sorted(k for k in d if not k.startswith("__"))
+        raise ValueError(f"{path}: variable {missing[0]!r} missing (the file holds {have})")
+    return {n: d[n] for n in names}
+
+
+def _real_array(value, where: str, ndim: int) -> np.ndarray:
+    """``value`` as a finite real float array of ``ndim`` dimensions; ValueError naming ``where``."""
+    a = np.asarray(value)
+    if np.iscomplexobj(a):
+        raise ValueError(f"{where}: complex values; the benchmark's data are real")
+    if a.dtype == object or a.dtype.kind not in "biuf":
+        raise ValueError(f"{where}: not a numeric array (dtype {a.dtype})")
+    a = a.astype(float)
+    if a.ndim != ndim:
+        raise ValueError(f"{where}: expected a {ndim}-D array, got shape {a.shape}")
+    bad = np.argwhere(~np.isfinite(a))
+    if bad.size:
+        i = tuple(int(v) for v in bad[0])
+        raise ValueError(f"{where}: entry {list(i)} = {a[i]}: must be finite")
+    return a
+
+
+def check_case(case: BenchmarkCase) -> BenchmarkCase:
+    """Validates a case: M, C, K real, finite, square, of one size, symmetric; M and K positive
+    definite; C positive semi-definite.  ValueError naming the source and the matrix otherwise."""
+    mats = {}
+    for name in ("M", "C", "K"):
+        a = _real_array(getattr(case, name), f"{case.source}: {name}", 2)
+        if a.shape[0] != a.shape[1] or a.shape[0] < 1:
+            raise ValueError(f"{case.source}: {name} must be square, got shape {a.shape}")
+        scale = float(np.max(np.abs(a)))
+        asym = float(np.max(np.abs(a - a.T)))
+        if asym > SYMMETRY_RTOL * scale:
+            i, j = np.unravel_index(int(np.argmax(np.abs(a - a.T))), a.shape)
+            raise ValueError(f"{case.source}: {name} must be symmetric; {name}[{i},{j}] = {a[i, j]:.9g} but "
+                             f"{name}[{j},{i}] = {a[j, i]:.9g}")
+        mats[name] = a
+    shapes = {n: a.shape for n, a in mats.items()}
+    if len(set(shapes.values())) != 1:
+        raise ValueError(f"{case.source}: M, C and K must have one size, got {shapes}")
+    for name, definite in (("M", True), ("K", True), ("C", False)):
+        a = mats[name]
+        low = float(np.min(np.linalg.eigvalsh(0.5 * (a + a.T))))
+        tol = 1e-12 * float(np.max(np.abs(a)))
+        if (definite and not low > tol) or (not definite and low < -tol * 1e3):
+            need = "positive definite" if definite else "positive semi-definite"
+            raise ValueError(f"{case.source}: {name} must be {need}; its smallest eigenvalue is {low:.6g}")
+    case.M, case.C, case.K = mats["M"], mats["C"], mats["K"]
+    return case
+
+
+def check_record(rec: Record) -> Record:
+    """Validates a record: finite, real, 1-D, of one length, on a uniform increasing time row."""
+    from ..timegrid import uniform_dt
+
+    t = _real_array(rec.time, f"{rec.source}: time", 1)
+    a = _real_array(rec.acceleration, f"{rec.source}: acceleration", 1)
+    if t.size != a.size:
+        raise ValueError(f"{rec.source}: time has {t.size} samples but acceleration {a.size}")
+    uniform_dt(t, f"{rec.source}: time")
+    rec.time, rec.acceleration = t, a
+    return rec
+
+
 def load_case(root: str | Path, number: int) -> BenchmarkCase:
     """Case N from the official ``Case_N.mat`` (either layout) or ``building_cases.json``."""
     if number not in CASES:
@@ -89,15 +169,24 @@ def load_case(root: str | Path, number: int) -> BenchmarkCase:
         raise ValueError(f"invalid data = {str(root)!r}: not a directory")
     p = _first_file(root, [f"Building cases/Case_{number}.mat", f"Case_{number}.mat"])
     if p is not None:
-        import scipy.io as sio
-        d = sio.loadmat(str(p))  # sys_r (an ss object) is opaque to scipy: rebuilt from M, C, K
-        return BenchmarkCase(number, np.asarray(d["M"], dtype=float), np.asarray(d["C"], dtype=float),
-                             np.asarray(d["K"], dtype=float), source=str(p))
+        d = _read_mat(p, ["M", "C", "K"])  # sys_r (an ss object) is opaque to scipy: rebuilt from M, C, K
+        return check_case(BenchmarkCase(number, d["M"], d["C"], d["K"], source=str(p)))
     j = _first_file(root, ["building_cases.json", "../building_cases.json"])
     if j is not None:
-        c = json.loads(j.read_text())["cases"][f"case_{number}"]
-        return BenchmarkCase(number, np.array(c["M"], dtype=float), np.array(c["C"], dtype=float),
-                             np.array(c["K"], dtype=float), source=str(j))
+        try:
+            c = json.loads(j.read_text(encoding="utf-8"))["cases"][f"case_{number}"]
+            mats = [c[n] for n in ("M", "C", "K")]
+        except (OSError, UnicodeDecodeError, ValueError) as e:
+            raise ValueError(f"{j}: cannot read this JSON file ({' '.join(str(e).split())})") from None
+        except (KeyError, TypeError) as e:
+            raise ValueError(f"{j}: no cases.case_{number} with M, C and K ({type(e).__name__}: {e})") from None
+        arrays = []
+        for n, m in zip("MCK", mats):
+            try:
+                arrays.append(np.array(m))
+            except ValueError as e:  # ragged rows
+                raise ValueError(f"{j}: cases.case_{number}.{n}: not a matrix ({' '.join(str(e).split())})") from None
+        return check_case(BenchmarkCase(number, *arrays, source=f"{j} (cases.case_{number})"))
     raise ValueError(f"invalid data = {str(root)!r}: Case_{number}.mat not found (neither "
                      "'Building cases/Case_N.mat' nor 'Case_N.mat' nor building_cases.json)")
 
@@ -113,16 +202,35 @@ def load_record(root: str | Path | None, name: str) -> Record:
     fname, var, csv_name = RECORDS[name]
     p = _first_file(root, [fname])
     if p is not None:
-        import scipy.io as sio
-        t, a = np.asarray(sio.loadmat(str(p))[var], dtype=float)
-        return Record(name, t.copy(), a.copy(), source=str(p))
+        arr = np.asarray(_read_mat(p, [var])[var])
+        if arr.ndim != 2 or arr.shape[0] != 2:
+            raise ValueError(f"{p}: variable {var!r} must be 2 rows (time, acceleration), got shape {arr.shape}")
+        return check_record(Record(name, arr[0].copy(), arr[1].copy(), source=str(p)))
     c = _first_file(root, [csv_name, f"../{csv_name}"])
     if c is not None:
-        with open(c, newline="") as fh:
-            rows = list(csv.reader(fh))
-        arr = np.array([[float(v) for v in r] for r in rows[1:]])
-        return Record(name, arr[:, 0].copy(), arr[:, 1].copy(), source=str(c))
+        return check_record(Record(name, *_read_csv(c), source=str(c)))
     raise ValueError(f"invalid data = {str(root)!r}: {fname} not found")
+
+
+def _read_csv(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """(time, acceleration) of a record's CSV copy (a header row, then two numbers a row)."""
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            rows = list(csv.reader(fh))
+    except (OSError, UnicodeDecodeError, csv.Error) as e:
+        raise ValueError(f"{path}: cannot read this CSV file ({' '.join(str(e).split())})") from None
+    values = []
+    for i, r in enumerate(rows[1:], start=2):
+        try:
+            t, a = (float(v) for v in r)
+        except ValueError:
+            raise ValueError(f"{path}: line {i} = {','.join(r)[:80]!r}: expected two numbers "
+                             "(time, acceleration)") from None
+        values.append((t, a))
+    if not values:
+        raise ValueError(f"{path}: no data rows")
+    arr = np.array(values)
+    return arr[:, 0].copy(), arr[:, 1].copy()
 
 
 # ----------------------------------------------------------------------------- embedded default

@@ -5,14 +5,13 @@ from __future__ import annotations
 
 import json
 import math
-import os
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
 
 from ..atomic import FileSet
+from ..workers import check_workers, default_workers, process_pool
 from .benchmark import FORCE_LIMIT, controller_label, noise_generator, run_case
 from .data import EQ_INTENSITY, embedded_case, load_case, load_record, synthetic_record
 from .evaluation import J_LABELS, J_NAMES
@@ -77,17 +76,19 @@ def run_benchmark(data: str | Path | None = None, record: str = "elcentro", case
     elif data is None:
         meta["label"] = ("EMBEDDED DEFAULT: reference structure rebuilt from the published parameters, driven by the "
                          "benchmark's chirp (no published results).")
+    loaded = {n: load(n) for n in case_list}  # every case validated before the first run
     trials, tables = {}, {}
     # a controller object cannot go to worker processes: run_case then runs its trials here, one after another
     parallel = perturbed > 0 and isinstance(controller, str)
-    executor = ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1) if parallel else None
+    workers = default_workers() if workers is None else check_workers(workers)
+    executor = process_pool(workers) if parallel else None
     bar = None
     if progress:
         from tqdm.auto import tqdm
         bar = tqdm(total=len(case_list) * (1 + int(perturbed)), desc="rths-benchmark", unit="run")
     try:
         for n in case_list:
-            case = load(n)
+            case = loaded[n]
             out = run_case(case, rec, controller, perturbed=int(perturbed), seed=seed, scale=scale,
                            executor=executor, progress=False, keep_signals=True,
                            csi_derivative_block=csi == "derivative-block", noise=noise)

@@ -155,6 +155,56 @@ void bad_parameter_is_an_error(const Api& api) {
   CHECK(g_log.find("cannot read") != std::string::npos);
 }
 
+//! Issue 26: a non-finite start time is refused; a doStep of more than kMaxSamplesPerStep samples
+//! returns at once with fmi2Error and a message; dt below kMinDt is refused at initialisation; a
+//! plant started at a Unix time (1.7e9 s) gives the outputs of one started at 0, bit for bit.
+void timing_limits(const Api& api) {
+  const std::string dir = resources("plant", "displacement");
+  const std::string uri = "file://" + dir;
+  fmi2Component c = api.instantiate("t", fmi2CoSimulation, "{test}", uri.c_str(), &kCallbacks, fmi2False, fmi2False);
+  CHECK(api.setup(c, fmi2False, 0.0, NAN, fmi2False, 0.0) == fmi2Error);
+  CHECK(g_log.find("invalid startTime = nan") != std::string::npos);
+  CHECK(api.setup(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) == fmi2OK);
+  CHECK(api.enter(c) == fmi2OK);
+  const fmi2ValueReference dt_vr = vr(fmu::Kind::Plant, ControlMode::Displacement, "dt");
+  const double tiny = 5e-16, dt = 5e-4;
+  CHECK(api.set_real(c, &dt_vr, 1, &tiny) == fmi2OK);
+  CHECK(api.exit(c) == fmi2Error);
+  CHECK(g_log.find("invalid dt = 5e-16") != std::string::npos);
+  api.free_instance(c);
+
+  fmi2Component a = start(api, dir, "a");
+  const double huge = 2.0 * static_cast<double>(fmu::kMaxSamplesPerStep) * dt;
+  CHECK(api.do_step(a, 0.0, huge, fmi2True) == fmi2Error);
+  CHECK(g_log.find("more than the 10000000") != std::string::npos);
+  CHECK(api.do_step(a, 0.0, INFINITY, fmi2True) == fmi2Error);
+  CHECK(api.do_step(a, 0.0, dt, fmi2True) == fmi2OK);  // a bad step size can be retried
+
+  // the same commands from t = 0 and t = 1.7e9 s: the same outputs
+  fmi2Component b = api.instantiate("b", fmi2CoSimulation, "{test}", uri.c_str(), &kCallbacks, fmi2False, fmi2False);
+  const double t0 = 1.7e9;
+  CHECK(api.setup(b, fmi2False, 0.0, t0, fmi2False, 0.0) == fmi2OK);
+  CHECK(api.enter(b) == fmi2OK);
+  CHECK(api.exit(b) == fmi2OK);
+  const fmi2ValueReference u_vr = vr(fmu::Kind::Plant, ControlMode::Displacement, "command");
+  const fmi2ValueReference x_vr = vr(fmu::Kind::Plant, ControlMode::Displacement, "force");
+  fmi2Component z = start(api, dir, "z");
+  long differ = 0;
+  for (int k = 0; k < 1000; ++k) {
+    const double u = 0.002 * std::sin(2 * M_PI * 5.0 * k * dt);
+    double yb = 0.0, yz = 0.0;
+    api.set_real(b, &u_vr, 1, &u);
+    api.set_real(z, &u_vr, 1, &u);
+    CHECK(api.do_step(b, t0 + k * dt, dt, fmi2True) == fmi2OK);
+    CHECK(api.do_step(z, k * dt, dt, fmi2True) == fmi2OK);
+    api.get_real(b, &x_vr, 1, &yb);
+    api.get_real(z, &x_vr, 1, &yz);
+    if (yb != yz) ++differ;
+  }
+  CHECK(differ == 0);
+  for (fmi2Component x : {a, b, z}) api.free_instance(x);
+}
+
 }  // namespace
 
 int main() {
@@ -168,5 +218,6 @@ int main() {
   controller_allocates_nothing(api, fmu::Kind::Eft, "eft", "force");
   controller_allocates_nothing(api, fmu::Kind::Rpsd, "rpsd", "displacement");
   bad_parameter_is_an_error(api);
+  timing_limits(api);
   return sh_test::report("test_fmu_binary");
 }
