@@ -25,16 +25,8 @@ import pytest
 fmpy = pytest.importorskip("fmpy")
 from fmpy import extract, read_model_description  # noqa: E402
 from fmpy.fmi1 import FMICallException  # noqa: E402
-from fmpy.fmi2 import (  # noqa: E402
-    FMU2Slave,
-    calloc,
-    fmi2CallbackAllocateMemoryTYPE,
-    fmi2CallbackFreeMemoryTYPE,
-    fmi2CallbackFunctions,
-    fmi2CallbackLoggerTYPE,
-    free,
-)
 from fmpy.validation import validate_fmu  # noqa: E402
+from fmu_support import instantiate  # noqa: E402
 
 import servohydraulics as sh  # noqa: E402
 from servohydraulics import _core  # noqa: E402
@@ -55,16 +47,7 @@ class Slave:
         self.md = read_model_description(self.dir)
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
         self.var = {v.name: v for v in self.md.modelVariables}
-        self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.dir,
-                             modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=instance)
-        callbacks = None
-        if logs is not None:
-            callbacks = fmi2CallbackFunctions()
-            callbacks.logger = fmi2CallbackLoggerTYPE(lambda env, name, status, cat, msg: logs.append(msg.decode()))
-            callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-            callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        self._callbacks = callbacks  # kept alive as long as the instance
-        self.fmu.instantiate(callbacks=callbacks)
+        self.fmu, self._callbacks = instantiate(self.dir, self.md, instance, logs)  # callbacks kept alive
         self.t = 0.0
         if start:
             self.start()

@@ -21,15 +21,7 @@ import servohydraulics as sh
 fmpy = pytest.importorskip("fmpy")
 from fmpy import extract, read_model_description  # noqa: E402
 from fmpy.fmi1 import FMICallException  # noqa: E402
-from fmpy.fmi2 import (  # noqa: E402
-    FMU2Slave,
-    calloc,
-    fmi2CallbackAllocateMemoryTYPE,
-    fmi2CallbackFreeMemoryTYPE,
-    fmi2CallbackFunctions,
-    fmi2CallbackLoggerTYPE,
-    free,
-)
+from fmu_support import instantiate  # noqa: E402
 
 OUTCOMES = Tally()
 DT = 5e-4
@@ -57,15 +49,8 @@ def units(tmp_path_factory):
 
 class Instance:
     def __init__(self, folder, md, logs):
-        cb = fmi2CallbackFunctions()
-        cb.logger = fmi2CallbackLoggerTYPE(lambda env, name, status, cat, msg: logs.append(msg.decode()))
-        cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-        cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        self._cb = cb
         self.var = {v.name: v for v in md.modelVariables}
-        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=folder, modelIdentifier=md.coSimulation.modelIdentifier,
-                             instanceName="fuzz")
-        self.fmu.instantiate(callbacks=cb)
+        self.fmu, self._cb = instantiate(folder, md, "fuzz", logs)
 
     def set(self, name, value):
         v = self.var[name]

@@ -237,28 +237,13 @@ class _Fmu:
     def __init__(self, path, workdir, start: float = 0.0, logs: list[str] | None = None, **reals):
         pytest.importorskip("fmpy")
         from fmpy import extract, read_model_description
-        from fmpy.fmi2 import (
-            FMU2Slave,
-            calloc,
-            fmi2CallbackAllocateMemoryTYPE,
-            fmi2CallbackFreeMemoryTYPE,
-            fmi2CallbackFunctions,
-            fmi2CallbackLoggerTYPE,
-            free,
-        )
+        from fmu_support import instantiate
 
         self.logs: list[str] = [] if logs is None else logs
         d = extract(str(path), unzipdir=str(workdir))
         md = read_model_description(d)
         self.vr = {v.name: v.valueReference for v in md.modelVariables}
-        cb = fmi2CallbackFunctions()
-        cb.logger = fmi2CallbackLoggerTYPE(lambda env, name, status, cat, msg: self.logs.append(msg.decode()))
-        cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-        cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        self._cb = cb
-        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=d, modelIdentifier=md.coSimulation.modelIdentifier,
-                             instanceName="p")
-        self.fmu.instantiate(callbacks=cb)
+        self.fmu, self._cb = instantiate(d, md, "p", self.logs)
         self.fmu.setupExperiment(startTime=start)
         self.fmu.enterInitializationMode()
         for k, v in reals.items():
