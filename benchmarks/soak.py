@@ -53,8 +53,9 @@ def rss_kb() -> int:
 
 
 def soak_python(calls: int = 1000, every: int = 100) -> dict:
-    import servohydraulics as sh
     from tqdm import tqdm
+
+    import servohydraulics as sh
 
     rig = sh.zhao2003()
     u = 5e-3 * np.sin(2 * np.pi * 2.0 * np.arange(200) * 5e-4)

@@ -158,7 +158,7 @@ class FileSet:
         target = self._pending[-1][1] if self._pending else Path("?")
         try:
             if exc_type is None:
-                for tmp, target in self._pending:
+                for tmp, target in self._pending:  # noqa: B007 - target names the failing file below
                     if not tmp.exists():
                         raise FileNotFoundError(2, "it was not written")
                 for tmp, target in self._pending:

@@ -9,7 +9,7 @@ import warnings as _warnings
 _warnings.warn("methods is deprecated; import servohydraulics.loops", DeprecationWarning, stacklevel=2)
 
 
-from .loops import (  # noqa: F401
+from .loops import (  # noqa: F401, E402
     COMPENSATION,
     FORCE_MEASUREMENT,
     RESTORING_FORCE,
@@ -18,5 +18,5 @@ from .loops import (  # noqa: F401
     run_rpsd,
     run_tracking,
 )
-from .response import Response as MethodResult  # noqa: F401
-from .response import SimulationError as TestMethodError  # noqa: F401
+from .response import Response as MethodResult  # noqa: F401, E402
+from .response import SimulationError as TestMethodError  # noqa: F401, E402

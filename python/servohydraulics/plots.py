@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike
 
 from .atomic import write_with
 from .excitations import TWO_PI
+
 NOTE = ("Simulated counterpart. The paper's measured curves are not available: "
         "compare with the paper's stated numbers (reproduction.md).")
 

@@ -19,8 +19,7 @@ import pytest
 
 import servohydraulics as sh
 from servohydraulics.cli import main
-from servohydraulics.diagnosis import NAMES
-from servohydraulics.diagnosis import engine
+from servohydraulics.diagnosis import NAMES, engine
 from servohydraulics.records import Record
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "evaluation" / "diagnose_eval"))

@@ -17,8 +17,8 @@ import time
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
 from fuzz_support import Tally, counted
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import servohydraulics as sh

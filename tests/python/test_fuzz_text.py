@@ -12,8 +12,8 @@ import string
 import uuid
 
 import numpy as np
-from hypothesis import HealthCheck, given, settings
 from fuzz_support import Tally, counted
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import servohydraulics as sh

@@ -10,10 +10,10 @@ from functools import partial
 
 import numpy as np
 import pytest
+from shared_data import shared_path
 
 from servohydraulics import rths
 from servohydraulics.cli import main
-from shared_data import shared_path
 
 #: Published Table 3, case 1, El Centro x 0.4, sample controller, nominal plant
 #: (paper p. 30; the code's J order, BENCHMARK.md 10).
@@ -253,4 +253,5 @@ def test_cli_csi_derivative_block_option(data, tmp_path):
         assert outs[csi]["meta"]["csi"] == csi
     J0, J1 = outs["exact"]["cases"]["1"]["nominal"]["J"], outs["derivative-block"]["cases"]["1"]["nominal"]["J"]
     assert J1[3] - J0[3] == pytest.approx(0.05, abs=0.02)
-    assert outs["exact"]["cases"]["1"]["perturbed"]["J_mean"] != outs["derivative-block"]["cases"]["1"]["perturbed"]["J_mean"]
+    exact, block = outs["exact"]["cases"]["1"], outs["derivative-block"]["cases"]["1"]
+    assert exact["perturbed"]["J_mean"] != block["perturbed"]["J_mean"]

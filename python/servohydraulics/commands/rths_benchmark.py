@@ -31,7 +31,8 @@ def register(sub) -> None:
     p.add_argument("--data", default=None,
                    help="folder with the official files ('RTHS code RT V23/' layout or a flat folder of "
                         "Case_N.mat and the records); omitted: the embedded default with a synthetic ground motion")
-    p.add_argument("--record", default="elcentro", help="elcentro | kobe | morganhill | chirp (default: elcentro; chirp: the benchmark's 0.1-40 Hz "
+    p.add_argument("--record", default="elcentro",
+                   help="elcentro | kobe | morganhill | chirp (default: elcentro; chirp: the benchmark's 0.1-40 Hz "
                         "verification sweep, generated)")
     p.add_argument("--cases", default="1,2,3,4", help="comma-separated cases (default: 1,2,3,4)")
     p.add_argument("--controller", default="sample", metavar="NAME | module:Class",

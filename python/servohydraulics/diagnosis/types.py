@@ -55,7 +55,7 @@ class Screening:
 
     score: float
     z0: np.ndarray
-    signature: Optional[np.ndarray]
+    signature: np.ndarray | None
     failed: bool = False
 
 
@@ -78,8 +78,8 @@ class Refit:
     tried: bool = False
     kept: bool = False
     parameters: tuple[str, ...] = ()
-    delta_bic_with: Optional[float] = None
-    delta_bic_without: Optional[float] = None
+    delta_bic_with: float | None = None
+    delta_bic_without: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         if not self.tried:
@@ -133,19 +133,19 @@ class CandidateLog:
 
     name: str
     round: int
-    screening_score: Optional[float] = None
-    balance_score: Optional[float] = None
-    score: Optional[float] = None
-    delta_bic: Optional[float] = None
-    heldout_improvement: Optional[float] = None
-    parameters: Optional[dict] = None
+    screening_score: float | None = None
+    balance_score: float | None = None
+    score: float | None = None
+    delta_bic: float | None = None
+    heldout_improvement: float | None = None
+    parameters: dict | None = None
     accepted: bool = False
-    rejection: Optional[str] = None
-    joint_p_absent: Optional[float] = None
-    refit: Optional[Refit] = None
-    fit_seconds: Optional[float] = None
-    heldout_lr: Optional[float] = None
-    fit_gap_to_runner_up: Optional[float] = None
+    rejection: str | None = None
+    joint_p_absent: float | None = None
+    refit: Refit | None = None
+    fit_seconds: float | None = None
+    heldout_lr: float | None = None
+    fit_gap_to_runner_up: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {}
@@ -169,19 +169,19 @@ class JointRefit:
     round: int
     effects: tuple[str, ...]
     kept: bool = False
-    superseded: Optional[tuple[str, ...]] = None
-    reason: Optional[str] = None
-    parameters_fitted: Optional[tuple[str, ...]] = None
-    nfev: Optional[int] = None
-    bic_greedy: Optional[float] = None
-    bic_joint: Optional[float] = None
-    delta_bic: Optional[float] = None
-    gap_greedy: Optional[dict] = None
-    gap_joint: Optional[dict] = None
-    parameters_greedy: Optional[dict] = None
-    parameters_joint: Optional[dict] = None
-    excludes_absent_joint: Optional[dict] = None
-    seconds: Optional[float] = None
+    superseded: tuple[str, ...] | None = None
+    reason: str | None = None
+    parameters_fitted: tuple[str, ...] | None = None
+    nfev: int | None = None
+    bic_greedy: float | None = None
+    bic_joint: float | None = None
+    delta_bic: float | None = None
+    gap_greedy: dict | None = None
+    gap_joint: dict | None = None
+    parameters_greedy: dict | None = None
+    parameters_joint: dict | None = None
+    excludes_absent_joint: dict | None = None
+    seconds: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {}
@@ -200,9 +200,9 @@ class Round:
     number: int
     outcome: str
     log: tuple[CandidateLog, ...]
-    best: Optional[Fit] = None
+    best: Fit | None = None
     best_name: str = ""
-    signature: Optional[np.ndarray] = None  #: the best candidate's screening signature
+    signature: np.ndarray | None = None  #: the best candidate's screening signature
     summary: str = ""
     ambiguous_between: tuple[str, ...] = ()
     separating_experiment: str = ""
