@@ -273,9 +273,19 @@ void expose_rths(py::module_& m) {
       .def(py::init([](double kp, double ki) { return PiGains{kp, ki}; }), py::arg("Kp"), py::arg("Ki"))
       .def_readwrite("Kp", &PiGains::Kp).def_readwrite("Ki", &PiGains::Ki);
   py::class_<TrackingInput>(r, "TrackingInput").def(py::init<>())
-      .def(py::init([](double d, double dv, double da, double xm, double fm) { return TrackingInput{d, dv, da, xm, fm}; }),
+      .def(py::init([](double d, double dv, double da, double xm, double fm, double vm, double pm) {
+             return TrackingInput{d, dv, da, xm, fm, vm, pm};
+           }),
            py::arg("desired"), py::arg("desired_velocity") = 0.0, py::arg("desired_acceleration") = 0.0,
-           py::arg("measured") = 0.0, py::arg("measured_force") = 0.0);
+           py::arg("measured") = 0.0, py::arg("measured_force") = 0.0, py::arg("measured_velocity") = 0.0,
+           py::arg("measured_pressure") = 0.0)
+      .def_readwrite("desired", &TrackingInput::desired)
+      .def_readwrite("desired_velocity", &TrackingInput::desired_velocity)
+      .def_readwrite("desired_acceleration", &TrackingInput::desired_acceleration)
+      .def_readwrite("measured", &TrackingInput::measured)
+      .def_readwrite("measured_force", &TrackingInput::measured_force)
+      .def_readwrite("measured_velocity", &TrackingInput::measured_velocity)
+      .def_readwrite("measured_pressure", &TrackingInput::measured_pressure);
   py::class_<TrackingController>(r, "TrackingController")
       .def("reset", [](TrackingController& c) { bindings::require_idle(&c, "TrackingController.reset"); c.reset(); })
       .def("command", [](TrackingController& c, const TrackingInput& in) {

@@ -34,29 +34,36 @@ void EftConfig::validate() const {
   plant_options.validate();
 }
 
-EftController::EftController(const EftConfig& config, const Rig& model)
+EftController::EftController(const EftConfig& config, const Rig& model, TrackingController* tracking)
     : cfg_((config.validate(), config)),
-      vfc_(model, config.compensation, config.lead_T, config.alpha, config.dt),
+      paper_(model, config.compensation, config.lead_T, config.alpha, config.dt),
+      user_(tracking),
       delay_(config.compute_delay),
       mass_(config.mass.value_or(model.m)) {
   reset();
 }
 
 void EftController::reset() noexcept {
-  vfc_.reset();
+  tracking().reset();
   delay_.reset(0.0);
 }
 
 double EftController::command(const Output& s, double ground_acceleration, EftOutput* out) noexcept {
   const double P = -mass_ * ground_acceleration;  // effective force
-  const double du = vfc_.step(s.velocity, P - s.force, s.pressure);
-  const double u = delay_.step(P + du);
+  TrackingInput in;
+  in.desired = P;
+  in.measured = s.displacement;
+  in.measured_force = s.force;
+  in.measured_velocity = s.velocity;
+  in.measured_pressure = s.pressure;
+  const double c = tracking().command(in);  // paper: P + du (Eqs 9-10)
+  const double u = delay_.step(c);
   if (out) {
     out->plant = s;
     out->ground_acceleration = ground_acceleration;
     out->effective_force = P;
-    out->compensation = du;
-    out->compensation_opening = vfc_.last_opening();
+    out->compensation = user_ ? c - P : paper_.last_compensation();
+    out->compensation_opening = user_ ? 0.0 : paper_.compensator().last_opening();
     out->command = u;
   }
   return u;
@@ -89,10 +96,11 @@ std::variant<CentralDifference, ExplicitNewmark> make_scheme(const RpsdConfig& c
 }
 }  // namespace
 
-RpsdController::RpsdController(const RpsdConfig& config, const Rig& r)
+RpsdController::RpsdController(const RpsdConfig& config, const Rig& r, TrackingController* tracking)
     : cfg_(config),
       scheme_(make_scheme(config)),
       amplitude_(config.amplitude_T, config.alpha, config.dt),
+      user_(tracking),
       delay_comp_(config.delay_T, config.alpha, config.dt),
       delay_(config.compute_delay) {
   r.validate();
@@ -112,7 +120,7 @@ const IntegratorState& RpsdController::integrator_state() const noexcept {
 
 void RpsdController::reset() noexcept {
   std::visit([](auto& s) { s.reset(0.0); }, scheme_);
-  amplitude_.reset(0.0);
+  tracking().reset();
   delay_comp_.reset(0.0);
   delay_.reset(0.0);
 }
@@ -134,9 +142,17 @@ double RpsdController::command(const Output& s, double ground_acceleration, doub
   const double f_used = delay_comp_.step(f) + restoring_force_error;  // delay compensation T_ld
   const double load = -cfg_.model.m_m * ground_acceleration + external_force;  // Eq (15)
   const double d_next = std::visit([&](auto& sc) { return sc.step(load, f_used); }, scheme_);
-  const double u = delay_.step(amplitude_.step(d_next));  // amplitude compensation T_d
+  const IntegratorState& st = integrator_state();
+  TrackingInput in;
+  in.desired = d_next;
+  in.desired_velocity = st.velocity;
+  in.desired_acceleration = st.acceleration;
+  in.measured = s.displacement;
+  in.measured_force = s.force;
+  in.measured_velocity = s.velocity;
+  in.measured_pressure = s.pressure;
+  const double u = delay_.step(tracking().command(in));  // paper: amplitude compensation T_d
   if (out) {
-    const IntegratorState& st = integrator_state();
     out->plant = s;
     out->ground_acceleration = ground_acceleration;
     out->external_force = external_force;

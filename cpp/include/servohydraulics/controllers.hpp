@@ -24,6 +24,7 @@
 #include "servohydraulics/compensators.hpp"
 #include "servohydraulics/integration.hpp"
 #include "servohydraulics/plant.hpp"
+#include "servohydraulics/tracking.hpp"
 #include "servohydraulics/zhao2003.hpp"
 
 namespace servohydraulics {
@@ -62,14 +63,18 @@ inline constexpr ChannelInfoOf<EftOutput> kEftChannels[] = {
     {"command", "N", "force command sent to the servo controller", &EftOutput::command},
 };
 
-//! The EFT controller: P_eff = -m a_g plus the velocity feedback compensation
-//! (Eqs 9-10), through the optional compute delay.
+//! The EFT controller: P_eff = -m a_g through a tracking compensator (tracking.hpp;
+//! default: the paper's velocity feedback compensation, Eqs 9-10), then the
+//! optional compute delay.  The compensator reads desired = P_eff [N], the
+//! measured force, velocity and pressure, and returns the force command [N].
 class EftController {
  public:
   //! model: the controller's model of the rig, used by the compensator (A, K_v,
   //! K_s, C_F_force, G_p, flow curve and pressure factor) and, when
   //! config.mass is none, for m in P_eff = -m a_g.  config.plant_options is unused.
-  EftController(const EftConfig& config, const Rig& model);
+  //! tracking: a compensator in place of the paper's (not owned; must outlive the
+  //! controller); nullptr = VelocityFeedbackTracking of config.compensation.
+  EftController(const EftConfig& config, const Rig& model, TrackingController* tracking = nullptr);
 
   void reset() noexcept;  //!< at rest
   //! sensors at t_k (velocity, load-cell force, pressure are read), a_g(t_k)
@@ -79,11 +84,14 @@ class EftController {
 
   const EftConfig& config() const noexcept { return cfg_; }
   double mass() const noexcept { return mass_; }  //!< m in P_eff [kg]
-  const VelocityFeedbackCompensator& compensator() const noexcept { return vfc_; }
+  //! The paper's compensator (the one in use unless a tracking controller was given).
+  const VelocityFeedbackCompensator& compensator() const noexcept { return paper_.compensator(); }
+  TrackingController& tracking() noexcept { return user_ ? *user_ : paper_; }  //!< the compensator in use
 
  private:
   EftConfig cfg_;
-  VelocityFeedbackCompensator vfc_;
+  VelocityFeedbackTracking paper_;
+  TrackingController* user_ = nullptr;
   SampleDelay delay_;
   double mass_;
 };
@@ -151,8 +159,10 @@ inline constexpr ChannelInfoOf<RpsdOutput> kRpsdChannels[] = {
 };
 
 //! The RPsD controller: the restoring force from the sensors (options a-d), the
-//! delay compensation T_ld on it, the Eq (15) integration scheme, and the
-//! amplitude compensation T_d on the displacement command.
+//! delay compensation T_ld on it, the Eq (15) integration scheme, and a tracking
+//! compensator on the displacement command (tracking.hpp; default: the paper's
+//! amplitude compensation T_d).  The compensator reads desired = d_{k+1}, the
+//! solver's v_k and a_k, and the measured channels.
 class RpsdController {
  public:
   //! physical: the rig under test as built (its m is the structural mass behind
@@ -160,7 +170,9 @@ class RpsdController {
   //! k (k_m), m, m_p and effects.piston_mass (subtract_mass), c
   //! (subtract_damping) and A (force from the actuator pressure, p A).
   //! config.physical_mass_fraction and plant_options are unused here.
-  RpsdController(const RpsdConfig& config, const Rig& physical);
+  //! tracking: a compensator in place of the paper's amplitude lead (not owned; must
+  //! outlive the controller); nullptr = AmplitudeLead(amplitude_T, alpha, dt).
+  RpsdController(const RpsdConfig& config, const Rig& physical, TrackingController* tracking = nullptr);
 
   void reset() noexcept;  //!< at rest, solver at d = 0
   //! sensors at t_k, a_g [m/s^2], external force P_ext into the solver [N],
@@ -174,12 +186,15 @@ class RpsdController {
   double k_m() const noexcept { return k_m_; }
   double subtract_mass() const noexcept { return m_sub_; }
   double subtract_damping() const noexcept { return c_sub_; }
+  TrackingController& tracking() noexcept { return user_ ? *user_ : amplitude_; }  //!< the compensator in use
 
  private:
   double restoring_force(const Output& sensors) const noexcept;
   RpsdConfig cfg_;
   std::variant<CentralDifference, ExplicitNewmark> scheme_;
-  PhaseLead amplitude_, delay_comp_;
+  AmplitudeLead amplitude_;
+  TrackingController* user_ = nullptr;
+  PhaseLead delay_comp_;
   SampleDelay delay_;
   double k_m_, m_sub_, c_sub_, A_;
 };

@@ -20,23 +20,13 @@
 
 #include "servohydraulics/rths/benchmark_plant.hpp"
 #include "servohydraulics/rths/converters.hpp"
+#include "servohydraulics/tracking.hpp"
 
 namespace servohydraulics::rths {
 
-struct TrackingInput {
-  double desired = 0.0;               //!< y_n(1), desired displacement [m]
-  double desired_velocity = 0.0;      //!< numerical substructure velocity at the interface [m/s]
-  double desired_acceleration = 0.0;  //!< numerical substructure relative acceleration [m/s^2]
-  double measured = 0.0;              //!< x_m, measured specimen displacement [m]
-  double measured_force = 0.0;        //!< f_e,meas, measured specimen force [N]
-};
-
-class TrackingController {
- public:
-  virtual ~TrackingController() = default;
-  virtual void reset() noexcept = 0;
-  virtual double command(const TrackingInput& in) noexcept = 0;  //!< [m]
-};
+//! The core's tracking interface (servohydraulics/tracking.hpp), under its RTHS names.
+using TrackingInput = servohydraulics::TrackingInput;
+using TrackingController = servohydraulics::TrackingController;
 
 //! (b1 s + b0) / (a1 s + a0) discretised with Tustin (no prewarping) at h:
 //! y_k = -d1 y_{k-1} + n0 u_k + n1 u_{k-1}, zero initial state.
