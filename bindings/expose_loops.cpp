@@ -62,6 +62,7 @@ void expose_loop_converters(py::module_& m) {
       .def_readwrite("command", &LoopConverters::command)
       .def_readwrite("command_unit_delay", &LoopConverters::command_unit_delay)
       .def_readwrite("seed", &LoopConverters::seed)
+      .def_readwrite("generator", &LoopConverters::generator)
       .def_property_readonly("active", &LoopConverters::active)
       .def("validate", &LoopConverters::validate);
   py::class_<LoopIo>(m, "LoopIo", "the blocks' state: measure(truth) -> measured Output, actuate(command)")

@@ -147,38 +147,41 @@ void pi_and_converters(py::class_<T>& c) {
 void expose_rths(py::module_& m) {
   py::module_ r = m.def_submodule("rths", "RTHS benchmark blocks (Silva et al. 2020)");
 
-  // --- converters -------------------------------------------------------------------------------------
-  py::class_<Saturation>(r, "Saturation").def(py::init<>())
+  // --- converters (the core's blocks, converters.hpp; rths.* names kept as aliases) -------------------------------------------------------------------------------------
+  py::class_<Saturation>(m, "Saturation").def(py::init<>())
       .def(py::init([](double lo, double hi) { return Saturation{lo, hi}; }), py::arg("lower"), py::arg("upper"))
       .def_readwrite("lower", &Saturation::lower).def_readwrite("upper", &Saturation::upper)
       .def("__call__", &Saturation::operator());
-  py::class_<Quantizer>(r, "Quantizer").def(py::init<>())
+  py::class_<Quantizer>(m, "Quantizer").def(py::init<>())
       .def(py::init([](double q) { return Quantizer{q}; }), py::arg("step"))
       .def_readwrite("step", &Quantizer::step).def("__call__", &Quantizer::operator());
-  py::class_<Converter> conv(r, "Converter");
+  py::class_<Converter> conv(m, "Converter");
   py::enum_<Converter::Kind>(conv, "Kind")
       .value("AnalogToDigital", Converter::Kind::AnalogToDigital)
       .value("DigitalToAnalog", Converter::Kind::DigitalToAnalog);
   conv.def(py::init<>()).def_readwrite("kind", &Converter::kind).def_readwrite("saturation", &Converter::saturation)
       .def_readwrite("quantizer", &Converter::quantizer).def_readwrite("enabled", &Converter::enabled)
       .def("validate", &Converter::validate).def("__call__", &Converter::operator());
-  r.def("benchmark_converter", &benchmark_converter, py::arg("kind"));
-  r.def("ideal_converter", &ideal_converter, py::arg("kind") = Converter::Kind::AnalogToDigital);
-  py::enum_<NoiseGenerator>(r, "NoiseGenerator")
+  m.def("benchmark_converter", &benchmark_converter, py::arg("kind"));
+  m.def("ideal_converter", &ideal_converter, py::arg("kind") = Converter::Kind::AnalogToDigital);
+  py::enum_<NoiseGenerator>(m, "NoiseGenerator")
       .value("MersenneTwister", NoiseGenerator::MersenneTwister)
       .value("SimulinkRandomNumber", NoiseGenerator::SimulinkRandomNumber);
-  py::class_<GaussianSequence>(r, "GaussianSequence")
+  py::class_<GaussianSequence>(m, "GaussianSequence")
       .def(py::init<std::uint64_t, NoiseGenerator>(), py::arg("seed") = 0,
            py::arg("generator") = NoiseGenerator::MersenneTwister)
       .def("reset", &GaussianSequence::reset, py::arg("seed"), py::arg("generator") = NoiseGenerator::MersenneTwister)
       .def("next", &GaussianSequence::next)
       .def_property_readonly("generator", &GaussianSequence::generator)
       .def_static("simulink_state", &GaussianSequence::simulink_state, py::arg("seed"));
-  py::class_<SensorNoise>(r, "SensorNoise").def(py::init<>())
+  py::class_<SensorNoise>(m, "SensorNoise").def(py::init<>())
       .def(py::init([](double s, double g) { return SensorNoise{s, g}; }), py::arg("sigma"), py::arg("gain") = 1.0)
       .def_readwrite("sigma", &SensorNoise::sigma).def_readwrite("gain", &SensorNoise::gain)
       .def_static("band_limited_sigma", &SensorNoise::band_limited_sigma, py::arg("noise_power"),
                   py::arg("sample_time"));
+  for (const char* name : {"Saturation", "Quantizer", "Converter", "benchmark_converter", "ideal_converter",
+                           "NoiseGenerator", "GaussianSequence", "SensorNoise"})
+    r.attr(name) = m.attr(name);
   py::class_<ControllerConverters>(r, "ControllerConverters").def(py::init<>())
       .def_readwrite("ad", &ControllerConverters::ad).def_readwrite("da", &ControllerConverters::da);
 

@@ -44,6 +44,8 @@ RESTORING_FORCE = {"calculated_displacement": _core.RestoringForce.CalculatedDis
                    "measured_force_corrected": _core.RestoringForce.MeasuredForceCorrected}
 SCHEMES = {"central_difference": _core.IntegrationScheme.CentralDifference,
            "explicit_newmark": _core.IntegrationScheme.ExplicitNewmark}
+NOISE_GENERATORS = {"mersenne_twister": _core.NoiseGenerator.MersenneTwister,
+                    "simulink": _core.NoiseGenerator.SimulinkRandomNumber}
 FORCE_MEASUREMENT = {"load_cell": _core.ForceMeasurement.LoadCell,
                      "actuator_pressure": _core.ForceMeasurement.ActuatorPressure}
 
@@ -105,29 +107,29 @@ def sensor_channel(sigma: float = 0.0, quantum: float = 0.0, range: tuple[float,
     drawn once per sample, AD = saturation to ``range`` then quantizer of step ``quantum``
     (round half away from zero); ``unit_delay``: the controller sees y_{k-1}."""
     ch = _core.SensorChannel()
-    ch.noise = _core.rths.SensorNoise(_nonneg("sigma", sigma), gain)
+    ch.noise = _core.SensorNoise(_nonneg("sigma", sigma), gain)
     ch.converter = _converter("AnalogToDigital", quantum, range)
     ch.unit_delay = bool(unit_delay)
     return ch
 
 
-def _converter(kind: str, quantum: float, range: tuple[float, float] | None) -> "_core.rths.Converter":
-    c = _core.rths.Converter()
-    c.kind = getattr(_core.rths.Converter.Kind, kind)
+def _converter(kind: str, quantum: float, range: tuple[float, float] | None) -> "_core.Converter":
+    c = _core.Converter()
+    c.kind = getattr(_core.Converter.Kind, kind)
     c.enabled = quantum != 0.0 or range is not None
-    c.quantizer = _core.rths.Quantizer(_nonneg("quantum", quantum))
+    c.quantizer = _core.Quantizer(_nonneg("quantum", quantum))
     big = np.finfo(float).max  # no range: a saturation that never acts
     lo, hi = (-big, big) if range is None else (float(range[0]), float(range[1]))
     if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo):
         raise ValueError(f"invalid range = {range!r}: expected (lower, upper), finite, upper > lower")
-    c.saturation = _core.rths.Saturation(lo, hi)
+    c.saturation = _core.Saturation(lo, hi)
     return c
 
 
 def loop_converters(displacement: _core.SensorChannel | None = None, velocity: _core.SensorChannel | None = None,
                     force: _core.SensorChannel | None = None, command_quantum: float = 0.0,
                     command_range: tuple[float, float] | None = None, command_unit_delay: bool = False,
-                    seed: int = 0) -> _core.LoopConverters:
+                    seed: int = 0, generator: str = "mersenne_twister") -> _core.LoopConverters:
     """The sensor and converter blocks of an EFT or RPsD loop (all off by default).
 
     Args:
@@ -136,6 +138,8 @@ def loop_converters(displacement: _core.SensorChannel | None = None, velocity: _
         command_quantum, command_range: the D/A on the command (quantizer then saturation).
         command_unit_delay: the plant receives the command of the previous sample.
         seed: of the noise generators (one per channel).
+        generator: which generator draws the noise, ``"mersenne_twister"`` or ``"simulink"``
+            (Simulink's Random Number block, the RTHS benchmark's; converters.hpp NoiseGenerator).
     """
     c = _core.LoopConverters()
     for name, ch in (("displacement", displacement), ("velocity", velocity), ("force", force)):
@@ -144,6 +148,7 @@ def loop_converters(displacement: _core.SensorChannel | None = None, velocity: _
     c.command = _converter("DigitalToAnalog", command_quantum, command_range)
     c.command_unit_delay = bool(command_unit_delay)
     c.seed = _integer("seed", seed) & (2**64 - 1)
+    c.generator = _choice("generator", generator, NOISE_GENERATORS)
     c.validate()
     return c
 
