@@ -101,10 +101,13 @@ void expose_loops(py::module_& m) {
       .def_readonly("acceleration", &IntegratorState::acceleration)
       .def_readonly("next_displacement", &IntegratorState::next_displacement);
   m.attr("SolverState") = m.attr("IntegratorState");  // the name before issue 11
-  py::enum_<IntegrationScheme>(m, "IntegrationScheme")
-      .value("CentralDifference", IntegrationScheme::CentralDifference)
-      .value("ExplicitNewmark", IntegrationScheme::ExplicitNewmark);
-  m.attr("SolverKind") = m.attr("IntegrationScheme");  // the name before issue 11
+  py::enum_<StructuralScheme>(m, "StructuralScheme")
+      .value("CentralDifference", StructuralScheme::CentralDifference)
+      .value("ExplicitNewmark", StructuralScheme::ExplicitNewmark)
+      .value("RungeKutta4", StructuralScheme::RungeKutta4)
+      .value("AverageAcceleration", StructuralScheme::AverageAcceleration);
+  m.attr("IntegrationScheme") = m.attr("StructuralScheme");  // the RPsD name before issue 22
+  m.attr("SolverKind") = m.attr("StructuralScheme");  // the name before issue 11
   py::class_<CentralDifference>(m, "CentralDifference", "Explicit central-difference solver of Eq (15)")
       .def(py::init<const ModelSDOF&, double>(), py::arg("model"), py::arg("dt"))
       .def("reset", &CentralDifference::reset, py::arg("d0") = 0.0)
@@ -132,7 +135,8 @@ void expose_loops(py::module_& m) {
   m.attr("EFT_CHANNELS") = sh_py::channel_units(kEftChannels);
   py::class_<EftController>(m, "EftController",
                             "EFT controller (Fig 1a): sensors at t_k and a_g -> force command [N]")
-      .def(py::init<const EftConfig&, const Rig&>(), py::arg("config"), py::arg("model"))
+      .def(py::init<const EftConfig&, const Rig&, TrackingController*>(), py::arg("config"), py::arg("model"),
+           py::arg("tracking") = py::none(), py::keep_alive<1, 4>())
       .def("reset", bindings::guarded(&EftController::reset, "EftController.reset"))
       .def("command",
            [](EftController& c, const Output& s, double ag) {
@@ -154,8 +158,10 @@ void expose_loops(py::module_& m) {
       .def_property_readonly("compensator", &EftController::compensator, py::return_value_policy::reference_internal);
   expose_loop_converters(m);
   py::class_<EffectiveForceTest>(m, "EffectiveForceTest", "Effective force testing loop (force control, Fig 1a)")
-      .def(py::init<const Rig&, const EftConfig&, const std::optional<Rig>&, const LoopConverters&>(),
-           py::arg("rig"), py::arg("config"), py::arg("model") = py::none(), py::arg("converters") = LoopConverters{})
+      .def(py::init<const Rig&, const EftConfig&, const std::optional<Rig>&, const LoopConverters&,
+                    TrackingController*>(),
+           py::arg("rig"), py::arg("config"), py::arg("model") = py::none(), py::arg("converters") = LoopConverters{},
+           py::arg("tracking") = py::none(), py::keep_alive<1, 6>())
       .def_property_readonly("converters", [](const EffectiveForceTest& t) { return t.converters().config(); })
       .def("reset",
            [](EffectiveForceTest& t) {
@@ -228,7 +234,9 @@ void expose_loops(py::module_& m) {
   m.attr("RPSD_CHANNELS") = sh_py::channel_units(kRpsdChannels);
   py::class_<RpsdController>(m, "RpsdController",
                              "RPsD controller (Figs 1b, 7): sensors at t_k, a_g, P_ext -> displacement command [m]")
-      .def(py::init<const RpsdConfig&, const Rig&>(), py::arg("config"), py::arg("physical"))
+      .def(py::init<const RpsdConfig&, const Rig&, TrackingController*, NumericalSubstructure*>(), py::arg("config"),
+           py::arg("physical"), py::arg("tracking") = py::none(), py::arg("substructure") = py::none(),
+           py::keep_alive<1, 4>(), py::keep_alive<1, 5>())
       .def("reset", bindings::guarded(&RpsdController::reset, "RpsdController.reset"))
       .def("command",
            [](RpsdController& c, const Output& s, double ag, double pe, double fe) {
@@ -254,8 +262,13 @@ void expose_loops(py::module_& m) {
       .def_property_readonly("subtract_damping", &RpsdController::subtract_damping);
   py::class_<RealTimePseudoDynamicTest>(m, "RealTimePseudoDynamicTest",
                                         "Real-time pseudodynamic testing loop (displacement control, Figs 1b, 7)")
-      .def(py::init<const Rig&, const RpsdConfig&, const LoopConverters&>(), py::arg("rig"), py::arg("config"),
-           py::arg("converters") = LoopConverters{})
+      .def(py::init<const Rig&, const RpsdConfig&, const LoopConverters&, TrackingController*,
+                    NumericalSubstructure*>(),
+           py::arg("rig"), py::arg("config"), py::arg("converters") = LoopConverters{},
+           py::arg("tracking") = py::none(), py::arg("substructure") = py::none(), py::keep_alive<1, 5>(),
+           py::keep_alive<1, 6>(),
+           "tracking: a TrackingController in place of the amplitude lead; substructure: a NumericalSubstructure "
+           "(e.g. rths.LinearSubstructure, rths.PythonSubstructure) in place of Eq (15)'s 1-DOF model")
       .def_property_readonly("converters", [](const RealTimePseudoDynamicTest& t) { return t.converters().config(); })
       .def("reset",
            [](RealTimePseudoDynamicTest& t) {
@@ -282,7 +295,9 @@ void expose_loops(py::module_& m) {
             RunSummary sum;
             const double* a = ag.data();
             {
-              bindings::BusyGuard busy({&t, &t.plant(), &t.controller()}, "RealTimePseudoDynamicTest.run");
+              bindings::BusyGuard busy({&t, &t.plant(), &t.controller(), &t.controller().substructure(),
+                                        &t.controller().tracking()},
+                                       "RealTimePseudoDynamicTest.run");
               py::gil_scoped_release release;
               sum = run_rpsd(t, a, pp, pf, n, rows.data());
             }

@@ -228,11 +228,7 @@ void expose_rths(py::module_& m) {
            py::arg("options") = SolverOptions{});
 
   // --- numerical substructure -----------------------------------------------------------------------
-  py::enum_<SubstructureScheme>(r, "SubstructureScheme")
-      .value("RungeKutta4", SubstructureScheme::RungeKutta4)
-      .value("CentralDifference", SubstructureScheme::CentralDifference)
-      .value("ExplicitNewmark", SubstructureScheme::ExplicitNewmark)
-      .value("AverageAcceleration", SubstructureScheme::AverageAcceleration);
+  r.attr("SubstructureScheme") = m.attr("StructuralScheme");  // one enum (integration.hpp)
   py::class_<LinearSubstructureModel>(r, "LinearSubstructureModel").def(py::init<>())
       .def(py::init([](Eigen::MatrixXd M, Eigen::MatrixXd C, Eigen::MatrixXd K, Eigen::VectorXd g,
                        Eigen::VectorXd gam) { return LinearSubstructureModel{M, C, K, g, gam}; }),

@@ -89,16 +89,21 @@ void RpsdConfig::validate() const {
 }
 
 namespace {
-std::variant<CentralDifference, ExplicitNewmark> make_scheme(const RpsdConfig& cfg) {
+const RpsdConfig& validated(const RpsdConfig& cfg, const NumericalSubstructure* sub) {
   cfg.validate();
-  if (cfg.scheme == IntegrationScheme::CentralDifference) return CentralDifference(cfg.model, cfg.dt);
-  return ExplicitNewmark(cfg.model, cfg.dt);
+  if (sub)
+    require(std::fabs(sub->sample_time() - cfg.dt) <= 1e-12 * cfg.dt, "substructure.sample_time",
+            sub->sample_time(), "the controller's dt");
+  return cfg;
 }
 }  // namespace
 
-RpsdController::RpsdController(const RpsdConfig& config, const Rig& r, TrackingController* tracking)
-    : cfg_(config),
-      scheme_(make_scheme(config)),
+RpsdController::RpsdController(const RpsdConfig& config, const Rig& r, TrackingController* tracking,
+                               NumericalSubstructure* substructure)
+    : cfg_(validated(config, substructure)),
+      eq15_(config.model, config.dt,
+            substructure ? StructuralScheme::CentralDifference : config.scheme),
+      user_sub_(substructure),
       amplitude_(config.amplitude_T, config.alpha, config.dt),
       user_(tracking),
       delay_comp_(config.delay_T, config.alpha, config.dt),
@@ -114,12 +119,9 @@ RpsdController::RpsdController(const RpsdConfig& config, const Rig& r, TrackingC
   reset();
 }
 
-const IntegratorState& RpsdController::integrator_state() const noexcept {
-  return std::visit([](const auto& s) -> const IntegratorState& { return s.state(); }, scheme_);
-}
-
 void RpsdController::reset() noexcept {
-  std::visit([](auto& s) { s.reset(0.0); }, scheme_);
+  substructure().reset();
+  st_ = IntegratorState{};
   tracking().reset();
   delay_comp_.reset(0.0);
   delay_.reset(0.0);
@@ -141,8 +143,22 @@ double RpsdController::command(const Output& s, double ground_acceleration, doub
   const double f = restoring_force(s);
   const double f_used = delay_comp_.step(f) + restoring_force_error;  // delay compensation T_ld
   const double load = -cfg_.model.m_m * ground_acceleration + external_force;  // Eq (15)
-  const double d_next = std::visit([&](auto& sc) { return sc.step(load, f_used); }, scheme_);
-  const IntegratorState& st = integrator_state();
+  double d_next;
+  if (!user_sub_) {
+    d_next = eq15_.step_load(load, f_used);
+    st_ = eq15_.state();
+  } else {  // P_ext acts on the interface DOF; a_g held over the sample
+    NumericalSubstructure& sub = *user_sub_;
+    const Eigen::Index i = sub.interface_dof();
+    const double fin = f_used - external_force;
+    st_.displacement = sub.dof_displacement(i);
+    sub.step(ground_acceleration, ground_acceleration, ground_acceleration, fin);
+    d_next = sub.dof_displacement(i);
+    st_.velocity = sub.interface_velocity();
+    st_.acceleration = sub.interface_acceleration(ground_acceleration, fin);
+    st_.next_displacement = d_next;
+  }
+  const IntegratorState& st = st_;
   TrackingInput in;
   in.desired = d_next;
   in.desired_velocity = st.velocity;

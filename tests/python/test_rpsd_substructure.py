@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import servohydraulics as sh
+from servohydraulics import _core
 
 ROOT = Path(__file__).resolve().parents[2]
 _spec = importlib.util.spec_from_file_location("rpsd_reference", ROOT / "scripts" / "rpsd_reference.py")
@@ -24,3 +25,96 @@ def test_default_rpsd_is_bit_identical_to_the_base_commit(key, kw):
     r = sh.run_rpsd(sh.zhao2003(), **kw)
     for ch in reference.CHANNELS:
         np.testing.assert_array_equal(r.channels[ch], DATA[f"{key}/{ch}"], err_msg=f"{key}/{ch}")
+
+
+def _ag(n=3000, seed=3):
+    """A record starting at rest (a_g(t_0) = 0: Eq (15)'s textbook starter and LinearSubstructure's
+    at-rest start coincide)."""
+    from servohydraulics.excitations import synthetic_earthquake
+    ag = synthetic_earthquake(duration=n * 5e-4, pga=0.5, seed=seed, t_rise=0.2, t_strong=0.8)
+    ag[0] = 0.0
+    return ag
+
+
+def test_one_dof_linear_substructure_is_eq15_in_closed_loop():
+    """The 1-DOF LinearSubstructure (M = m_m, C = c_m, K = 0, ground = m_m, interface = 1) with the
+    central difference runs RPsD like Eq (15)'s default: the closed loop amplifies the round-off
+    of the open-loop comparison (tests/cpp/test_loops.cpp) only through the plant's solver."""
+    rig, ag = sh.zhao2003(), _ag()
+    cfg = _core.RpsdConfig()
+    m, c = cfg.model.m_m, cfg.model.c_m
+    ref = sh.run_rpsd(rig, ground_acceleration=ag)
+    one = sh.run_rpsd(rig, ground_acceleration=ag, substructure=sh.linear_substructure([[m]], [[c]], [[0.0]]))
+    d0, d1 = np.asarray(ref.channels["calc_displacement"]), np.asarray(one.channels["calc_displacement"])
+    assert np.max(np.abs(d0)) > 1e-4
+    assert np.max(np.abs(d1 - d0)) <= 1e-6 * np.max(np.abs(d0))
+
+
+def test_rpsd_of_a_linear_mdof_substructure_matches_the_frame_without_servo():
+    """A 2-storey shear frame whose first storey is the rig's structure (measured_displacement:
+    f = k x_meas): with ATS tracking and no delay compensation, the interface displacement follows
+    the frame's own response (the whole frame as one LinearSubstructure, no servo-system)."""
+    rig, ag = sh.zhao2003(), _ag(6000)
+    dt = _core.RpsdConfig().dt
+    m, k2 = 3000.0, 2.0 * rig.k
+    M = np.diag([m, m])
+    K_num = np.array([[k2, -k2], [-k2, k2]])  # the second storey; the first is the specimen
+    K_all = K_num + np.diag([rig.k, 0.0])
+    C = 1e-3 * K_all
+    exact = sh.linear_substructure(M, C, K_all, dt=dt)
+    x_exact = []
+    exact.reset()
+    for a in ag:
+        x_exact.append(exact.displacement[0])
+        exact.step(a, a, a, 0.0)
+    x_exact = np.array(x_exact)
+    r = sh.run_rpsd(rig, ground_acceleration=ag, substructure=sh.linear_substructure(M, C, K_num, dt=dt),
+                    tracking=_ats(dt, initial=(1.0, 0.08, 5.5e-4)), delay_T=0.0, k_m=rig.k, c_m=0.0)
+    x = np.asarray(r.channels["calc_displacement"])
+    assert np.max(np.abs(x_exact)) > 1e-3
+    assert np.sqrt(np.mean((x - x_exact) ** 2) / np.mean(x_exact**2)) < 0.1
+
+
+def _ats(dt, initial=None):
+    """ATS at the RPsD rate, ideal converters, feedforward only; initial: (a0, a1, a2) at the start
+    (None: the benchmark's 1, 0, 0)."""
+    c = _core.rths.AtsConfig()
+    c.dt = dt
+    if initial is not None:
+        c.initial = list(initial)
+    c.converters.ad = _core.ideal_converter(_core.Converter.Kind.AnalogToDigital)
+    c.converters.da = _core.ideal_converter(_core.Converter.Kind.DigitalToAnalog)
+    c.pi = _core.rths.PiGains(0.0, 0.0)
+    return _core.rths.AdaptiveTimeSeries(c)
+
+
+def _delay_ms(r):
+    t = np.asarray(r.channels["target_displacement"])[:-1]
+    x = np.asarray(r.channels["displacement"])[1:]
+    lags = np.arange(0, 80)
+    cc = [np.dot(t[: t.size - m], x[m:]) for m in lags]
+    return lags[int(np.argmax(cc))] * r.dt * 1e3
+
+
+def test_rpsd_with_ats_on_the_papers_rig_tracks_better_than_the_68_ms_lead():
+    """ATS as RPsD's tracking compensator on sh.zhao2003() (docs/methods.md,
+    scripts/rpsd_ats_tracking.py): the tracking delay falls below the 68 ms lead's."""
+    from servohydraulics.excitations import synthetic_earthquake
+    rig, ag = sh.zhao2003(), synthetic_earthquake(duration=10.0, pga=0.05 * 9.80665, seed=0)
+    dt = _core.RpsdConfig().dt
+    paper = sh.run_rpsd(rig, ground_acceleration=ag)
+    ats = sh.run_rpsd(rig, ground_acceleration=ag, tracking=_ats(dt), delay_T=0.0)
+    assert _delay_ms(paper) > 10.0
+    assert _delay_ms(ats) < 0.3 * _delay_ms(paper)
+
+
+def test_bad_substructure_and_tracking_name_the_argument():
+    rig = sh.zhao2003()
+    with pytest.raises(ValueError, match="substructure"):
+        sh.run_rpsd(rig, ground_acceleration=np.zeros(10), substructure=object())
+    with pytest.raises(ValueError, match="tracking"):
+        sh.run_rpsd(rig, ground_acceleration=np.zeros(10), tracking="ats")
+    with pytest.raises(ValueError, match="sample_time"):
+        sh.run_rpsd(rig, ground_acceleration=np.zeros(10), substructure=sh.linear_substructure(1.0, 0.0, 0.0, dt=1e-3))
+    with pytest.raises(ValueError, match="scheme"):
+        sh.run_rpsd(rig, ground_acceleration=np.zeros(10), scheme="runge_kutta4")

@@ -24,6 +24,7 @@
 #include "servohydraulics/compensators.hpp"
 #include "servohydraulics/integration.hpp"
 #include "servohydraulics/plant.hpp"
+#include "servohydraulics/substructure.hpp"
 #include "servohydraulics/tracking.hpp"
 #include "servohydraulics/zhao2003.hpp"
 
@@ -115,7 +116,8 @@ struct RpsdConfig {
   double dt = Zhao2003TestMethods{}.dt;     //!< controller sample time [s]
   ModelSDOF model = Zhao2003TestMethods{}.model;  //!< m_m, c_m of Eq (15) (Table I)
   std::optional<double> k_m;                //!< stiffness for options (a), (b) [N/m]; none = the physical rig's k
-  IntegrationScheme scheme = IntegrationScheme::CentralDifference;  //!< integrates Eq (15) online
+  //! integrates Eq (15) online (the default 1-DOF substructure; unused when a substructure is given)
+  StructuralScheme scheme = StructuralScheme::CentralDifference;
   RestoringForce restoring_force = RestoringForce::MeasuredDisplacement;
   ForceMeasurement force_measurement = ForceMeasurement::LoadCell;
   double amplitude_T = Zhao2003TestMethods{}.amplitude_T;  //!< amplitude compensation T_d on the command [s]; 0 = none
@@ -172,7 +174,14 @@ class RpsdController {
   //! config.physical_mass_fraction and plant_options are unused here.
   //! tracking: a compensator in place of the paper's amplitude lead (not owned; must
   //! outlive the controller); nullptr = AmplitudeLead(amplitude_T, alpha, dt).
-  RpsdController(const RpsdConfig& config, const Rig& physical, TrackingController* tracking = nullptr);
+  //! substructure: the numerical substructure in place of Eq (15)'s 1-DOF model (not owned;
+  //! must outlive the controller; its sample time must be config.dt): any NumericalSubstructure
+  //! (LinearSubstructure of any size, a Python one such as the OpenSeesPy adapter).  It is
+  //! stepped with a_g held over the sample and f_in = f - P_ext on its interface DOF; the
+  //! command's target is its interface displacement.  nullptr = Eq15Substructure(config.model,
+  //! config.dt, config.scheme).
+  RpsdController(const RpsdConfig& config, const Rig& physical, TrackingController* tracking = nullptr,
+                 NumericalSubstructure* substructure = nullptr);
 
   void reset() noexcept;  //!< at rest, solver at d = 0
   //! sensors at t_k, a_g [m/s^2], external force P_ext into the solver [N],
@@ -182,7 +191,15 @@ class RpsdController {
                  double restoring_force_error = 0.0, RpsdOutput* out = nullptr) noexcept;
 
   const RpsdConfig& config() const noexcept { return cfg_; }
-  const IntegratorState& integrator_state() const noexcept;
+  //! The solver's d_k, v_k, a_k and target d_{k+1} (a given substructure: its interface DOF).
+  const IntegratorState& integrator_state() const noexcept { return st_; }
+  NumericalSubstructure& substructure() noexcept { return user_sub_ ? *user_sub_ : eq15_; }  //!< in use
+  const NumericalSubstructure& substructure() const noexcept {
+    return user_sub_ ? *user_sub_ : static_cast<const NumericalSubstructure&>(eq15_);
+  }
+  const TrackingController& tracking() const noexcept {
+    return user_ ? *user_ : static_cast<const TrackingController&>(amplitude_);
+  }
   double k_m() const noexcept { return k_m_; }
   double subtract_mass() const noexcept { return m_sub_; }
   double subtract_damping() const noexcept { return c_sub_; }
@@ -191,7 +208,9 @@ class RpsdController {
  private:
   double restoring_force(const Output& sensors) const noexcept;
   RpsdConfig cfg_;
-  std::variant<CentralDifference, ExplicitNewmark> scheme_;
+  Eq15Substructure eq15_;
+  NumericalSubstructure* user_sub_ = nullptr;
+  IntegratorState st_;
   AmplitudeLead amplitude_;
   TrackingController* user_ = nullptr;
   PhaseLead delay_comp_;

@@ -18,8 +18,14 @@ struct ModelSDOF {
   void validate() const;
 };
 
-//! Which scheme integrates Eq (15) online.
-enum class IntegrationScheme { CentralDifference, ExplicitNewmark };
+//! The structural integration schemes of a numerical substructure (substructure.hpp), one
+//! enum for every hybrid loop.  Eq (15) of RPsD takes CentralDifference or ExplicitNewmark
+//! (its own 1-DOF forms below, Eq15Substructure); RungeKutta4 and AverageAcceleration (implicit
+//! Newmark, gamma = 1/2, beta = 1/4, unconditionally stable) run on LinearSubstructure.
+//! The values of CentralDifference and ExplicitNewmark are those of the RPsD enum before (the FMU
+//! enumeration items, cpp/fmu/model.cpp, index them).
+enum class StructuralScheme { CentralDifference, ExplicitNewmark, RungeKutta4, AverageAcceleration };
+using IntegrationScheme = StructuralScheme;  //!< the RPsD name before issue 22
 
 //! State of an integration scheme at time t_k.
 struct IntegratorState {
