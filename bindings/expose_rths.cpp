@@ -327,6 +327,18 @@ void expose_rths(py::module_& m) {
   py::class_<ModelBasedCompensator, TrackingController>(r, "ModelBasedCompensator")
       .def(py::init<const ModelBasedConfig&>(), py::arg("config"));
   r.def("plant_delay", &plant_delay, py::arg("plant"));
+  // The paper's compensators as TrackingControllers of the core (tracking.hpp), usable in every loop.
+  m.attr("TrackingInput") = r.attr("TrackingInput");
+  m.attr("TrackingController") = r.attr("TrackingController");
+  py::class_<AmplitudeLead, TrackingController>(m, "AmplitudeLead",
+                                                "the paper's amplitude compensation: u = lead(desired) (RPsD)")
+      .def(py::init<double, double, double>(), py::arg("T"), py::arg("alpha"), py::arg("dt"))
+      .def_property_readonly("lead", &AmplitudeLead::lead);
+  py::class_<VelocityFeedbackTracking, TrackingController>(
+      m, "VelocityFeedbackTracking", "the paper's velocity feedback compensation: u = desired + du (EFT)")
+      .def(py::init<const Rig&, VelocityFeedbackCompensator::Kind, double, double, double>(), py::arg("model"),
+           py::arg("kind"), py::arg("lead_T"), py::arg("alpha"), py::arg("dt"))
+      .def_property_readonly("last_compensation", &VelocityFeedbackTracking::last_compensation);
 
   // --- loop -----------------------------------------------------------------------------------------------
   py::class_<RthsLoopConfig>(r, "RthsLoopConfig").def(py::init<>())
