@@ -131,6 +131,7 @@ py::dict run_loop(RthsLoop& loop, const NumericalSubstructure& num, const Ground
   out["rows"] = s.rows;
   out["ok"] = s.ok;
   out["failure_time"] = s.failure_time;
+  out["status"] = s.status;
   out["peak_actuator_force"] = s.peak_actuator_force;
   out["peak_displacement"] = s.peak_displacement;
   out["peak_velocity"] = s.peak_velocity;
