@@ -309,7 +309,9 @@ void expose_rths(py::module_& m) {
   pi_and_converters(ac);
   py::class_<ModelBasedConfig> mc(r, "ModelBasedConfig");
   mc.def(py::init<>()).def_readwrite("coefficients", &ModelBasedConfig::coefficients)
-      .def_static("from_plant", &ModelBasedConfig::from_plant, py::arg("plant"), py::arg("order") = 2);
+      .def_static("from_plant", &model_based_config, py::arg("plant"), py::arg("order") = 2)
+      .def_static("from_denominator", &ModelBasedConfig::from_denominator, py::arg("A"), py::arg("b0"),
+                  py::arg("order") = 2);
   pi_and_converters(mc);
   py::class_<SampleController, TrackingController>(r, "SampleController")
       .def(py::init<const SampleControllerConfig&>(), py::arg("config") = SampleControllerConfig{})

@@ -231,7 +231,7 @@ void no_allocation() {
   pc.tau = plant_delay(par);
   PolynomialExtrapolation poly(pc);
   AdaptiveTimeSeries ats(AtsConfig{});
-  ModelBasedCompensator model(ModelBasedConfig::from_plant(par, 3));
+  ModelBasedCompensator model(model_based_config(par, 3));
   TrackingController* ctrls[] = {&sample, &poly, &ats, &model};
   BenchmarkPlant plant(par, kH);
   LinearSubstructure subs[] = {{three_storey(), kH, SubstructureScheme::RungeKutta4},
