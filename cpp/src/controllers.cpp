@@ -17,6 +17,16 @@ void require_lead(double T, const char* field) {
 void require_alpha(double alpha) {
   require(std::isfinite(alpha) && alpha > 0.0 && alpha <= 1.0, "alpha", alpha, "must be in (0, 1]");
 }
+// The tracking compensator's input: the target and the measured channels of the sensors.
+TrackingInput tracking_input(const Output& s, double desired) noexcept {
+  TrackingInput in;
+  in.desired = desired;
+  in.measured = s.displacement;
+  in.measured_force = s.force;
+  in.measured_velocity = s.velocity;
+  in.measured_pressure = s.pressure;
+  return in;
+}
 // An optional value, when given, must be finite and >= 0 (> 0 if positive).
 void require_given(const std::optional<double>& v, const char* field, bool positive, const char* requirement) {
   if (v) require(std::isfinite(*v) && (positive ? *v > 0.0 : *v >= 0.0), field, *v, requirement);
@@ -50,13 +60,7 @@ void EftController::reset() noexcept {
 
 double EftController::command(const Output& s, double ground_acceleration, EftOutput* out) noexcept {
   const double P = -mass_ * ground_acceleration;  // effective force
-  TrackingInput in;
-  in.desired = P;
-  in.measured = s.displacement;
-  in.measured_force = s.force;
-  in.measured_velocity = s.velocity;
-  in.measured_pressure = s.pressure;
-  const double c = tracking().command(in);  // paper: P + du (Eqs 9-10)
+  const double c = tracking().command(tracking_input(s, P));  // paper: P + du (Eqs 9-10)
   const double u = delay_.step(c);
   if (out) {
     out->plant = s;
@@ -159,14 +163,9 @@ double RpsdController::command(const Output& s, double ground_acceleration, doub
     st_.next_displacement = d_next;
   }
   const IntegratorState& st = st_;
-  TrackingInput in;
-  in.desired = d_next;
+  TrackingInput in = tracking_input(s, d_next);
   in.desired_velocity = st.velocity;
   in.desired_acceleration = st.acceleration;
-  in.measured = s.displacement;
-  in.measured_force = s.force;
-  in.measured_velocity = s.velocity;
-  in.measured_pressure = s.pressure;
   const double u = delay_.step(tracking().command(in));  // paper: amplitude compensation T_d
   if (out) {
     out->plant = s;
