@@ -1,4 +1,6 @@
 #include <optional>
+#include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -47,6 +49,24 @@ const double* optional_input(const std::optional<Arr>& a, std::size_t n, const c
 }  // namespace
 
 // The optional sensor and converter blocks of the loops (loop_converters.hpp).
+// A config's field table (config_fields.hpp): def_readwrite of every field (its meaning as the doc);
+// returns the field names in table order for add_protocol.
+template <class Cls, class Table>
+std::vector<std::string> def_fields(Cls& cls, const Table& table) {
+  std::vector<std::string> names;
+  std::apply([&](const auto&... f) { ((cls.def_readwrite(f.name, f.member, f.meaning), names.push_back(f.name)), ...); },
+             table);
+  return names;
+}
+
+//! [(name, unit, meaning), ...] of a config's field table.
+template <class Table>
+py::list field_table(const Table& table) {
+  py::list out;
+  std::apply([&](const auto&... f) { (out.append(py::make_tuple(f.name, f.unit, f.meaning)), ...); }, table);
+  return out;
+}
+
 void expose_loop_converters(py::module_& m) {
   py::class_<SensorChannel>(m, "SensorChannel", "noise, A/D converter and unit delay of one measured channel")
       .def(py::init<>())
@@ -121,16 +141,9 @@ void expose_loops(py::module_& m) {
 
   // --- EFT -------------------------------------------------------------------
   py::class_<EftConfig> eft_config(m, "EftConfig");
-  eft_config.def(py::init<>())
-      .def_readwrite("dt", &EftConfig::dt)
-      .def_readwrite("mass", &EftConfig::mass)
-      .def_readwrite("compensation", &EftConfig::compensation)
-      .def_readwrite("lead_T", &EftConfig::lead_T)
-      .def_readwrite("alpha", &EftConfig::alpha)
-      .def_readwrite("compute_delay", &EftConfig::compute_delay)
-      .def_readwrite("plant_options", &EftConfig::plant_options)
-      .def("validate", &EftConfig::validate);
-  add_protocol(eft_config, {"dt", "mass", "compensation", "lead_T", "alpha", "compute_delay", "plant_options"});
+  eft_config.def(py::init<>()).def("validate", &EftConfig::validate);
+  add_protocol(eft_config, def_fields(eft_config, kEftConfigFields));
+  m.attr("EFT_CONFIG_FIELDS") = field_table(kEftConfigFields);
   expose_row(m, "EftOutput", kEftChannels);
   m.attr("EFT_CHANNELS") = sh_py::channel_units(kEftChannels);
   py::class_<EftController>(m, "EftController",
@@ -211,25 +224,9 @@ void expose_loops(py::module_& m) {
       .value("LoadCell", ForceMeasurement::LoadCell)
       .value("ActuatorPressure", ForceMeasurement::ActuatorPressure);
   py::class_<RpsdConfig> rpsd_config(m, "RpsdConfig");
-  rpsd_config.def(py::init<>())
-      .def_readwrite("dt", &RpsdConfig::dt)
-      .def_readwrite("model", &RpsdConfig::model)
-      .def_readwrite("k_m", &RpsdConfig::k_m)
-      .def_readwrite("scheme", &RpsdConfig::scheme)
-      .def_readwrite("restoring_force", &RpsdConfig::restoring_force)
-      .def_readwrite("force_measurement", &RpsdConfig::force_measurement)
-      .def_readwrite("amplitude_T", &RpsdConfig::amplitude_T)
-      .def_readwrite("delay_T", &RpsdConfig::delay_T)
-      .def_readwrite("alpha", &RpsdConfig::alpha)
-      .def_readwrite("physical_mass_fraction", &RpsdConfig::physical_mass_fraction)
-      .def_readwrite("subtract_mass", &RpsdConfig::subtract_mass)
-      .def_readwrite("subtract_damping", &RpsdConfig::subtract_damping)
-      .def_readwrite("compute_delay", &RpsdConfig::compute_delay)
-      .def_readwrite("plant_options", &RpsdConfig::plant_options)
-      .def("validate", &RpsdConfig::validate);
-  add_protocol(rpsd_config, {"dt", "model", "k_m", "scheme", "restoring_force", "force_measurement", "amplitude_T",
-                             "delay_T", "alpha", "physical_mass_fraction", "subtract_mass", "subtract_damping",
-                             "compute_delay", "plant_options"});
+  rpsd_config.def(py::init<>()).def("validate", &RpsdConfig::validate);
+  add_protocol(rpsd_config, def_fields(rpsd_config, kRpsdConfigFields));
+  m.attr("RPSD_CONFIG_FIELDS") = field_table(kRpsdConfigFields);
   expose_row(m, "RpsdOutput", kRpsdChannels);
   m.attr("RPSD_CHANNELS") = sh_py::channel_units(kRpsdChannels);
   py::class_<RpsdController>(m, "RpsdController",

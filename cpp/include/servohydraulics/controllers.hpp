@@ -22,6 +22,7 @@
 
 #include "servohydraulics/channels.hpp"
 #include "servohydraulics/compensators.hpp"
+#include "servohydraulics/config_fields.hpp"
 #include "servohydraulics/integration.hpp"
 #include "servohydraulics/plant.hpp"
 #include "servohydraulics/substructure.hpp"
@@ -44,6 +45,16 @@ struct EftConfig {
   SolverOptions plant_options;  //!< the simulated plant's ODE integrator (loops.hpp only)
   void validate() const;
 };
+
+//! EftConfig's fields (config_fields.hpp): the binding's attributes and EFT_CONFIG_FIELDS.
+inline constexpr auto kEftConfigFields = std::make_tuple(
+    config_field("dt", "s", "controller sample time", &EftConfig::dt),
+    config_field("mass", "kg", "m in P_eff = -m a_g (none: the rig's m)", &EftConfig::mass),
+    config_field("compensation", "", "velocity feedback compensation: none, linear, nonlinear", &EftConfig::compensation),
+    config_field("lead_T", "s", "phase lead on the compensation (0: none)", &EftConfig::lead_T),
+    config_field("alpha", "-", "phase-lead constant", &EftConfig::alpha),
+    config_field("compute_delay", "samples", "compute delay on the command", &EftConfig::compute_delay),
+    config_field("plant_options", "", "the simulated plant's ODE integrator (loops only)", &EftConfig::plant_options));
 
 //! Every channel of one EFT sample.
 struct EftOutput {
@@ -130,6 +141,25 @@ struct RpsdConfig {
   SolverOptions plant_options;          //!< the simulated plant's ODE integrator (loops.hpp only)
   void validate() const;
 };
+
+//! RpsdConfig's fields (config_fields.hpp): the binding's attributes and RPSD_CONFIG_FIELDS.
+inline constexpr auto kRpsdConfigFields = std::make_tuple(
+    config_field("dt", "s", "controller sample time", &RpsdConfig::dt),
+    config_field("model", "", "m_m [kg], c_m [N s/m] of Eq (15)", &RpsdConfig::model),
+    config_field("k_m", "N/m", "stiffness for options (a), (b) (none: the physical rig's k)", &RpsdConfig::k_m),
+    config_field("scheme", "", "Eq (15)'s integration scheme", &RpsdConfig::scheme),
+    config_field("restoring_force", "", "restoring-force option (a)-(d)", &RpsdConfig::restoring_force),
+    config_field("force_measurement", "", "load cell or actuator pressure p A", &RpsdConfig::force_measurement),
+    config_field("amplitude_T", "s", "amplitude compensation T_d on the command (0: none)", &RpsdConfig::amplitude_T),
+    config_field("delay_T", "s", "delay compensation T_ld on the restoring force (0: none)", &RpsdConfig::delay_T),
+    config_field("alpha", "-", "phase-lead constant of both networks", &RpsdConfig::alpha),
+    config_field("physical_mass_fraction", "-", "simulation: the plant's structural mass / m_m",
+                 &RpsdConfig::physical_mass_fraction),
+    config_field("subtract_mass", "kg", "(d): mass times measured acceleration removed", &RpsdConfig::subtract_mass),
+    config_field("subtract_damping", "N s/m", "(d): damping times measured velocity removed",
+                 &RpsdConfig::subtract_damping),
+    config_field("compute_delay", "samples", "compute delay on the command", &RpsdConfig::compute_delay),
+    config_field("plant_options", "", "the simulated plant's ODE integrator (loops only)", &RpsdConfig::plant_options));
 
 //! Every channel of one RPsD sample.
 struct RpsdOutput {
