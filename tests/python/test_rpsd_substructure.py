@@ -165,3 +165,34 @@ def test_the_papers_amplitude_lead_runs_in_the_rths_loop():
         delays[T] = lags[int(np.argmax([np.dot(d[: d.size - m], x[m:]) for m in lags]))] * rths.DT
     assert delays[0.0] > 0.5 * tau
     assert delays[tau / 0.9] < 0.3 * delays[0.0]
+
+
+class _FailingSubstructure:
+    """The adapter protocol (rths.OpenSeesSubstructure's), failing at its 10th step."""
+
+    h, size, interface_dof = 5e-4, 1, 0
+
+    def __init__(self):
+        self.k = 0
+
+    def reset(self):
+        self.k = 0
+
+    def step(self, ag0, ag_mid, ag1, f_in):
+        self.k += 1
+        if self.k == 10:
+            raise ArithmeticError("the model diverged")
+
+    def displacements(self):
+        return [0.0]
+
+    def interface_velocity(self):
+        return 0.0
+
+    def interface_acceleration(self, ag, f_in):
+        return 0.0
+
+
+def test_a_failing_python_substructure_is_reported_with_its_message():
+    with pytest.raises(RuntimeError, match="the model diverged"):
+        sh.run_rpsd(sh.zhao2003(), ground_acceleration=np.zeros(50), substructure=_FailingSubstructure())
