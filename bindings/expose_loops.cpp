@@ -1,4 +1,6 @@
 #include <optional>
+#include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -48,6 +50,24 @@ const double* optional_input(const std::optional<Arr>& a, std::size_t n, const c
 }  // namespace
 
 // The optional sensor and converter blocks of the loops (loop_converters.hpp).
+// A config's field table (config_fields.hpp): def_readwrite of every field (its meaning as the doc);
+// returns the field names in table order for add_protocol.
+template <class Cls, class Table>
+std::vector<std::string> def_fields(Cls& cls, const Table& table) {
+  std::vector<std::string> names;
+  std::apply([&](const auto&... f) { ((cls.def_readwrite(f.name, f.member, f.meaning), names.push_back(f.name)), ...); },
+             table);
+  return names;
+}
+
+//! [(name, unit, meaning), ...] of a config's field table.
+template <class Table>
+py::list field_table(const Table& table) {
+  py::list out;
+  std::apply([&](const auto&... f) { (out.append(py::make_tuple(f.name, f.unit, f.meaning)), ...); }, table);
+  return out;
+}
+
 void expose_loop_converters(py::module_& m) {
   py::class_<SensorChannel>(m, "SensorChannel", "noise, A/D converter and unit delay of one measured channel")
       .def(py::init<>())
@@ -63,6 +83,7 @@ void expose_loop_converters(py::module_& m) {
       .def_readwrite("command", &LoopConverters::command)
       .def_readwrite("command_unit_delay", &LoopConverters::command_unit_delay)
       .def_readwrite("seed", &LoopConverters::seed)
+      .def_readwrite("generator", &LoopConverters::generator)
       .def_property_readonly("active", &LoopConverters::active)
       .def("validate", &LoopConverters::validate);
   py::class_<LoopIo>(m, "LoopIo", "the blocks' state: measure(truth) -> measured Output, actuate(command)")
@@ -101,9 +122,10 @@ void expose_loops(py::module_& m) {
       .def_readonly("acceleration", &IntegratorState::acceleration)
       .def_readonly("next_displacement", &IntegratorState::next_displacement);
   m.attr("SolverState") = m.attr("IntegratorState");  // the name before issue 11
-  sh_py::bind_enum(m, "IntegrationScheme", kSchemeNames);
+  sh_py::bind_enum(m, "StructuralScheme", kSchemeNames);
   m.attr("SCHEME_NAMES") = sh_py::enum_names(kSchemeNames);
-  m.attr("SolverKind") = m.attr("IntegrationScheme");  // the name before issue 11
+  m.attr("IntegrationScheme") = m.attr("StructuralScheme");  // the RPsD name before issue 22
+  m.attr("SolverKind") = m.attr("StructuralScheme");  // the name before issue 11
   py::class_<CentralDifference>(m, "CentralDifference", "Explicit central-difference solver of Eq (15)")
       .def(py::init<const ModelSDOF&, double>(), py::arg("model"), py::arg("dt"))
       .def("reset", &CentralDifference::reset, py::arg("d0") = 0.0)
@@ -117,21 +139,15 @@ void expose_loops(py::module_& m) {
 
   // --- EFT -------------------------------------------------------------------
   py::class_<EftConfig> eft_config(m, "EftConfig");
-  eft_config.def(py::init<>())
-      .def_readwrite("dt", &EftConfig::dt)
-      .def_readwrite("mass", &EftConfig::mass)
-      .def_readwrite("compensation", &EftConfig::compensation)
-      .def_readwrite("lead_T", &EftConfig::lead_T)
-      .def_readwrite("alpha", &EftConfig::alpha)
-      .def_readwrite("compute_delay", &EftConfig::compute_delay)
-      .def_readwrite("plant_options", &EftConfig::plant_options)
-      .def("validate", &EftConfig::validate);
-  add_protocol(eft_config, {"dt", "mass", "compensation", "lead_T", "alpha", "compute_delay", "plant_options"});
+  eft_config.def(py::init<>()).def("validate", &EftConfig::validate);
+  add_protocol(eft_config, def_fields(eft_config, kEftConfigFields));
+  m.attr("EFT_CONFIG_FIELDS") = field_table(kEftConfigFields);
   expose_row(m, "EftOutput", kEftChannels);
   m.attr("EFT_CHANNELS") = sh_py::channel_units(kEftChannels);
   py::class_<EftController>(m, "EftController",
                             "EFT controller (Fig 1a): sensors at t_k and a_g -> force command [N]")
-      .def(py::init<const EftConfig&, const Rig&>(), py::arg("config"), py::arg("model"))
+      .def(py::init<const EftConfig&, const Rig&, TrackingController*>(), py::arg("config"), py::arg("model"),
+           py::arg("tracking") = py::none(), py::keep_alive<1, 4>())
       .def("reset", bindings::guarded(&EftController::reset, "EftController.reset"))
       .def("command",
            [](EftController& c, const Output& s, double ag) {
@@ -153,8 +169,10 @@ void expose_loops(py::module_& m) {
       .def_property_readonly("compensator", &EftController::compensator, py::return_value_policy::reference_internal);
   expose_loop_converters(m);
   py::class_<EffectiveForceTest>(m, "EffectiveForceTest", "Effective force testing loop (force control, Fig 1a)")
-      .def(py::init<const Rig&, const EftConfig&, const std::optional<Rig>&, const LoopConverters&>(),
-           py::arg("rig"), py::arg("config"), py::arg("model") = py::none(), py::arg("converters") = LoopConverters{})
+      .def(py::init<const Rig&, const EftConfig&, const std::optional<Rig>&, const LoopConverters&,
+                    TrackingController*>(),
+           py::arg("rig"), py::arg("config"), py::arg("model") = py::none(), py::arg("converters") = LoopConverters{},
+           py::arg("tracking") = py::none(), py::keep_alive<1, 6>())
       .def_property_readonly("converters", [](const EffectiveForceTest& t) { return t.converters().config(); })
       .def("reset",
            [](EffectiveForceTest& t) {
@@ -200,30 +218,16 @@ void expose_loops(py::module_& m) {
   m.attr("RESTORING_FORCE_NAMES") = sh_py::enum_names(kRestoringForceNames);
   m.attr("FORCE_MEASUREMENT_NAMES") = sh_py::enum_names(kForceMeasurementNames);
   py::class_<RpsdConfig> rpsd_config(m, "RpsdConfig");
-  rpsd_config.def(py::init<>())
-      .def_readwrite("dt", &RpsdConfig::dt)
-      .def_readwrite("model", &RpsdConfig::model)
-      .def_readwrite("k_m", &RpsdConfig::k_m)
-      .def_readwrite("scheme", &RpsdConfig::scheme)
-      .def_readwrite("restoring_force", &RpsdConfig::restoring_force)
-      .def_readwrite("force_measurement", &RpsdConfig::force_measurement)
-      .def_readwrite("amplitude_T", &RpsdConfig::amplitude_T)
-      .def_readwrite("delay_T", &RpsdConfig::delay_T)
-      .def_readwrite("alpha", &RpsdConfig::alpha)
-      .def_readwrite("physical_mass_fraction", &RpsdConfig::physical_mass_fraction)
-      .def_readwrite("subtract_mass", &RpsdConfig::subtract_mass)
-      .def_readwrite("subtract_damping", &RpsdConfig::subtract_damping)
-      .def_readwrite("compute_delay", &RpsdConfig::compute_delay)
-      .def_readwrite("plant_options", &RpsdConfig::plant_options)
-      .def("validate", &RpsdConfig::validate);
-  add_protocol(rpsd_config, {"dt", "model", "k_m", "scheme", "restoring_force", "force_measurement", "amplitude_T",
-                             "delay_T", "alpha", "physical_mass_fraction", "subtract_mass", "subtract_damping",
-                             "compute_delay", "plant_options"});
+  rpsd_config.def(py::init<>()).def("validate", &RpsdConfig::validate);
+  add_protocol(rpsd_config, def_fields(rpsd_config, kRpsdConfigFields));
+  m.attr("RPSD_CONFIG_FIELDS") = field_table(kRpsdConfigFields);
   expose_row(m, "RpsdOutput", kRpsdChannels);
   m.attr("RPSD_CHANNELS") = sh_py::channel_units(kRpsdChannels);
   py::class_<RpsdController>(m, "RpsdController",
                              "RPsD controller (Figs 1b, 7): sensors at t_k, a_g, P_ext -> displacement command [m]")
-      .def(py::init<const RpsdConfig&, const Rig&>(), py::arg("config"), py::arg("physical"))
+      .def(py::init<const RpsdConfig&, const Rig&, TrackingController*, NumericalSubstructure*>(), py::arg("config"),
+           py::arg("physical"), py::arg("tracking") = py::none(), py::arg("substructure") = py::none(),
+           py::keep_alive<1, 4>(), py::keep_alive<1, 5>())
       .def("reset", bindings::guarded(&RpsdController::reset, "RpsdController.reset"))
       .def("command",
            [](RpsdController& c, const Output& s, double ag, double pe, double fe) {
@@ -249,8 +253,13 @@ void expose_loops(py::module_& m) {
       .def_property_readonly("subtract_damping", &RpsdController::subtract_damping);
   py::class_<RealTimePseudoDynamicTest>(m, "RealTimePseudoDynamicTest",
                                         "Real-time pseudodynamic testing loop (displacement control, Figs 1b, 7)")
-      .def(py::init<const Rig&, const RpsdConfig&, const LoopConverters&>(), py::arg("rig"), py::arg("config"),
-           py::arg("converters") = LoopConverters{})
+      .def(py::init<const Rig&, const RpsdConfig&, const LoopConverters&, TrackingController*,
+                    NumericalSubstructure*>(),
+           py::arg("rig"), py::arg("config"), py::arg("converters") = LoopConverters{},
+           py::arg("tracking") = py::none(), py::arg("substructure") = py::none(), py::keep_alive<1, 5>(),
+           py::keep_alive<1, 6>(),
+           "tracking: a TrackingController in place of the amplitude lead; substructure: a NumericalSubstructure "
+           "(e.g. rths.LinearSubstructure, rths.PythonSubstructure) in place of Eq (15)'s 1-DOF model")
       .def_property_readonly("converters", [](const RealTimePseudoDynamicTest& t) { return t.converters().config(); })
       .def("reset",
            [](RealTimePseudoDynamicTest& t) {
@@ -277,7 +286,9 @@ void expose_loops(py::module_& m) {
             RunSummary sum;
             const double* a = ag.data();
             {
-              bindings::BusyGuard busy({&t, &t.plant(), &t.controller()}, "RealTimePseudoDynamicTest.run");
+              bindings::BusyGuard busy({&t, &t.plant(), &t.controller(), &t.controller().substructure(),
+                                        &t.controller().tracking()},
+                                       "RealTimePseudoDynamicTest.run");
               py::gil_scoped_release release;
               sum = run_rpsd(t, a, pp, pf, n, rows.data());
             }

@@ -133,6 +133,7 @@ py::dict run_loop(RthsLoop& loop, const NumericalSubstructure& num, const Ground
   out["rows"] = s.rows;
   out["ok"] = s.ok;
   out["failure_time"] = s.failure_time;
+  out["status"] = s.status;
   out["peak_actuator_force"] = s.peak_actuator_force;
   out["peak_displacement"] = s.peak_displacement;
   out["peak_velocity"] = s.peak_velocity;
@@ -149,38 +150,41 @@ void pi_and_converters(py::class_<T>& c) {
 void expose_rths(py::module_& m) {
   py::module_ r = m.def_submodule("rths", "RTHS benchmark blocks (Silva et al. 2020)");
 
-  // --- converters -------------------------------------------------------------------------------------
-  py::class_<Saturation>(r, "Saturation").def(py::init<>())
+  // --- converters (the core's blocks, converters.hpp; rths.* names kept as aliases) -------------------------------------------------------------------------------------
+  py::class_<Saturation>(m, "Saturation").def(py::init<>())
       .def(py::init([](double lo, double hi) { return Saturation{lo, hi}; }), py::arg("lower"), py::arg("upper"))
       .def_readwrite("lower", &Saturation::lower).def_readwrite("upper", &Saturation::upper)
       .def("__call__", &Saturation::operator());
-  py::class_<Quantizer>(r, "Quantizer").def(py::init<>())
+  py::class_<Quantizer>(m, "Quantizer").def(py::init<>())
       .def(py::init([](double q) { return Quantizer{q}; }), py::arg("step"))
       .def_readwrite("step", &Quantizer::step).def("__call__", &Quantizer::operator());
-  py::class_<Converter> conv(r, "Converter");
+  py::class_<Converter> conv(m, "Converter");
   py::enum_<Converter::Kind>(conv, "Kind")
       .value("AnalogToDigital", Converter::Kind::AnalogToDigital)
       .value("DigitalToAnalog", Converter::Kind::DigitalToAnalog);
   conv.def(py::init<>()).def_readwrite("kind", &Converter::kind).def_readwrite("saturation", &Converter::saturation)
       .def_readwrite("quantizer", &Converter::quantizer).def_readwrite("enabled", &Converter::enabled)
       .def("validate", &Converter::validate).def("__call__", &Converter::operator());
-  r.def("benchmark_converter", &benchmark_converter, py::arg("kind"));
-  r.def("ideal_converter", &ideal_converter, py::arg("kind") = Converter::Kind::AnalogToDigital);
-  py::enum_<NoiseGenerator>(r, "NoiseGenerator")
+  m.def("benchmark_converter", &benchmark_converter, py::arg("kind"));
+  m.def("ideal_converter", &ideal_converter, py::arg("kind") = Converter::Kind::AnalogToDigital);
+  py::enum_<NoiseGenerator>(m, "NoiseGenerator")
       .value("MersenneTwister", NoiseGenerator::MersenneTwister)
       .value("SimulinkRandomNumber", NoiseGenerator::SimulinkRandomNumber);
-  py::class_<GaussianSequence>(r, "GaussianSequence")
+  py::class_<GaussianSequence>(m, "GaussianSequence")
       .def(py::init<std::uint64_t, NoiseGenerator>(), py::arg("seed") = 0,
            py::arg("generator") = NoiseGenerator::MersenneTwister)
       .def("reset", &GaussianSequence::reset, py::arg("seed"), py::arg("generator") = NoiseGenerator::MersenneTwister)
       .def("next", &GaussianSequence::next)
       .def_property_readonly("generator", &GaussianSequence::generator)
       .def_static("simulink_state", &GaussianSequence::simulink_state, py::arg("seed"));
-  py::class_<SensorNoise>(r, "SensorNoise").def(py::init<>())
+  py::class_<SensorNoise>(m, "SensorNoise").def(py::init<>())
       .def(py::init([](double s, double g) { return SensorNoise{s, g}; }), py::arg("sigma"), py::arg("gain") = 1.0)
       .def_readwrite("sigma", &SensorNoise::sigma).def_readwrite("gain", &SensorNoise::gain)
       .def_static("band_limited_sigma", &SensorNoise::band_limited_sigma, py::arg("noise_power"),
                   py::arg("sample_time"));
+  for (const char* name : {"Saturation", "Quantizer", "Converter", "benchmark_converter", "ideal_converter",
+                           "NoiseGenerator", "GaussianSequence", "SensorNoise"})
+    r.attr(name) = m.attr(name);
   py::class_<ControllerConverters>(r, "ControllerConverters").def(py::init<>())
       .def_readwrite("ad", &ControllerConverters::ad).def_readwrite("da", &ControllerConverters::da);
 
@@ -227,11 +231,7 @@ void expose_rths(py::module_& m) {
            py::arg("options") = SolverOptions{});
 
   // --- numerical substructure -----------------------------------------------------------------------
-  py::enum_<SubstructureScheme>(r, "SubstructureScheme")
-      .value("RungeKutta4", SubstructureScheme::RungeKutta4)
-      .value("CentralDifference", SubstructureScheme::CentralDifference)
-      .value("ExplicitNewmark", SubstructureScheme::ExplicitNewmark)
-      .value("AverageAcceleration", SubstructureScheme::AverageAcceleration);
+  r.attr("SubstructureScheme") = m.attr("StructuralScheme");  // one enum (integration.hpp)
   py::class_<LinearSubstructureModel>(r, "LinearSubstructureModel").def(py::init<>())
       .def(py::init([](Eigen::MatrixXd M, Eigen::MatrixXd C, Eigen::MatrixXd K, Eigen::VectorXd g,
                        Eigen::VectorXd gam) { return LinearSubstructureModel{M, C, K, g, gam}; }),
@@ -275,9 +275,19 @@ void expose_rths(py::module_& m) {
       .def(py::init([](double kp, double ki) { return PiGains{kp, ki}; }), py::arg("Kp"), py::arg("Ki"))
       .def_readwrite("Kp", &PiGains::Kp).def_readwrite("Ki", &PiGains::Ki);
   py::class_<TrackingInput>(r, "TrackingInput").def(py::init<>())
-      .def(py::init([](double d, double dv, double da, double xm, double fm) { return TrackingInput{d, dv, da, xm, fm}; }),
+      .def(py::init([](double d, double dv, double da, double xm, double fm, double vm, double pm) {
+             return TrackingInput{d, dv, da, xm, fm, vm, pm};
+           }),
            py::arg("desired"), py::arg("desired_velocity") = 0.0, py::arg("desired_acceleration") = 0.0,
-           py::arg("measured") = 0.0, py::arg("measured_force") = 0.0);
+           py::arg("measured") = 0.0, py::arg("measured_force") = 0.0, py::arg("measured_velocity") = 0.0,
+           py::arg("measured_pressure") = 0.0)
+      .def_readwrite("desired", &TrackingInput::desired)
+      .def_readwrite("desired_velocity", &TrackingInput::desired_velocity)
+      .def_readwrite("desired_acceleration", &TrackingInput::desired_acceleration)
+      .def_readwrite("measured", &TrackingInput::measured)
+      .def_readwrite("measured_force", &TrackingInput::measured_force)
+      .def_readwrite("measured_velocity", &TrackingInput::measured_velocity)
+      .def_readwrite("measured_pressure", &TrackingInput::measured_pressure);
   // Python controllers (tracking_trampoline.hpp): subclass TrackingController, or wrap any object.
   py::class_<TrackingController, bindings::PyTrackingController>(r, "TrackingController")
       .def(py::init<>())
@@ -286,15 +296,17 @@ void expose_rths(py::module_& m) {
         c.reset();
         bindings::raise_controller_error(c, std::nan(""));
       })
-      .def("command", [](TrackingController& c, double d, double dv, double da, double xm, double fm) {
+      .def("command", [](TrackingController& c, double d, double dv, double da, double xm, double fm, double vm,
+                         double pm) {
         bindings::require_idle(&c, "TrackingController.command");
-        const double u = c.command(TrackingInput{d, dv, da, xm, fm});
+        const double u = c.command(TrackingInput{d, dv, da, xm, fm, vm, pm});
         bindings::raise_controller_error(c, std::nan(""));
         return u;
       }, py::arg("desired"), py::arg("desired_velocity") = 0.0, py::arg("desired_acceleration") = 0.0,
-         py::arg("measured") = 0.0, py::arg("measured_force") = 0.0,
-         "The command [m] from the desired displacement [m], velocity [m/s] and acceleration [m/s^2] and the "
-         "measured displacement [m] and force [N].")
+         py::arg("measured") = 0.0, py::arg("measured_force") = 0.0, py::arg("measured_velocity") = 0.0,
+         py::arg("measured_pressure") = 0.0,
+         "The command from the desired value (displacement [m] in RPsD/RTHS, force [N] in EFT), its velocity and "
+         "acceleration, and the measured displacement [m], force [N], velocity [m/s] and pressure [Pa].")
       .def("command", [](TrackingController& c, const TrackingInput& in) {
         bindings::require_idle(&c, "TrackingController.command");
         const double u = c.command(in);
@@ -322,7 +334,9 @@ void expose_rths(py::module_& m) {
   pi_and_converters(ac);
   py::class_<ModelBasedConfig> mc(r, "ModelBasedConfig");
   mc.def(py::init<>()).def_readwrite("coefficients", &ModelBasedConfig::coefficients)
-      .def_static("from_plant", &ModelBasedConfig::from_plant, py::arg("plant"), py::arg("order") = 2);
+      .def_static("from_plant", &model_based_config, py::arg("plant"), py::arg("order") = 2)
+      .def_static("from_denominator", &ModelBasedConfig::from_denominator, py::arg("A"), py::arg("b0"),
+                  py::arg("order") = 2);
   pi_and_converters(mc);
   py::class_<SampleController, TrackingController>(r, "SampleController")
       .def(py::init<const SampleControllerConfig&>(), py::arg("config") = SampleControllerConfig{})
@@ -341,6 +355,18 @@ void expose_rths(py::module_& m) {
   py::class_<ModelBasedCompensator, TrackingController>(r, "ModelBasedCompensator")
       .def(py::init<const ModelBasedConfig&>(), py::arg("config"));
   r.def("plant_delay", &plant_delay, py::arg("plant"));
+  // The paper's compensators as TrackingControllers of the core (tracking.hpp), usable in every loop.
+  m.attr("TrackingInput") = r.attr("TrackingInput");
+  m.attr("TrackingController") = r.attr("TrackingController");
+  py::class_<AmplitudeLead, TrackingController>(m, "AmplitudeLead",
+                                                "the paper's amplitude compensation: u = lead(desired) (RPsD)")
+      .def(py::init<double, double, double>(), py::arg("T"), py::arg("alpha"), py::arg("dt"))
+      .def_property_readonly("lead", &AmplitudeLead::lead);
+  py::class_<VelocityFeedbackTracking, TrackingController>(
+      m, "VelocityFeedbackTracking", "the paper's velocity feedback compensation: u = desired + du (EFT)")
+      .def(py::init<const Rig&, VelocityFeedbackCompensator::Kind, double, double, double>(), py::arg("model"),
+           py::arg("kind"), py::arg("lead_T"), py::arg("alpha"), py::arg("dt"))
+      .def_property_readonly("last_compensation", &VelocityFeedbackTracking::last_compensation);
 
   // --- loop -----------------------------------------------------------------------------------------------
   py::class_<RthsLoopConfig>(r, "RthsLoopConfig").def(py::init<>())

@@ -132,13 +132,14 @@ Variable integer(std::string name, std::string doc, std::function<I&(Values&)> r
   return x;
 }
 
-//! An enum parameter; its items are the names of the enum's table (enum_name.hpp), in the enum's order.
+//! An enum parameter; its items are the names of the enum's table (enum_name.hpp), in the enum's order
+//! (the first `count` rows, where the setting takes only those).
 template <class E, std::size_t N>
 Variable enumeration(std::string name, std::string type_name, const EnumName<E> (&table)[N], std::string doc,
-                     std::function<E&(Values&)> ref) {
+                     std::function<E&(Values&)> ref, std::size_t count = N) {
   Variable x = base(name, Type::Enumeration, Causality::Parameter, Variability::Fixed, "", std::move(doc));
   x.type_name = std::move(type_name);
-  for (const auto& row : table) x.items.emplace_back(row.name);
+  for (std::size_t i = 0; i < count && i < N; ++i) x.items.emplace_back(table[i].name);
   x.get = [ref](const Values& v) { return static_cast<double>(static_cast<int>(ref(const_cast<Values&>(v)))); };
   const std::string expected = "expected one of " + expected_items(x);
   const double n = static_cast<double>(x.items.size());
@@ -285,7 +286,7 @@ void add_rpsd_config(std::vector<Variable>& out) {
                          [](Values& v) -> Opt& { return v.settings.rpsd.k_m; }));
   out.push_back(enumeration<IntegrationScheme>(
       "rpsd.scheme", "IntegrationScheme", kSchemeNames, "integration scheme of Eq (15)",
-      [](Values& v) -> IntegrationScheme& { return v.settings.rpsd.scheme; }));
+      [](Values& v) -> IntegrationScheme& { return v.settings.rpsd.scheme; }, kEq15Schemes));
   out.push_back(enumeration<RestoringForce>(
       "rpsd.restoring_force", "RestoringForce", kRestoringForceNames, "restoring force option (a)-(d)", [](Values& v) -> RestoringForce& { return v.settings.rpsd.restoring_force; }));
   out.push_back(enumeration<ForceMeasurement>(

@@ -17,6 +17,16 @@ void require_lead(double T, const char* field) {
 void require_alpha(double alpha) {
   require(std::isfinite(alpha) && alpha > 0.0 && alpha <= 1.0, "alpha", alpha, "must be in (0, 1]");
 }
+// The tracking compensator's input: the target and the measured channels of the sensors.
+TrackingInput tracking_input(const Output& s, double desired) noexcept {
+  TrackingInput in;
+  in.desired = desired;
+  in.measured = s.displacement;
+  in.measured_force = s.force;
+  in.measured_velocity = s.velocity;
+  in.measured_pressure = s.pressure;
+  return in;
+}
 // An optional value, when given, must be finite and >= 0 (> 0 if positive).
 void require_given(const std::optional<double>& v, const char* field, bool positive, const char* requirement) {
   if (v) require(std::isfinite(*v) && (positive ? *v > 0.0 : *v >= 0.0), field, *v, requirement);
@@ -34,29 +44,30 @@ void EftConfig::validate() const {
   plant_options.validate();
 }
 
-EftController::EftController(const EftConfig& config, const Rig& model)
+EftController::EftController(const EftConfig& config, const Rig& model, TrackingController* tracking)
     : cfg_((config.validate(), config)),
-      vfc_(model, config.compensation, config.lead_T, config.alpha, config.dt),
+      paper_(model, config.compensation, config.lead_T, config.alpha, config.dt),
+      user_(tracking),
       delay_(config.compute_delay),
       mass_(config.mass.value_or(model.m)) {
   reset();
 }
 
 void EftController::reset() noexcept {
-  vfc_.reset();
+  tracking().reset();
   delay_.reset(0.0);
 }
 
 double EftController::command(const Output& s, double ground_acceleration, EftOutput* out) noexcept {
   const double P = -mass_ * ground_acceleration;  // effective force
-  const double du = vfc_.step(s.velocity, P - s.force, s.pressure);
-  const double u = delay_.step(P + du);
+  const double c = tracking().command(tracking_input(s, P));  // paper: P + du (Eqs 9-10)
+  const double u = delay_.step(c);
   if (out) {
     out->plant = s;
     out->ground_acceleration = ground_acceleration;
     out->effective_force = P;
-    out->compensation = du;
-    out->compensation_opening = vfc_.last_opening();
+    out->compensation = user_ ? c - P : paper_.last_compensation();
+    out->compensation_opening = user_ ? 0.0 : paper_.compensator().last_opening();
     out->command = u;
   }
   return u;
@@ -82,17 +93,23 @@ void RpsdConfig::validate() const {
 }
 
 namespace {
-std::variant<CentralDifference, ExplicitNewmark> make_scheme(const RpsdConfig& cfg) {
+const RpsdConfig& validated(const RpsdConfig& cfg, const NumericalSubstructure* sub) {
   cfg.validate();
-  if (cfg.scheme == IntegrationScheme::CentralDifference) return CentralDifference(cfg.model, cfg.dt);
-  return ExplicitNewmark(cfg.model, cfg.dt);
+  if (sub)
+    require(std::fabs(sub->sample_time() - cfg.dt) <= 1e-12 * cfg.dt, "substructure.sample_time",
+            sub->sample_time(), "the controller's dt");
+  return cfg;
 }
 }  // namespace
 
-RpsdController::RpsdController(const RpsdConfig& config, const Rig& r)
-    : cfg_(config),
-      scheme_(make_scheme(config)),
+RpsdController::RpsdController(const RpsdConfig& config, const Rig& r, TrackingController* tracking,
+                               NumericalSubstructure* substructure)
+    : cfg_(validated(config, substructure)),
+      eq15_(config.model, config.dt,
+            substructure ? StructuralScheme::CentralDifference : config.scheme),
+      user_sub_(substructure),
       amplitude_(config.amplitude_T, config.alpha, config.dt),
+      user_(tracking),
       delay_comp_(config.delay_T, config.alpha, config.dt),
       delay_(config.compute_delay) {
   r.validate();
@@ -106,13 +123,10 @@ RpsdController::RpsdController(const RpsdConfig& config, const Rig& r)
   reset();
 }
 
-const IntegratorState& RpsdController::integrator_state() const noexcept {
-  return std::visit([](const auto& s) -> const IntegratorState& { return s.state(); }, scheme_);
-}
-
 void RpsdController::reset() noexcept {
-  std::visit([](auto& s) { s.reset(0.0); }, scheme_);
-  amplitude_.reset(0.0);
+  substructure().reset();
+  st_ = IntegratorState{};
+  tracking().reset();
   delay_comp_.reset(0.0);
   delay_.reset(0.0);
 }
@@ -133,10 +147,27 @@ double RpsdController::command(const Output& s, double ground_acceleration, doub
   const double f = restoring_force(s);
   const double f_used = delay_comp_.step(f) + restoring_force_error;  // delay compensation T_ld
   const double load = -cfg_.model.m_m * ground_acceleration + external_force;  // Eq (15)
-  const double d_next = std::visit([&](auto& sc) { return sc.step(load, f_used); }, scheme_);
-  const double u = delay_.step(amplitude_.step(d_next));  // amplitude compensation T_d
+  double d_next;
+  if (!user_sub_) {
+    d_next = eq15_.step_load(load, f_used);
+    st_ = eq15_.state();
+  } else {  // P_ext acts on the interface DOF; a_g held over the sample
+    NumericalSubstructure& sub = *user_sub_;
+    const Eigen::Index i = sub.interface_dof();
+    const double fin = f_used - external_force;
+    st_.displacement = sub.dof_displacement(i);
+    sub.step(ground_acceleration, ground_acceleration, ground_acceleration, fin);
+    d_next = sub.dof_displacement(i);
+    st_.velocity = sub.interface_velocity();
+    st_.acceleration = sub.interface_acceleration(ground_acceleration, fin);
+    st_.next_displacement = d_next;
+  }
+  const IntegratorState& st = st_;
+  TrackingInput in = tracking_input(s, d_next);
+  in.desired_velocity = st.velocity;
+  in.desired_acceleration = st.acceleration;
+  const double u = delay_.step(tracking().command(in));  // paper: amplitude compensation T_d
   if (out) {
-    const IntegratorState& st = integrator_state();
     out->plant = s;
     out->ground_acceleration = ground_acceleration;
     out->external_force = external_force;

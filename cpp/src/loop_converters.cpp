@@ -16,7 +16,7 @@ void SensorChannel::validate(const char* name) const {
   require(std::isfinite(noise.sigma) && noise.sigma >= 0.0, (n + ".noise.sigma").c_str(), noise.sigma,
           "finite and >= 0");
   require(std::isfinite(noise.gain), (n + ".noise.gain").c_str(), noise.gain, "finite");
-  require(converter.kind == rths::Converter::Kind::AnalogToDigital, (n + ".converter.kind").c_str(),
+  require(converter.kind == Converter::Kind::AnalogToDigital, (n + ".converter.kind").c_str(),
           static_cast<double>(converter.kind), "AnalogToDigital (a sensor channel's converter is an A/D)");
   converter.validate();
 }
@@ -29,7 +29,7 @@ void LoopConverters::validate() const {
   displacement.validate("converters.displacement");
   velocity.validate("converters.velocity");
   force.validate("converters.force");
-  require(command.kind == rths::Converter::Kind::DigitalToAnalog, "converters.command.kind",
+  require(command.kind == Converter::Kind::DigitalToAnalog, "converters.command.kind",
           static_cast<double>(command.kind), "DigitalToAnalog (the command's converter is a D/A)");
   command.validate();
 }
@@ -42,9 +42,9 @@ LoopIo::LoopIo(const LoopConverters& config) : cfg_(config) {
 
 void LoopIo::reset() noexcept {
   // One generator per channel, seeds spread so that the channels are independent.
-  d_.w.reset(cfg_.seed);
-  v_.w.reset(cfg_.seed ^ 0x9E3779B97F4A7C15ull);
-  f_.w.reset(cfg_.seed ^ 0xC2B2AE3D27D4EB4Full);
+  d_.w.reset(cfg_.seed, cfg_.generator);
+  v_.w.reset(cfg_.seed ^ 0x9E3779B97F4A7C15ull, cfg_.generator);
+  f_.w.reset(cfg_.seed ^ 0xC2B2AE3D27D4EB4Full, cfg_.generator);
   d_.delay.reset();
   v_.delay.reset();
   f_.delay.reset();

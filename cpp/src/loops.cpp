@@ -21,9 +21,9 @@ EftConfig with_mass(const EftConfig& config, const Rig& rig) {
 }  // namespace
 
 EffectiveForceTest::EffectiveForceTest(const Rig& rig, const EftConfig& config, const std::optional<Rig>& model,
-                                       const LoopConverters& converters)
+                                       const LoopConverters& converters, TrackingController* tracking)
     : ClosedLoop(Plant(rig, ControlMode::Force, config.dt, config.plant_options),
-                 EftController(with_mass(config, rig), model.value_or(rig)), converters) {}
+                 EftController(with_mass(config, rig), model.value_or(rig), tracking), converters) {}
 
 Rig RealTimePseudoDynamicTest::physical_rig(const Rig& rig, const RpsdConfig& cfg) {
   cfg.validate();
@@ -34,9 +34,11 @@ Rig RealTimePseudoDynamicTest::physical_rig(const Rig& rig, const RpsdConfig& cf
 }
 
 RealTimePseudoDynamicTest::RealTimePseudoDynamicTest(const Rig& rig, const RpsdConfig& config,
-                                                     const LoopConverters& converters)
+                                                     const LoopConverters& converters,
+                                                     TrackingController* tracking,
+                                                     NumericalSubstructure* substructure)
     : ClosedLoop(Plant(physical_rig(rig, config), ControlMode::Displacement, config.dt, config.plant_options),
-                 RpsdController(config, physical_rig(rig, config)), converters) {}
+                 RpsdController(config, physical_rig(rig, config), tracking, substructure), converters) {}
 
 // -------------------------------------------------------------------- runners
 

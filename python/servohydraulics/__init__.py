@@ -35,7 +35,7 @@ except ImportError as e:  # pragma: no cover - only without a built core
 
 from ._core import ConcurrentUseError, ControlMode, Dynamics, FlowCurve, Plant, SolverOptions  # noqa: E402
 from .controllers import EftController, RpsdController  # noqa: E402
-from .loops import loop_converters, run_eft, run_rpsd, run_tracking, sensor_channel  # noqa: E402
+from .loops import linear_substructure, loop_converters, run_eft, run_rpsd, run_tracking, sensor_channel  # noqa: E402
 from .records import read_record, write_record  # noqa: E402
 from .response import Response, SimulationError  # noqa: E402
 from .rig import (  # noqa: E402
@@ -128,6 +128,7 @@ __all__ = [
     "rig_to_dict",
     "run_eft",
     "run_rpsd",
+    "linear_substructure",
     "run_tracking",
     "save_rig",
     "simulate",

@@ -38,8 +38,12 @@ from .simulate import solver_options as _solver_options
 # Names from the core's tables (enum_name.hpp), in the enum's order.
 COMPENSATION = dict(_core.COMPENSATION_NAMES)
 RESTORING_FORCE = dict(_core.RESTORING_FORCE_NAMES)
-SCHEMES = dict(_core.SCHEME_NAMES)
+#: every structural scheme (a LinearSubstructure takes any); Eq (15) itself the first two (SCHEMES)
+STRUCTURAL_SCHEMES = dict(_core.SCHEME_NAMES)
+SCHEMES = dict(list(STRUCTURAL_SCHEMES.items())[:2])
 FORCE_MEASUREMENT = dict(_core.FORCE_MEASUREMENT_NAMES)
+NOISE_GENERATORS = {"mersenne_twister": _core.NoiseGenerator.MersenneTwister,
+                    "simulink": _core.NoiseGenerator.SimulinkRandomNumber}
 
 
 def _default(value: float | None, config: object, name: str) -> float:
@@ -99,29 +103,29 @@ def sensor_channel(sigma: float = 0.0, quantum: float = 0.0, range: tuple[float,
     drawn once per sample, AD = saturation to ``range`` then quantizer of step ``quantum``
     (round half away from zero); ``unit_delay``: the controller sees y_{k-1}."""
     ch = _core.SensorChannel()
-    ch.noise = _core.rths.SensorNoise(_nonneg("sigma", sigma), gain)
+    ch.noise = _core.SensorNoise(_nonneg("sigma", sigma), gain)
     ch.converter = _converter("AnalogToDigital", quantum, range)
     ch.unit_delay = bool(unit_delay)
     return ch
 
 
-def _converter(kind: str, quantum: float, range: tuple[float, float] | None) -> _core.rths.Converter:
-    c = _core.rths.Converter()
-    c.kind = getattr(_core.rths.Converter.Kind, kind)
+def _converter(kind: str, quantum: float, range: tuple[float, float] | None) -> _core.Converter:
+    c = _core.Converter()
+    c.kind = getattr(_core.Converter.Kind, kind)
     c.enabled = quantum != 0.0 or range is not None
-    c.quantizer = _core.rths.Quantizer(_nonneg("quantum", quantum))
+    c.quantizer = _core.Quantizer(_nonneg("quantum", quantum))
     big = np.finfo(float).max  # no range: a saturation that never acts
     lo, hi = (-big, big) if range is None else (float(range[0]), float(range[1]))
     if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo):
         raise ValueError(f"invalid range = {range!r}: expected (lower, upper), finite, upper > lower")
-    c.saturation = _core.rths.Saturation(lo, hi)
+    c.saturation = _core.Saturation(lo, hi)
     return c
 
 
 def loop_converters(displacement: _core.SensorChannel | None = None, velocity: _core.SensorChannel | None = None,
                     force: _core.SensorChannel | None = None, command_quantum: float = 0.0,
                     command_range: tuple[float, float] | None = None, command_unit_delay: bool = False,
-                    seed: int = 0) -> _core.LoopConverters:
+                    seed: int = 0, generator: str = "mersenne_twister") -> _core.LoopConverters:
     """The sensor and converter blocks of an EFT or RPsD loop (all off by default).
 
     Args:
@@ -130,6 +134,8 @@ def loop_converters(displacement: _core.SensorChannel | None = None, velocity: _
         command_quantum, command_range: the D/A on the command (quantizer then saturation).
         command_unit_delay: the plant receives the command of the previous sample.
         seed: of the noise generators (one per channel).
+        generator: which generator draws the noise, ``"mersenne_twister"`` or ``"simulink"``
+            (Simulink's Random Number block, the RTHS benchmark's; converters.hpp NoiseGenerator).
     """
     c = _core.LoopConverters()
     for name, ch in (("displacement", displacement), ("velocity", velocity), ("force", force)):
@@ -138,6 +144,7 @@ def loop_converters(displacement: _core.SensorChannel | None = None, velocity: _
     c.command = _converter("DigitalToAnalog", command_quantum, command_range)
     c.command_unit_delay = bool(command_unit_delay)
     c.seed = _integer("seed", seed) & (2**64 - 1)
+    c.generator = _choice("generator", generator, NOISE_GENERATORS)
     c.validate()
     return c
 
@@ -169,8 +176,12 @@ def run_eft(rig: Rig, ground_acceleration: ArrayLike | None = None, effective_fo
             alpha: float | None = None, mass: float | None = None, compute_delay: int = 0,
             model: Rig | None = None, solver_options: _core.SolverOptions | None = None,
             raise_on_failure: bool = True, options: _core.SolverOptions | None = None,
-            converters: _core.LoopConverters | None = None) -> Response:
+            converters: _core.LoopConverters | None = None, tracking=None) -> Response:
     """Effective force testing (force control) of ``rig``.
+
+    ``tracking`` (None: the paper's velocity feedback compensation of ``compensation``) is any
+    TrackingController (tracking.hpp): it reads desired = P_eff [N] and the measured force,
+    velocity and pressure, and returns the force command [N].
 
     Args:
         ground_acceleration: a_g [m/s^2] per controller sample; or
@@ -201,9 +212,62 @@ def run_eft(rig: Rig, ground_acceleration: ArrayLike | None = None, effective_fo
     m = rig.m if cfg.mass is None else cfg.mass
     ag = (_array("ground_acceleration", ground_acceleration) if effective_force is None
           else -_array("effective_force", effective_force) / m)
-    test = _core.EffectiveForceTest(rig, cfg, model, _converters(converters))
+    test = _core.EffectiveForceTest(rig, cfg, model, _converters(converters), _tracking(tracking))
     d, s = test.run(ag)
     return finish(Response(d, kind="eft", mode="force", dt=cfg.dt, rig=rig, work=s), raise_on_failure)
+
+
+_SUBSTRUCTURE_PROTOCOL = ("h", "size", "interface_dof", "reset", "step", "displacements", "interface_velocity",
+                          "interface_acceleration")
+
+
+def linear_substructure(M: ArrayLike, C: ArrayLike, K: ArrayLike, ground: ArrayLike | None = None,
+                        interface: ArrayLike | int = 0, dt: float | None = None,
+                        scheme: str = "central_difference") -> _core.rths.LinearSubstructure:
+    """A linear numerical substructure M x'' + C x' + K x = -ground a_g - interface f_in of any
+    size, for ``run_rpsd(substructure=...)`` (and the RTHS loop).
+
+    Args:
+        M, C, K: mass [kg], damping [N s/m] and stiffness [N/m] matrices (n x n; scalars for 1 DOF).
+        ground: ground-load vector [kg] (None: M @ 1, a rigid base).
+        interface: the DOF the measured restoring force acts on (an index), or the vector gamma.
+        dt: sample time [s] (None: the core's RPsD 0.5 ms); must equal the loop's.
+        scheme: ``"central_difference"``, ``"explicit_newmark"``, ``"average_acceleration"`` or
+            ``"runge_kutta4"`` (substructure.hpp).
+    """
+    Mm, Cm, Km = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (M, C, K))
+    n = Mm.shape[0]
+    g = Mm @ np.ones(n) if ground is None else np.atleast_1d(np.asarray(ground, dtype=float))
+    if isinstance(interface, (int, np.integer)) and not isinstance(interface, bool):
+        if not 0 <= interface < n:
+            raise ValueError(f"invalid interface = {interface}: a DOF index 0..{n - 1}")
+        gam = np.zeros(n)
+        gam[int(interface)] = 1.0
+    else:
+        gam = np.atleast_1d(np.asarray(interface, dtype=float))
+    model = _core.rths.LinearSubstructureModel(Mm, Cm, Km, g, gam)
+    model.validate()
+    h = _default(dt, _core.RpsdConfig(), "dt")
+    return _core.rths.LinearSubstructure(model, h, _choice("scheme", scheme, STRUCTURAL_SCHEMES))
+
+
+def _substructure(sub):
+    """The core object for ``run_rpsd(substructure=...)``: a core NumericalSubstructure as is, a
+    Python object with the adapter protocol (rths.OpenSeesSubstructure) wrapped, None kept."""
+    if sub is None or isinstance(sub, _core.rths.NumericalSubstructure):
+        return sub
+    missing = [a for a in _SUBSTRUCTURE_PROTOCOL if not hasattr(sub, a)]
+    if missing:
+        raise ValueError(f"invalid substructure = {sub!r}: expected a NumericalSubstructure "
+                         f"(linear_substructure(...)) or an object with {', '.join(missing)}")
+    return _core.rths.PythonSubstructure(sub)
+
+
+def _tracking(t):
+    if t is not None and not isinstance(t, _core.rths.TrackingController):
+        raise ValueError(f"invalid tracking = {t!r}: expected a TrackingController "
+                         "(e.g. _core.rths.AdaptiveTimeSeries)")
+    return t
 
 
 def rpsd_config(dt: float | None = None, m_m: float | None = None, c_m: float | None = None,
@@ -244,8 +308,15 @@ def run_rpsd(rig: Rig, ground_acceleration: ArrayLike | None = None, external_fo
              subtract_damping: float | None = None, compute_delay: int = 0,
              solver_options: _core.SolverOptions | None = None, raise_on_failure: bool = True,
              solver: str | None = None, options: _core.SolverOptions | None = None,
-             converters: _core.LoopConverters | None = None) -> Response:
+             converters: _core.LoopConverters | None = None, substructure=None, tracking=None) -> Response:
     """Real-time pseudodynamic testing (displacement control) of ``rig``.
+
+    ``substructure`` (None: Eq (15)'s 1-DOF model of m_m, c_m and ``scheme``) is the numerical
+    substructure the solver steps: ``linear_substructure(M, C, K, ...)`` of any size, or a Python
+    object with the adapter protocol (``rths.OpenSeesSubstructure(..., h=dt)``).  It is stepped
+    with a_g held over the sample; the restoring force f (minus P_ext) acts on its interface
+    DOF, and the command's target is that DOF's displacement.  ``tracking`` (None: the paper's
+    amplitude compensation T_d) is any TrackingController (tracking.hpp), e.g. ATS.
 
     ``converters`` (``loop_converters(...)``; None: ideal) puts sensor noise, A/D and D/A
     converters and unit delays between the plant and the controller.
@@ -295,8 +366,11 @@ def run_rpsd(rig: Rig, ground_acceleration: ArrayLike | None = None, external_fo
     cfg = rpsd_config(dt, m_m, c_m, k_m, scheme, restoring_force, amplitude_T, delay_T, alpha,
                       physical_mass_fraction, force_measurement, subtract_mass, subtract_damping, compute_delay,
                       opts or _solver_options())
-    test = _core.RealTimePseudoDynamicTest(rig, cfg, _converters(converters))
+    sub = _substructure(substructure)
+    test = _core.RealTimePseudoDynamicTest(rig, cfg, _converters(converters), _tracking(tracking), sub)
     d, s = test.run(ag, pe, fe)
+    if isinstance(sub, _core.rths.PythonSubstructure) and sub.error:
+        raise RuntimeError(f"numerical substructure failed: {sub.error}")
     phys = _core.RealTimePseudoDynamicTest.physical_rig(rig, cfg)
     return finish(Response(d, kind="rpsd", mode="displacement", dt=cfg.dt, rig=phys, work=s), raise_on_failure)
 

@@ -5,10 +5,12 @@
 #include <cstdio>
 #include <vector>
 
-#include "alloc_counter.hpp"
-#include "check.hpp"
 #include "servohydraulics/loops.hpp"
+#include "servohydraulics/rths/tracking.hpp"
 #include "servohydraulics/zhao2003.hpp"
+
+#include "alloc_counter.hpp"  // after the headers that pull in mm_malloc.h (Eigen)
+#include "check.hpp"
 
 using namespace servohydraulics;
 constexpr double kPi = 3.14159265358979323846;
@@ -168,11 +170,100 @@ static void eft_follows_eq10() {
   CHECK(std::abs(std::abs(H) - std::abs(H10)) < 0.05);
 }
 
+// Sensors of a smooth motion, the same for every controller (open loop: the
+// controllers' commands compare sample for sample).
+static Output sensors_at(int k, double dt) {
+  // x = X sin^3(w t): at rest at t_0 (x, v, a and the forces 0), as a loop starts.
+  const double t = k * dt, w = 2 * kPi * 1.3, sn = std::sin(w * t), cs = std::cos(w * t), X = 2e-3;
+  Output s;
+  s.time = t;
+  s.displacement = X * sn * sn * sn;
+  s.velocity = 3 * X * w * sn * sn * cs;
+  s.acceleration = X * w * w * (6 * sn * cs * cs - 3 * sn * sn * sn);
+  s.force = 3e3 * sn * sn * sn + 500.0 * sn * sn;
+  s.pressure = s.force / 8.21e-3;
+  return s;
+}
+
+// Eq (15)'s central difference is the 1-DOF case of LinearSubstructure (M = m_m,
+// C = c_m, K = 0, ground = m_m, interface = 1): the RPsD commands agree to round-off
+// for every restoring-force option, and the loop runs it without allocating.
+static void eq15_is_the_one_dof_linear_substructure() {
+  const Rig rig = zhao2003();
+  for (auto rf : {RestoringForce::CalculatedDisplacement, RestoringForce::MeasuredDisplacement,
+                  RestoringForce::MeasuredForce, RestoringForce::MeasuredForceCorrected}) {
+    RpsdConfig rc;
+    rc.restoring_force = rf;
+    LinearSubstructureModel m1;
+    m1.M = Eigen::MatrixXd::Constant(1, 1, rc.model.m_m);
+    m1.C = Eigen::MatrixXd::Constant(1, 1, rc.model.c_m);
+    m1.K = Eigen::MatrixXd::Zero(1, 1);
+    m1.ground = Eigen::VectorXd::Constant(1, rc.model.m_m);
+    m1.interface = Eigen::VectorXd::Ones(1);
+    LinearSubstructure lin(m1, rc.dt, StructuralScheme::CentralDifference);
+    RpsdController eq15(rc, rig), one(rc, rig, nullptr, &lin);
+    double peak = 0.0, worst = 0.0;
+    for (int k = 0; k < 4000; ++k) {
+      const Output s = sensors_at(k, rc.dt);
+      const double ag = k == 0 ? 0.0 : 2.0 * std::sin(2 * kPi * 2.1 * k * rc.dt);  // at rest at t_0
+      const double pe = 500.0 * std::sin(2 * kPi * 0.7 * k * rc.dt);
+      const double u1 = eq15.command(s, ag, pe), u2 = one.command(s, ag, pe);
+      peak = std::fmax(peak, std::fabs(u1));
+      worst = std::fmax(worst, std::fabs(u1 - u2));
+      CHECK_NEAR(eq15.integrator_state().displacement, one.integrator_state().displacement, 1e-9 * (peak + 1e-6));
+    }
+    CHECK(peak > 1e-4);
+    CHECK(worst <= 1e-9 * peak);
+    std::printf("  1-DOF linear vs Eq (15) central difference, option %d: max |du| = %.3g of peak %.3g m\n",
+                static_cast<int>(rf), worst, peak);
+  }
+}
+
+// RPsD on a 3-DOF linear substructure with ATS as the tracking compensator: runs,
+// finite, and neither step nor run allocates.
+static void rpsd_mdof_with_ats_does_not_allocate() {
+  const Rig rig = zhao2003();
+  RpsdConfig rc;
+  rc.restoring_force = RestoringForce::MeasuredDisplacement;
+  LinearSubstructureModel m3;
+  m3.M = 2000.0 * Eigen::MatrixXd::Identity(3, 3);
+  m3.K.setZero(3, 3);
+  const double k = 4e6;
+  m3.K << k, -k, 0, -k, 2 * k, -k, 0, -k, k;
+  m3.C = 1e-3 * m3.K;
+  m3.ground = m3.M * Eigen::VectorXd::Ones(3);
+  m3.interface = Eigen::VectorXd::Unit(3, 0);
+  LinearSubstructure lin(m3, rc.dt, StructuralScheme::CentralDifference);
+  rths::AtsConfig ac;
+  ac.dt = rc.dt;
+  ac.converters.ad = ideal_converter();
+  ac.converters.da = ideal_converter(Converter::Kind::DigitalToAnalog);
+  rths::AdaptiveTimeSeries ats(ac);
+  RealTimePseudoDynamicTest rp(rig, rc, {}, &ats, &lin);
+  std::vector<RpsdOutput> rows(3000);
+  std::vector<double> ag(rows.size());
+  for (std::size_t i = 0; i < ag.size(); ++i) ag[i] = 0.3 * std::sin(2 * kPi * 2.0 * i * rc.dt);
+  RpsdOutput ro;
+  rp.step(0.0, 0.0, 0.0, ro);
+  RunSummary sum;
+  const long n = count_allocations([&] {
+    rp.reset();
+    sum = run_rpsd(rp, ag.data(), nullptr, nullptr, ag.size(), rows.data());
+  });
+  CHECK(n == 0);
+  CHECK(sum.rows == rows.size());
+  double peak = 0.0;
+  for (const RpsdOutput& r : rows) peak = std::fmax(peak, std::fabs(r.plant.displacement));
+  CHECK(std::isfinite(peak) && peak > 1e-5 && peak < 0.1);
+}
+
 int main() {
   phase_lead();
   sample_delay();
   solvers();
   loops_do_not_allocate();
   eft_follows_eq10();
+  eq15_is_the_one_dof_linear_substructure();
+  rpsd_mdof_with_ats_does_not_allocate();
   return sh_test::report("test_loops");
 }

@@ -231,7 +231,7 @@ void no_allocation() {
   pc.tau = plant_delay(par);
   PolynomialExtrapolation poly(pc);
   AdaptiveTimeSeries ats(AtsConfig{});
-  ModelBasedCompensator model(ModelBasedConfig::from_plant(par, 3));
+  ModelBasedCompensator model(model_based_config(par, 3));
   TrackingController* ctrls[] = {&sample, &poly, &ats, &model};
   BenchmarkPlant plant(par, kH);
   LinearSubstructure subs[] = {{three_storey(), kH, SubstructureScheme::RungeKutta4},
@@ -296,11 +296,24 @@ void no_allocation() {
 }
 }  // namespace
 
+// The experimental substructure's step returns a Status: Ok on a normal sample,
+// NonFinite when the benchmark plant's state diverges, and the loop's summary
+// carries it at the failure.
+static void experimental_status() {
+  BenchmarkPlant plant(BenchmarkPlantParameters{}, 1.0 / 4096.0);
+  CHECK(plant.step(1e-3).ok());
+  const Status bad = plant.step(std::nan(""));
+  CHECK(bad.code == Status::NonFinite);
+  plant.reset();
+  CHECK(plant.step(1e-3).ok());
+}
+
 int main() {
   tustin_coefficients();
   converters();
   loop_io();
   substructure_step();
   no_allocation();
+  experimental_status();
   return sh_test::report("test_rths");
 }

@@ -8,12 +8,13 @@
 #include <string>
 #include <vector>
 
-#include "alloc_counter.hpp"
-#include "check.hpp"
-#include "same_output.hpp"
 #include "servohydraulics/controllers.hpp"
 #include "servohydraulics/loops.hpp"
 #include "servohydraulics/zhao2003.hpp"
+
+#include "alloc_counter.hpp"  // after the headers that pull in mm_malloc.h (Eigen)
+#include "check.hpp"
+#include "same_output.hpp"
 
 using namespace servohydraulics;
 

@@ -112,3 +112,21 @@ def test_bad_input_names_the_field():
     c.force.noise.sigma = float("nan")
     with pytest.raises(ValueError, match=r"converters\.force\.noise\.sigma"):
         c.validate()
+
+
+def test_loop_converters_choose_the_noise_generator():
+    """The displacement channel's noise is sigma w_k of the chosen generator (the core's
+    GaussianSequence, converters.hpp): read back through option (b), f = k_m x_meas."""
+    rig = sh.zhao2003()
+    ag = np.zeros(200)
+    sigma = 1e-4
+    for name, gen in (("mersenne_twister", _core.NoiseGenerator.MersenneTwister),
+                      ("simulink", _core.NoiseGenerator.SimulinkRandomNumber)):
+        conv = sh.loop_converters(displacement=sh.sensor_channel(sigma=sigma), seed=7, generator=name)
+        r = sh.run_rpsd(rig, ground_acceleration=ag, converters=conv, k_m=1e6, delay_T=0.0)
+        noise = np.asarray(r.channels["measured_restoring_force"]) / 1e6 - np.asarray(r.channels["displacement"])
+        w = _core.GaussianSequence(7, gen)
+        expected = sigma * np.array([w.next() for _ in ag])
+        np.testing.assert_allclose(noise, expected, rtol=1e-9, atol=1e-15)
+    with pytest.raises(ValueError, match="generator"):
+        sh.loop_converters(generator="bogus")

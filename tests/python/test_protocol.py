@@ -120,3 +120,19 @@ def test_protocol_covers_every_writable_field(obj):
     assert sorted(state) == sorted(writable)
     text = repr(obj)
     assert all(f"{n}=" in text for n in writable)
+
+
+def test_config_field_tables_drive_the_loop_configs():
+    """kEftConfigFields / kRpsdConfigFields (controllers.hpp) are the configs' attributes, in the
+    order the protocol's repr uses, each with a unit and a meaning; pickling keeps every one."""
+    for cls, table in ((_core.EftConfig, _core.EFT_CONFIG_FIELDS), (_core.RpsdConfig, _core.RPSD_CONFIG_FIELDS)):
+        names = [name for name, _, _ in table]
+        obj = cls()
+        assert all(hasattr(obj, n) for n in names)
+        assert all(isinstance(unit, str) and meaning for _, unit, meaning in table)
+        text = repr(obj)
+        assert text.startswith(f"{cls.__name__}({names[0]}=")
+        positions = [text.index(f"{n}=") for n in names]
+        assert positions == sorted(positions)
+        assert pickle.loads(pickle.dumps(obj)) == obj
+    assert [n for n, _, _ in _core.RPSD_CONFIG_FIELDS][:4] == ["dt", "model", "k_m", "scheme"]

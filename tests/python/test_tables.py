@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import inspect
 
+import numpy as np
 import pytest
 
 import servohydraulics as sh
@@ -21,11 +22,19 @@ TABLES = {
     "methods": (METHODS, _core.METHOD_NAMES, _core.SolverOptions.Method),
     "restarts": (RESTARTS, _core.RESTART_NAMES, _core.SolverOptions.Restart),
     "compensation": (loops.COMPENSATION, _core.COMPENSATION_NAMES, _core.VelocityFeedbackCompensator.Kind),
-    "schemes": (loops.SCHEMES, _core.SCHEME_NAMES, _core.IntegrationScheme),
+    "schemes": (loops.STRUCTURAL_SCHEMES, _core.SCHEME_NAMES, _core.StructuralScheme),
     "restoring_force": (loops.RESTORING_FORCE, _core.RESTORING_FORCE_NAMES, _core.RestoringForce),
     "force_measurement": (loops.FORCE_MEASUREMENT, _core.FORCE_MEASUREMENT_NAMES, _core.ForceMeasurement),
     "flow_curve_kind": (rig.FLOW_CURVE_KINDS, _core.FLOW_CURVE_KIND_NAMES, _core.FlowCurve.Kind),
 }
+
+
+def test_eq15_schemes_are_the_first_rows_of_the_scheme_table():
+    """run_rpsd's scheme= (Eq 15 itself) takes the first two structural schemes; the others need a
+    LinearSubstructure, and Eq (15) refuses them by name."""
+    assert list(loops.SCHEMES.items()) == list(_core.SCHEME_NAMES)[:2]
+    with pytest.raises(Exception, match="scheme"):
+        sh.run_rpsd(sh.zhao2003(), np.zeros(10), scheme="runge_kutta4")
 
 
 @pytest.mark.parametrize("key", TABLES)

@@ -22,8 +22,11 @@
 
 #include "servohydraulics/channels.hpp"
 #include "servohydraulics/compensators.hpp"
+#include "servohydraulics/config_fields.hpp"
 #include "servohydraulics/integration.hpp"
 #include "servohydraulics/plant.hpp"
+#include "servohydraulics/substructure.hpp"
+#include "servohydraulics/tracking.hpp"
 #include "servohydraulics/zhao2003.hpp"
 
 namespace servohydraulics {
@@ -42,6 +45,16 @@ struct EftConfig {
   SolverOptions plant_options;  //!< the simulated plant's ODE integrator (loops.hpp only)
   void validate() const;
 };
+
+//! EftConfig's fields (config_fields.hpp): the binding's attributes and EFT_CONFIG_FIELDS.
+inline constexpr auto kEftConfigFields = std::make_tuple(
+    config_field("dt", "s", "controller sample time", &EftConfig::dt),
+    config_field("mass", "kg", "m in P_eff = -m a_g (none: the rig's m)", &EftConfig::mass),
+    config_field("compensation", "", "velocity feedback compensation: none, linear, nonlinear", &EftConfig::compensation),
+    config_field("lead_T", "s", "phase lead on the compensation (0: none)", &EftConfig::lead_T),
+    config_field("alpha", "-", "phase-lead constant", &EftConfig::alpha),
+    config_field("compute_delay", "samples", "compute delay on the command", &EftConfig::compute_delay),
+    config_field("plant_options", "", "the simulated plant's ODE integrator (loops only)", &EftConfig::plant_options));
 
 //! Every channel of one EFT sample.
 struct EftOutput {
@@ -62,14 +75,18 @@ inline constexpr ChannelInfoOf<EftOutput> kEftChannels[] = {
     {"command", "N", "force command sent to the servo controller", &EftOutput::command},
 };
 
-//! The EFT controller: P_eff = -m a_g plus the velocity feedback compensation
-//! (Eqs 9-10), through the optional compute delay.
+//! The EFT controller: P_eff = -m a_g through a tracking compensator (tracking.hpp;
+//! default: the paper's velocity feedback compensation, Eqs 9-10), then the
+//! optional compute delay.  The compensator reads desired = P_eff [N], the
+//! measured force, velocity and pressure, and returns the force command [N].
 class EftController {
  public:
   //! model: the controller's model of the rig, used by the compensator (A, K_v,
   //! K_s, C_F_force, G_p, flow curve and pressure factor) and, when
   //! config.mass is none, for m in P_eff = -m a_g.  config.plant_options is unused.
-  EftController(const EftConfig& config, const Rig& model);
+  //! tracking: a compensator in place of the paper's (not owned; must outlive the
+  //! controller); nullptr = VelocityFeedbackTracking of config.compensation.
+  EftController(const EftConfig& config, const Rig& model, TrackingController* tracking = nullptr);
 
   void reset() noexcept;  //!< at rest
   //! sensors at t_k (velocity, load-cell force, pressure are read), a_g(t_k)
@@ -79,11 +96,14 @@ class EftController {
 
   const EftConfig& config() const noexcept { return cfg_; }
   double mass() const noexcept { return mass_; }  //!< m in P_eff [kg]
-  const VelocityFeedbackCompensator& compensator() const noexcept { return vfc_; }
+  //! The paper's compensator (the one in use unless a tracking controller was given).
+  const VelocityFeedbackCompensator& compensator() const noexcept { return paper_.compensator(); }
+  TrackingController& tracking() noexcept { return user_ ? *user_ : paper_; }  //!< the compensator in use
 
  private:
   EftConfig cfg_;
-  VelocityFeedbackCompensator vfc_;
+  VelocityFeedbackTracking paper_;
+  TrackingController* user_ = nullptr;
   SampleDelay delay_;
   double mass_;
 };
@@ -119,7 +139,8 @@ struct RpsdConfig {
   double dt = Zhao2003TestMethods{}.dt;     //!< controller sample time [s]
   ModelSDOF model = Zhao2003TestMethods{}.model;  //!< m_m, c_m of Eq (15) (Table I)
   std::optional<double> k_m;                //!< stiffness for options (a), (b) [N/m]; none = the physical rig's k
-  IntegrationScheme scheme = IntegrationScheme::CentralDifference;  //!< integrates Eq (15) online
+  //! integrates Eq (15) online (the default 1-DOF substructure; unused when a substructure is given)
+  StructuralScheme scheme = StructuralScheme::CentralDifference;
   RestoringForce restoring_force = RestoringForce::MeasuredDisplacement;
   ForceMeasurement force_measurement = ForceMeasurement::LoadCell;
   double amplitude_T = Zhao2003TestMethods{}.amplitude_T;  //!< amplitude compensation T_d on the command [s]; 0 = none
@@ -132,6 +153,25 @@ struct RpsdConfig {
   SolverOptions plant_options;          //!< the simulated plant's ODE integrator (loops.hpp only)
   void validate() const;
 };
+
+//! RpsdConfig's fields (config_fields.hpp): the binding's attributes and RPSD_CONFIG_FIELDS.
+inline constexpr auto kRpsdConfigFields = std::make_tuple(
+    config_field("dt", "s", "controller sample time", &RpsdConfig::dt),
+    config_field("model", "", "m_m [kg], c_m [N s/m] of Eq (15)", &RpsdConfig::model),
+    config_field("k_m", "N/m", "stiffness for options (a), (b) (none: the physical rig's k)", &RpsdConfig::k_m),
+    config_field("scheme", "", "Eq (15)'s integration scheme", &RpsdConfig::scheme),
+    config_field("restoring_force", "", "restoring-force option (a)-(d)", &RpsdConfig::restoring_force),
+    config_field("force_measurement", "", "load cell or actuator pressure p A", &RpsdConfig::force_measurement),
+    config_field("amplitude_T", "s", "amplitude compensation T_d on the command (0: none)", &RpsdConfig::amplitude_T),
+    config_field("delay_T", "s", "delay compensation T_ld on the restoring force (0: none)", &RpsdConfig::delay_T),
+    config_field("alpha", "-", "phase-lead constant of both networks", &RpsdConfig::alpha),
+    config_field("physical_mass_fraction", "-", "simulation: the plant's structural mass / m_m",
+                 &RpsdConfig::physical_mass_fraction),
+    config_field("subtract_mass", "kg", "(d): mass times measured acceleration removed", &RpsdConfig::subtract_mass),
+    config_field("subtract_damping", "N s/m", "(d): damping times measured velocity removed",
+                 &RpsdConfig::subtract_damping),
+    config_field("compute_delay", "samples", "compute delay on the command", &RpsdConfig::compute_delay),
+    config_field("plant_options", "", "the simulated plant's ODE integrator (loops only)", &RpsdConfig::plant_options));
 
 //! Every channel of one RPsD sample.
 struct RpsdOutput {
@@ -163,8 +203,10 @@ inline constexpr ChannelInfoOf<RpsdOutput> kRpsdChannels[] = {
 };
 
 //! The RPsD controller: the restoring force from the sensors (options a-d), the
-//! delay compensation T_ld on it, the Eq (15) integration scheme, and the
-//! amplitude compensation T_d on the displacement command.
+//! delay compensation T_ld on it, the Eq (15) integration scheme, and a tracking
+//! compensator on the displacement command (tracking.hpp; default: the paper's
+//! amplitude compensation T_d).  The compensator reads desired = d_{k+1}, the
+//! solver's v_k and a_k, and the measured channels.
 class RpsdController {
  public:
   //! physical: the rig under test as built (its m is the structural mass behind
@@ -172,7 +214,16 @@ class RpsdController {
   //! k (k_m), m, m_p and effects.piston_mass (subtract_mass), c
   //! (subtract_damping) and A (force from the actuator pressure, p A).
   //! config.physical_mass_fraction and plant_options are unused here.
-  RpsdController(const RpsdConfig& config, const Rig& physical);
+  //! tracking: a compensator in place of the paper's amplitude lead (not owned; must
+  //! outlive the controller); nullptr = AmplitudeLead(amplitude_T, alpha, dt).
+  //! substructure: the numerical substructure in place of Eq (15)'s 1-DOF model (not owned;
+  //! must outlive the controller; its sample time must be config.dt): any NumericalSubstructure
+  //! (LinearSubstructure of any size, a Python one such as the OpenSeesPy adapter).  It is
+  //! stepped with a_g held over the sample and f_in = f - P_ext on its interface DOF; the
+  //! command's target is its interface displacement.  nullptr = Eq15Substructure(config.model,
+  //! config.dt, config.scheme).
+  RpsdController(const RpsdConfig& config, const Rig& physical, TrackingController* tracking = nullptr,
+                 NumericalSubstructure* substructure = nullptr);
 
   void reset() noexcept;  //!< at rest, solver at d = 0
   //! sensors at t_k, a_g [m/s^2], external force P_ext into the solver [N],
@@ -182,16 +233,29 @@ class RpsdController {
                  double restoring_force_error = 0.0, RpsdOutput* out = nullptr) noexcept;
 
   const RpsdConfig& config() const noexcept { return cfg_; }
-  const IntegratorState& integrator_state() const noexcept;
+  //! The solver's d_k, v_k, a_k and target d_{k+1} (a given substructure: its interface DOF).
+  const IntegratorState& integrator_state() const noexcept { return st_; }
+  NumericalSubstructure& substructure() noexcept { return user_sub_ ? *user_sub_ : eq15_; }  //!< in use
+  const NumericalSubstructure& substructure() const noexcept {
+    return user_sub_ ? *user_sub_ : static_cast<const NumericalSubstructure&>(eq15_);
+  }
+  const TrackingController& tracking() const noexcept {
+    return user_ ? *user_ : static_cast<const TrackingController&>(amplitude_);
+  }
   double k_m() const noexcept { return k_m_; }
   double subtract_mass() const noexcept { return m_sub_; }
   double subtract_damping() const noexcept { return c_sub_; }
+  TrackingController& tracking() noexcept { return user_ ? *user_ : amplitude_; }  //!< the compensator in use
 
  private:
   double restoring_force(const Output& sensors) const noexcept;
   RpsdConfig cfg_;
-  std::variant<CentralDifference, ExplicitNewmark> scheme_;
-  PhaseLead amplitude_, delay_comp_;
+  Eq15Substructure eq15_;
+  NumericalSubstructure* user_sub_ = nullptr;
+  IntegratorState st_;
+  AmplitudeLead amplitude_;
+  TrackingController* user_ = nullptr;
+  PhaseLead delay_comp_;
   SampleDelay delay_;
   double k_m_, m_sub_, c_sub_, A_;
 };

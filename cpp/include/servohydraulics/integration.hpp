@@ -20,13 +20,23 @@ struct ModelSDOF {
   void validate() const;
 };
 
-//! Which scheme integrates Eq (15) online.
-enum class IntegrationScheme { CentralDifference, ExplicitNewmark };
-inline constexpr EnumName<IntegrationScheme> kSchemeNames[] = {
-    {IntegrationScheme::CentralDifference, "central_difference", "CentralDifference"},
-    {IntegrationScheme::ExplicitNewmark, "explicit_newmark", "ExplicitNewmark"},
+//! The structural integration schemes of a numerical substructure (substructure.hpp), one
+//! enum for every hybrid loop.  Eq (15) of RPsD takes CentralDifference or ExplicitNewmark
+//! (its own 1-DOF forms below, Eq15Substructure); RungeKutta4 and AverageAcceleration (implicit
+//! Newmark, gamma = 1/2, beta = 1/4, unconditionally stable) run on LinearSubstructure.
+//! The values of CentralDifference and ExplicitNewmark are those of the RPsD enum before (the FMU
+//! enumeration items, cpp/fmu/model.cpp, index them).
+enum class StructuralScheme { CentralDifference, ExplicitNewmark, RungeKutta4, AverageAcceleration };
+using IntegrationScheme = StructuralScheme;  //!< the RPsD name before issue 22
+inline constexpr EnumName<StructuralScheme> kSchemeNames[] = {
+    {StructuralScheme::CentralDifference, "central_difference", "CentralDifference"},
+    {StructuralScheme::ExplicitNewmark, "explicit_newmark", "ExplicitNewmark"},
+    {StructuralScheme::RungeKutta4, "runge_kutta4", "RungeKutta4"},
+    {StructuralScheme::AverageAcceleration, "average_acceleration", "AverageAcceleration"},
 };
 static_assert(in_enum_order(kSchemeNames), "kSchemeNames: one row per enumerator, in order");
+//! The schemes Eq (15) itself takes (RpsdConfig::scheme): the first two rows of kSchemeNames.
+inline constexpr int kEq15Schemes = 2;
 
 //! State of an integration scheme at time t_k.
 struct IntegratorState {

@@ -1,5 +1,5 @@
 // Sensors and converters as optional blocks of the EFT and RPsD closed loops
-// (loops.hpp), built from the RTHS benchmark's general blocks (rths/converters.hpp):
+// (loops.hpp), built from the core's converter blocks (converters.hpp):
 // per measured channel (displacement, velocity, force)
 //   y_k = AD(gain x_k + sigma w_k), then optionally one sample of delay,
 // with w_k ~ N(0, 1) drawn once per sample (seeded, one generator per channel),
@@ -14,14 +14,14 @@
 #include <cstdint>
 
 #include "servohydraulics/output.hpp"
-#include "servohydraulics/rths/converters.hpp"
+#include "servohydraulics/converters.hpp"
 
 namespace servohydraulics {
 
 //! One measured channel: noise and sensor gain, A/D converter, optional unit delay.
 struct SensorChannel {
-  rths::SensorNoise noise{0.0, 1.0};                   //!< sigma [channel units], gain [-]
-  rths::Converter converter = rths::ideal_converter();  //!< A/D (kind AnalogToDigital), off by default
+  SensorNoise noise{0.0, 1.0};             //!< sigma [channel units], gain [-]
+  Converter converter = ideal_converter();  //!< A/D (kind AnalogToDigital), off by default
   bool unit_delay = false;                             //!< the controller sees y_{k-1} (0 at k = 0)
   bool active() const noexcept;
   void validate(const char* name) const;
@@ -32,9 +32,10 @@ struct LoopConverters {
   SensorChannel displacement;  //!< Output::displacement [m]
   SensorChannel velocity;      //!< Output::velocity [m/s]
   SensorChannel force;         //!< Output::force (load cell) [N]
-  rths::Converter command = rths::ideal_converter(rths::Converter::Kind::DigitalToAnalog);  //!< D/A on the command [m or N], off by default
+  Converter command = ideal_converter(Converter::Kind::DigitalToAnalog);  //!< D/A on the command [m or N], off by default
   bool command_unit_delay = false;  //!< the plant receives u_{k-1} (0 at k = 0)
   std::uint64_t seed = 0;           //!< of the noise generators
+  NoiseGenerator generator = NoiseGenerator::MersenneTwister;  //!< which generator draws the noise
   bool active() const noexcept;
   void validate() const;
 };
@@ -52,14 +53,14 @@ class LoopIo {
 
  private:
   struct Channel {
-    rths::GaussianSequence w;
-    rths::UnitDelay delay;
+    GaussianSequence w;
+    UnitDelay delay;
   };
   double channel(const SensorChannel& c, Channel& s, double x) noexcept;
   LoopConverters cfg_;
   bool active_ = false;
   Channel d_, v_, f_;
-  rths::UnitDelay u_delay_;
+  UnitDelay u_delay_;
 };
 
 }  // namespace servohydraulics

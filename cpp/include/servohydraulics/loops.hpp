@@ -78,8 +78,9 @@ class EffectiveForceTest : public ClosedLoop<EftController> {
   //! (none = the same rig, i.e. perfect knowledge).  config.mass none = rig.m
   //! (the plant's, whatever the model).
   //! converters: the optional sensor and converter blocks (loop_converters.hpp; off by default).
+  //! tracking: as EftController's (not owned; nullptr = the paper's velocity feedback compensation).
   EffectiveForceTest(const Rig& rig, const EftConfig& config, const std::optional<Rig>& model = std::nullopt,
-                     const LoopConverters& converters = {});
+                     const LoopConverters& converters = {}, TrackingController* tracking = nullptr);
 
   Status step(double ground_acceleration, EftOutput& out) noexcept {
     return ClosedLoop::step(out, ground_acceleration);
@@ -97,7 +98,9 @@ class RealTimePseudoDynamicTest : public ClosedLoop<RpsdController> {
  public:
   //! rig: the physical test (its m is replaced by physical_mass_fraction * m_m).
   //! converters: the optional sensor and converter blocks (loop_converters.hpp; off by default).
-  RealTimePseudoDynamicTest(const Rig& rig, const RpsdConfig& config, const LoopConverters& converters = {});
+  //! tracking, substructure: as RpsdController's (not owned; nullptr = the paper's).
+  RealTimePseudoDynamicTest(const Rig& rig, const RpsdConfig& config, const LoopConverters& converters = {},
+                            TrackingController* tracking = nullptr, NumericalSubstructure* substructure = nullptr);
 
   //! ground_acceleration [m/s^2], external_force into the solver [N], restoring_force_error added to f [N].
   Status step(double ground_acceleration, double external_force, double restoring_force_error,

@@ -67,7 +67,7 @@ void BenchmarkPlant::rhs(const std::array<double, 5>& p, double u, double rate, 
   dp[4] = (p[2] - c_e_ * p[4] - par_.k_e * p[3]) / par_.m_e;
 }
 
-bool BenchmarkPlant::step(double command) noexcept {
+Status BenchmarkPlant::step(double command) noexcept {
   std::array<double, 5> k1, k2, k3, k4, t;
   const double h = dt_;
   x_major_ = p_[3];
@@ -86,7 +86,9 @@ bool BenchmarkPlant::step(double command) noexcept {
     p_[i] += (h / 6.0) * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
     finite = finite && std::isfinite(p_[i]);
   }
-  return finite;
+  Status st;
+  if (!finite) st.code = Status::NonFinite;
+  return st;
 }
 
 ServoHydraulicSubstructure::ServoHydraulicSubstructure(const Rig& rig, double dt, const SolverOptions& options)
@@ -99,6 +101,6 @@ void ServoHydraulicSubstructure::reset() noexcept {
   plant_.observe(out_);
 }
 
-bool ServoHydraulicSubstructure::step(double command) noexcept { return plant_.step(command, out_).ok(); }
+Status ServoHydraulicSubstructure::step(double command) noexcept { return plant_.step(command, out_); }
 
 }  // namespace servohydraulics::rths

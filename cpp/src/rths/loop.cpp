@@ -53,7 +53,8 @@ RthsSummary RthsLoop::run(const GroundMotion& ag, std::size_t n, const RthsRecor
     const double fm = cfg_.force_noise(sp.k * x + sp.c * v + sp.m * a, wf);
     const double fin = delay_(fm);
     const double ag0 = ag(t);
-    const TrackingInput in{y1, num_.interface_velocity(), num_.interface_acceleration(ag0, fin), xm, fm};
+    TrackingInput in{y1, num_.interface_velocity(), num_.interface_acceleration(ag0, fin), xm, fm};
+    in.measured_velocity = v;  // the backward difference of the specimen displacement
     const double u = ctrl_.command(in);
     const double f = exp_.actuator_force();
     if (rec.measured) rec.measured[k] = xm;
@@ -67,12 +68,14 @@ RthsSummary RthsLoop::run(const GroundMotion& ag, std::size_t n, const RthsRecor
     sum.peak_actuator_force = std::fmax(sum.peak_actuator_force, std::fabs(f));
     sum.peak_displacement = std::fmax(sum.peak_displacement, std::fabs(x));
     sum.peak_velocity = std::fmax(sum.peak_velocity, std::fabs(exp_.velocity()));
-    const bool ok = exp_.step(u);
+    const Status st = exp_.step(u);
     num_.step(ag0, ag(t + 0.5 * h), ag(t + h), fin);
     if (rec.step_seconds) rec.step_seconds[k] = std::chrono::duration<double>(clock::now() - t0).count();
-    if (!ok || !std::isfinite(xm) || !std::isfinite(u) || !num_.healthy()) {
+    if (!st.ok() || !std::isfinite(xm) || !std::isfinite(u) || !num_.healthy()) {
       sum.ok = false;
       sum.failure_time = t;
+      sum.status = st;
+      if (st.ok()) sum.status.code = Status::NonFinite;  // the loop's own signals or the numerical part
       break;
     }
   }

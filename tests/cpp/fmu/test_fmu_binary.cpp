@@ -17,10 +17,11 @@
 #include <string>
 #include <vector>
 
-#include "alloc_counter.hpp"
-#include "check.hpp"
 #include "fmi2Functions.h"
 #include "model.hpp"
+
+#include "alloc_counter.hpp"  // after the headers that pull in mm_malloc.h (Eigen)
+#include "check.hpp"
 
 namespace fmu = servohydraulics::fmu;
 using servohydraulics::ControlMode;

@@ -67,8 +67,8 @@ class ExperimentalSubstructure {
  public:
   virtual ~ExperimentalSubstructure() = default;
   virtual void reset() noexcept = 0;  //!< at rest at t = 0
-  //! Hold command [m] over one sample; false if the step failed (the loop stops).
-  virtual bool step(double command) noexcept = 0;
+  //! Hold command [m] over one sample; the status of the step (not ok: the loop stops).
+  virtual Status step(double command) noexcept = 0;
   virtual double displacement() const noexcept = 0;    //!< true specimen displacement [m]
   virtual double velocity() const noexcept = 0;        //!< [m/s]
   virtual double actuator_force() const noexcept = 0;  //!< actuator force (benchmark: f; Plant: load cell) [N]
@@ -85,7 +85,7 @@ class BenchmarkPlant final : public ExperimentalSubstructure {
     x_prev_ = 0.0;
     first_ = true;
   }
-  bool step(double command) noexcept override;
+  Status step(double command) noexcept override;  //!< NonFinite when the state diverged
   double displacement() const noexcept override { return p_[3]; }
   double velocity() const noexcept override { return p_[4]; }
   double actuator_force() const noexcept override { return p_[2]; }
@@ -109,7 +109,7 @@ class ServoHydraulicSubstructure final : public ExperimentalSubstructure {
   //! The specimen is the rig's structure (m, c, k); dt the sample time.
   ServoHydraulicSubstructure(const Rig& rig, double dt, const SolverOptions& options = {});
   void reset() noexcept override;
-  bool step(double command) noexcept override;
+  Status step(double command) noexcept override;  //!< the Plant's own Status
   double displacement() const noexcept override { return out_.displacement; }
   double velocity() const noexcept override { return out_.velocity; }
   double actuator_force() const noexcept override { return out_.force; }

@@ -53,6 +53,7 @@ struct RthsSummary {
   double peak_actuator_force = 0.0;  //!< max |f| [N]
   double peak_displacement = 0.0;    //!< max |X_int| [m]
   double peak_velocity = 0.0;        //!< max |x'| [m/s]
+  Status status;                     //!< at the failure: the experimental substructure's (NonFinite otherwise)
 };
 
 class RthsLoop {

@@ -1,11 +1,11 @@
-#include "servohydraulics/rths/converters.hpp"
+#include "servohydraulics/converters.hpp"
 
 #include <cmath>
 #include <limits>
 
 #include "servohydraulics/error.hpp"
 
-namespace servohydraulics::rths {
+namespace servohydraulics {
 
 void Saturation::validate() const {
   require(std::isfinite(lower), "saturation.lower", lower, "finite");
@@ -111,4 +111,4 @@ BackwardDifference::BackwardDifference(double h) : h_(h) {
   require(std::isfinite(h) && h > 0.0, "h", h, "finite and > 0");
 }
 
-}  // namespace servohydraulics::rths
+}  // namespace servohydraulics
