@@ -29,19 +29,21 @@ Rig all_on() {
 void check_layout() {
   const Dynamics paper(zhao2003(), ControlMode::Displacement);
   CHECK(paper.num_states() == kNumStates);
-  CHECK(paper.layout().bw_z == -1 && paper.layout().mr_y == -1 && paper.layout().pade == -1);
+  CHECK(paper.layout().offset_of<BoucWen>() == -1 && paper.layout().offset_of<MrDamper>() == -1 &&
+        paper.layout().offset_of<PadeDelay>() == -1);
   const Dynamics d(all_on(), ControlMode::Displacement);
   CHECK(d.num_states() == kNumStates + 1 + 2 + 3);
-  CHECK(d.layout().bw_z == 6 && d.layout().mr_y == 7 && d.layout().pade == 9 && d.layout().pade_order == 3);
+  CHECK(d.layout().offset_of<BoucWen>() == 6 && d.layout().offset_of<MrDamper>() == 7 &&
+        d.layout().offset_of<PadeDelay>() == 9 && d.layout().count_of<PadeDelay>() == 3);
   CHECK(std::string(d.state_info(6).name) == "bw_z" && std::string(d.state_info(8).name) == "mr_z");
   CHECK(std::string(d.state_info(11).name) == "delay_3");
   // No actuator in free mode: no loop delay.
   const Dynamics f(all_on(), ControlMode::Free);
-  CHECK(f.num_states() == kNumStates + 3 && f.layout().pade == -1);
+  CHECK(f.num_states() == kNumStates + 3 && f.layout().offset_of<PadeDelay>() == -1);
   Rig mr = zhao2003();
   mr.effects.mr_damper = true;
   const Dynamics m(mr, ControlMode::Force);
-  CHECK(m.layout().mr_y == kNumStates && m.num_states() == kNumStates + 2);
+  CHECK(m.layout().offset_of<MrDamper>() == kNumStates && m.num_states() == kNumStates + 2);
 }
 
 // The operating point holds the plant at rest with every element on (incl. the
