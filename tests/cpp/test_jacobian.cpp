@@ -1,8 +1,8 @@
 // Analytic Jacobian df/dy, input gradient df/du and the linearised output
 // matrices (C, D) against central finite differences of Dynamics::rhs and
 // Dynamics::outputs, at many fixed-seed random states, in every control mode
-// and for every combination of the twelve effect switches (the nine of the
-// paper's plant, the Bouc-Wen and MR damper specimens and the Pade loop delay,
+// and for every combination of the thirteen effect switches (the nine of the
+// paper's plant, the Bouc-Wen, MR damper and fluid damper specimens and the Pade loop delay,
 // whose states are appended: every loop runs over Dynamics::num_states()).
 //
 // States are drawn away from the model's kinks (where the derivative is not
@@ -66,6 +66,7 @@ void set_effects(Effects& e, unsigned mask) {
   e.bouc_wen_hysteresis = mask & 512u;
   e.mr_damper = mask & 1024u;
   e.loop_delay = mask & 2048u;
+  e.fluid_damper = mask & 4096u;
 }
 
 struct Draw {
@@ -93,6 +94,9 @@ bool away_from_kinks(const Dynamics& dyn, const Draw& d) {
     if (std::fabs(y[kV] - ydot) < margin_v) return false;
     if (r.mr_n == 1.0 && std::fabs(y[iy + 1]) < 1e-6) return false;
   }
+  // Fluid damper: its rate (|F| / c)^(1/alpha) has a kink in its slope at F = 0 for alpha < 1.
+  if (const int iu = L.offset_of<FluidDamper>(); iu >= 0 && r.fd_alpha < 1.0)
+    if (std::fabs(y[kX] - y[iu]) < 1e-8) return false;
   if (dyn.mode() == ControlMode::Free) return true;
   Output o;
   dyn.outputs(y, d.in, o);
@@ -132,6 +136,8 @@ Draw draw(sh_test::Randomizer& rnd, const Dynamics& dyn) {
     d.y[iy] = d.y[kX] + rnd.signed_uniform(0.0, 0.01);
     d.y[iy + 1] = rnd.signed_uniform(0.0, 1.5 * ultimate(r.mr_A, r.mr_beta + r.mr_gamma, r.mr_n));
   }
+  // The fluid damper's series spring deflected by up to 1 mm (20 kN at the default fd_k).
+  if (const int iu = L.offset_of<FluidDamper>(); iu >= 0) d.y[iu] = d.y[kX] + rnd.signed_uniform(0.0, 1e-3);
   for (int k = 0; k < L.count_of<PadeDelay>(); ++k) d.y[L.offset_of<PadeDelay>() + k] = rnd.signed_uniform(0.0, 5.0);
   if (dyn.mode() == ControlMode::Displacement) {
     d.in.u = rnd.signed_uniform(0.0, 0.06);
@@ -303,8 +309,8 @@ int main() {
     worst = std::max(worst, st.worst_scaled);
   };
 
-  // Every combination of the twelve effect switches, calibrated preset.
-  for (unsigned mask = 0; mask < 4096; ++mask)
+  // Every combination of the thirteen effect switches, calibrated preset.
+  for (unsigned mask = 0; mask < 8192; ++mask)
     for (ControlMode mode : modes) {
       Rig rig = zhao2003();
       set_effects(rig.effects, mask);
@@ -350,6 +356,15 @@ int main() {
       run(spec, mode, 40, "specimens, n 2.5 / 1, Pade order " + std::to_string(order));
     }
   }
+  // The fluid damper linear (alpha = 1, a Maxwell element) and at alpha 0.3, with the specimens.
+  for (ControlMode mode : modes)
+    for (double alpha : {1.0, 0.3}) {
+      Rig fd = zhao2003();
+      fd.effects.fluid_damper = fd.effects.bouc_wen_hysteresis = fd.effects.loop_delay = true;
+      fd.fd_alpha = alpha;
+      fd.fd_k = 5e6;
+      run(fd, mode, 100, "fluid damper, alpha " + std::to_string(alpha));
+    }
   Rig underdamped = zhao2003();
   underdamped.zeta_v = 0.3;
   underdamped.f_v = 30.0;

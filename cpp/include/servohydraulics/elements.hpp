@@ -21,13 +21,14 @@
 #include <type_traits>
 
 #include "servohydraulics/elements/bouc_wen.hpp"
+#include "servohydraulics/elements/fluid_damper.hpp"
 #include "servohydraulics/elements/mr_damper.hpp"
 #include "servohydraulics/elements/pade_delay.hpp"
 
 namespace servohydraulics {
 
 //! Every switchable element, in the order their states are appended.
-using Elements = std::tuple<BoucWen, MrDamper, PadeDelay>;
+using Elements = std::tuple<BoucWen, MrDamper, PadeDelay, FluidDamper>;
 
 constexpr std::size_t kNumElements = std::tuple_size_v<Elements>;
 
