@@ -121,7 +121,7 @@ inline constexpr ParameterInfo kRigParameters[] = {
      "not in the paper: 2 ms", Bound::Positive, &Rig::loop_delay},
     {"delays", "loop_delay_order", "-", "Pade order of loop_delay", "modelling choice: 3", Bound::PadeOrder,
      &Rig::loop_delay_order},
-    {"specimen", "fd_c", "N (s/m)^alpha", "fluid damper coefficient: F = fd_c |u'|^fd_alpha sign(u')",
+    {"specimen", "fd_c", "N (s/m)^alpha", "fluid damper coefficient: F = fd_c abs(u')^fd_alpha sign(u')",
      "not in the paper: 20 kN at 1 m/s", Bound::Positive, &Rig::fd_c},
     {"specimen", "fd_alpha", "-", "fluid damper velocity exponent, in (0, 1]",
      "not in the paper: 0.5 (fluid viscous dampers: 0.3-1)", Bound::Positive, &Rig::fd_alpha},
