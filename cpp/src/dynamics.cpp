@@ -196,14 +196,13 @@ bool Dynamics::delay_drive(const double* y, Algebra& g) const noexcept {
   return on;
 }
 
+// Structure, Eq (5), with friction (the static law or LuGre, see friction()) and the structure
+// elements: the acceleration and its gradient.
 template <int W>
-void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noexcept {
-  g.zero<W>();
+void Dynamics::structure(const double* y, const Input& in, Algebra& g) const noexcept {
   const Rig& r = rig_;
   const bool actuator = mode_ != ControlMode::Free;
   const double x = y[kX], v = y[kV], p = y[kP];
-
-  // Friction (the static law or LuGre, see friction()).
   const Friction f = friction(v, y[kZ]);
   const double Ff = f.F, dFf_dv = f.dF_dv, dFf_dz = f.dF_dz;
   if (lugre_) {
@@ -212,7 +211,7 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
     g.dzdot[kZ] = f.dzdot_dz;
   }
 
-  // Structure, Eq (5) with the piston riding along: M a = pA - F_f - c v - f_s(x).
+  // M a = pA - F_f - c v - f_s(x) - F_sp, the piston riding along.
   const double applied = actuator ? p * r.A : in.u;  // Free: the command is an ideal force
   if (!specimen_on_) {
     g.a = (applied - Ff - r.c * v - spring_force(x)) / M_;
@@ -228,22 +227,18 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
   g.da[kZ] = -dFf_dz / M_;
   g.da[kP] = actuator ? r.A / M_ : 0.0;
   g.da[ku_] = actuator ? 0.0 : 1.0 / M_;
-  if (!actuator) {
-    g.dF[ku_] = 1.0;
-    g.F = in.u;
-    return;
-  }
-  // Load cell between piston and structure: F = pA - m_p a.
-  g.F = p * r.A - mp_ * g.a;
-  for (int j = 0; j < W; ++j) g.dF[j] = -mp_ * g.da[j];
-  g.dF[kP] += r.A;
+}
 
-  // Servo controller, Eq (1).
+// Servo controller, Eq (1), the drive saturation and the drive elements (the Pade loop delay):
+// true when the valve sees the delayed drive g.vdrive rather than g.drive.
+template <int W>
+bool Dynamics::servo_controller(const double* y, const Input& in, Algebra& g) const noexcept {
+  const Rig& r = rig_;
   double raw;
   double draw[kCap];
   std::fill(draw, draw + W, 0.0);
   if (mode_ == ControlMode::Displacement) {
-    raw = CF_ * (r.G_p * (in.u - x) + r.G_d * (in.u_rate - v));
+    raw = CF_ * (r.G_p * (in.u - y[kX]) + r.G_d * (in.u_rate - y[kV]));
     draw[kX] = -CF_ * r.G_p;
     draw[kV] = -CF_ * r.G_d;
     draw[ku_] = CF_ * r.G_p;
@@ -255,15 +250,16 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
   g.drive_sat = r.effects.drive_saturation && std::fabs(raw) >= r.v_max;
   g.drive = g.drive_sat ? std::copysign(r.v_max, raw) : raw;
   for (int j = 0; j < W; ++j) g.ddrive[j] = g.drive_sat ? 0.0 : draw[j];
-  // The drive the valve sees: delayed by the Pade loop delay when it is on.
-  double vdrive = g.drive;
-  const double* dvdrive = g.ddrive;
-  if (delay_drive<W>(y, g)) {
-    vdrive = g.vdrive;
-    dvdrive = g.dvdrive;
-  }
+  return delay_drive<W>(y, g);
+}
 
-  // Servovalve: Eq (2) as x_v'' = w_v^2 (K_s v - x_v) - 2 zeta_v w_v x_v', or Eq (6).
+// Servovalve (Eqs 2, 6), spool end stops, valve flow (Eq 3, or Eq 7 with the effects off) and
+// actuator continuity (Eq 4), driven by the drive the valve sees.
+template <int W>
+void Dynamics::valve(const double* y, double vdrive, const double* dvdrive, Algebra& g) const noexcept {
+  const Rig& r = rig_;
+  const double v = y[kV], p = y[kP];
+  // Eq (2) as x_v'' = w_v^2 (K_s v - x_v) - 2 zeta_v w_v x_v', or Eq (6).
   double xv;
   double dxv[kCap];
   std::fill(dxv, dxv + W, 0.0);
@@ -283,7 +279,7 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
   g.s = g.spool_sat ? std::copysign(r.x_v_max, xv) : xv;
   for (int j = 0; j < W; ++j) g.ds[j] = g.spool_sat ? 0.0 : dxv[j];
 
-  // Valve flow, Eq (3) (Eq 7 with the effects off).
+  // Valve flow, Eq (3).
   const double gs = flow_gain(g.s), R = pressure_factor(g.s, p);
   g.Q = r.K_v * gs * R;
   const double dQds = r.K_v * flow_gain_slope(g.s) * R;
@@ -295,6 +291,23 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
   for (int j = 0; j < W; ++j) g.dpdot[j] = g.dQ[j] / r.K_a;
   g.dpdot[kP] -= r.C_l / r.K_a;
   g.dpdot[kV] -= r.A / r.K_a;
+}
+
+template <int W>
+void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noexcept {
+  g.zero<W>();
+  structure<W>(y, in, g);
+  if (mode_ == ControlMode::Free) {
+    g.dF[ku_] = 1.0;
+    g.F = in.u;
+    return;
+  }
+  // Load cell between piston and structure: F = pA - m_p a.
+  g.F = y[kP] * rig_.A - mp_ * g.a;
+  for (int j = 0; j < W; ++j) g.dF[j] = -mp_ * g.da[j];
+  g.dF[kP] += rig_.A;
+  const bool delayed = servo_controller<W>(y, in, g);
+  valve<W>(y, delayed ? g.vdrive : g.drive, delayed ? g.dvdrive : g.ddrive, g);
 }
 
 // Dispatch on the gradient width num_states() + 1, a compile-time constant in each case.
@@ -423,6 +436,19 @@ State Dynamics::equilibrium(double x0) const noexcept {
   return y;
 }
 
+namespace {
+// The kinematic driver's automatic RK4 substeps: h rho <= 1, rho the elements' rate bound at the
+// motion's largest speed.
+int driver_substeps(const Dynamics& d, const double* v, std::size_t n, double dt) {
+  double vmax = 0.0;
+  for (std::size_t k = 0; k < n; ++k) vmax = std::max(vmax, std::fabs(v[k]));
+  const double steps = std::ceil(dt * d.element_rate_bound(vmax));
+  require(std::isfinite(steps) && steps <= 100000, "substeps (automatic)", steps,
+          "exceeds 100000 per sample: give substeps, or a finer dt");
+  return std::max(1, static_cast<int>(steps));
+}
+}  // namespace
+
 void Dynamics::specimen_forces(const double* x, const double* v, std::size_t n, double dt, int substeps,
                                double* F) const {
   require(std::isfinite(dt) && dt > 0.0, "dt", dt, "sample time must be finite and > 0 [s]");
@@ -440,14 +466,7 @@ void Dynamics::specimen_forces(const double* x, const double* v, std::size_t n, 
       for (int k = 0; k < e.count(); ++k) idx[m++] = off + k;
     }
   });
-  if (substeps == 0) {  // h rho <= 1 with rho the elements' rate bound at the largest speed
-    double vmax = 0.0;
-    for (std::size_t k = 0; k < n; ++k) vmax = std::max(vmax, std::fabs(v[k]));
-    const double steps = std::ceil(dt * element_rate_bound(vmax));
-    require(std::isfinite(steps) && steps <= 100000, "substeps (automatic)", steps,
-            "exceeds 100000 per sample: give substeps, or a finer dt");
-    substeps = std::max(1, static_cast<int>(steps));
-  }
+  if (substeps == 0) substeps = driver_substeps(*this, v, n, dt);
   // Rates of those states at (xt, vt, s) into r[0..m-1]; returns the specimen force.
   auto rates = [&](double xt, double vt, const State& s, double* r) {
     State at = s;

@@ -116,6 +116,12 @@ class Dynamics {
   void evaluate(const double* y, const Input& in, Algebra& a) const noexcept;
   void evaluate_any(const double* y, const Input& in, Algebra& a) const noexcept;
   template <int W>
+  void structure(const double* y, const Input& in, Algebra& a) const noexcept;
+  template <int W>
+  bool servo_controller(const double* y, const Input& in, Algebra& a) const noexcept;
+  template <int W>
+  void valve(const double* y, double vdrive, const double* dvdrive, Algebra& a) const noexcept;
+  template <int W>
   void specimen(const double* y, Algebra& a) const noexcept;
   template <int W>
   bool delay_drive(const double* y, Algebra& a) const noexcept;
