@@ -366,11 +366,7 @@ void Dynamics::jacobian(const double* y, const Input& in, Jacobian& J, State* B)
 
 // The rows of the elements' states.
 void Dynamics::jacobian_appended(const Algebra& g, Jacobian& J, State* B) const noexcept {
-  const int n = layout_.num_states;
-  for (int i = kNumStates; i < n; ++i) {
-    for (int j = 0; j < n; ++j) J[i][j] = g.drate[i][j];
-    if (B) (*B)[i] = g.drate[i][ku_];
-  }
+  each([&](const auto& e, int off) { e.jacobian(g, off, layout_.num_states, ku_, J, B); });
 }
 
 void Dynamics::outputs(const double* y, const Input& in, Output& out, OutputGradients* grad) const noexcept {

@@ -73,17 +73,18 @@ void PadeDelay::eval(const double* y, int i0, Algebra& g) const noexcept {
     g.dvdrive[i0 + k] += c[k];
     last -= a[k] * y[i0 + k];
   }
-  // The chain q_k' = q_(k+1) / tau, and the last state's rate.
-  for (int k = 0; k + 1 < N; ++k) {
-    double* dr = g.drate[i0 + k];
-    std::fill(dr, dr + W, 0.0);
-    g.rate[i0 + k] = y[i0 + k + 1] / tau;
-    dr[i0 + k + 1] = 1.0 / tau;
-  }
+  // The chain q_k' = q_(k+1) / tau (its constant gradient rows are written by jacobian()), and
+  // the last state's rate.
+  for (int k = 0; k + 1 < N; ++k) g.rate[i0 + k] = y[i0 + k + 1] / tau;
   double* dq = g.drate[i0 + N - 1];
   g.rate[i0 + N - 1] = last / tau;
   for (int j = 0; j < W; ++j) dq[j] = g.ddrive[j] / tau;
   for (int k = 0; k < N; ++k) dq[i0 + k] -= a[k] / tau;
+}
+
+void PadeDelay::jacobian(const Algebra& g, int i0, int n, int ku, Jacobian& J, State* B) const noexcept {
+  for (int k = 0; k + 1 < order; ++k) J[i0 + k][i0 + k + 1] = 1.0 / tau;
+  copy_rows(g, i0 + order - 1, 1, n, ku, J, B);
 }
 
 SH_ELEMENT_EVAL_WIDTHS(PadeDelay);

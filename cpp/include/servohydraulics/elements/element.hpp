@@ -55,6 +55,16 @@ struct RestPoint {
   double spool = 0.0;  //!< the spool opening that feeds the leakage [-] (0 in free mode)
 };
 
+//! Copies an element's gradient rows (its states offset .. offset + count - 1) into the rows of J
+//! (columns 0..n-1) and of B (column ku, the command's): an element's jacobian() for rows it
+//! evaluates in full.
+inline void copy_rows(const Algebra& g, int offset, int count, int n, int ku, Jacobian& J, State* B) noexcept {
+  for (int i = offset; i < offset + count; ++i) {
+    for (int j = 0; j < n; ++j) J[i][j] = g.drate[i][j];
+    if (B) (*B)[i] = g.drate[i][ku];
+  }
+}
+
 }  // namespace servohydraulics
 
 //! Instantiates E::eval for every gradient width Dynamics dispatches on (kNumStates + 1 ..

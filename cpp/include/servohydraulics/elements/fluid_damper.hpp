@@ -27,6 +27,10 @@ struct FluidDamper {
   double rate_bound(double v_ref) const noexcept;
   template <int W>
   void eval(const double* y, int offset, Algebra& g) const noexcept;
+  //! Its rows of J = df/dy and B = df/du (J and B zero on entry) from the evaluation g.
+  void jacobian(const Algebra& g, int offset, int n, int ku, Jacobian& J, State* B) const noexcept {
+    copy_rows(g, offset, count(), n, ku, J, B);
+  }
 };
 
 }  // namespace servohydraulics

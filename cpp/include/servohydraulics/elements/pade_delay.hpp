@@ -32,6 +32,9 @@ struct PadeDelay {
   double rate_bound(double) const noexcept { return 0.0; }  // linear: the spectral radius sees it
   template <int W>
   void eval(const double* y, int offset, Algebra& g) const noexcept;
+  //! Its rows of J and B (zero on entry): the chain's constant 1 / tau, and the last state's row
+  //! from the evaluation g (the only one eval fills).
+  void jacobian(const Algebra& g, int offset, int n, int ku, Jacobian& J, State* B) const noexcept;
 };
 
 //! Coefficients of the (N, N) Pade approximant of exp(-s tau) in s tau, lowest power first:
