@@ -10,7 +10,9 @@
 //   double rate_bound(double v_ref)                  |d rate / d state| when sliding at v_ref,
 //   template <int W> void eval(const double* y, int offset, Algebra&)
 //                                 adds its force (or delays the drive) and writes its states'
-//                                 rates, with their gradients (the first W columns).
+//                                 rates, with their gradients (the first W columns),
+//   void jacobian(const Algebra&, int offset, int n, int ku, Jacobian&, State* B)
+//                                 its rows of J and B (copy_rows, or constant rows of its own).
 // Adding an element: docs/architecture.md, "Add an element".
 #pragma once
 
