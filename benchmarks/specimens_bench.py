@@ -106,10 +106,13 @@ def pade_table(tau: float = 2e-3) -> str:
 
 def mr_table() -> str:
     """Peak force of the core's MR damper (Spencer 1997 Table 1 parameters) under the paper's
-    test motion x = 1.5 cm sin(2 pi 2.5 t), over the second half of 0.8 s (steady cycles)."""
+    test motion x = 1.5 cm sin(2 pi 2.5 t), over the second half of 0.8 s (steady cycles): the
+    largest |F|, the signed peaks (the accumulator's k1 (x - x0) = -k1 x0 at x = 0 shifts the
+    loop down) and the mean |F| where |v| is within 1e-4 of its peak."""
     X, f, T = 0.015, 2.5, 0.8
     w = 2 * np.pi * f
-    rows = ["| voltage [V] | peak force [N] | force at peak velocity [N] |", "|---|---|---|"]
+    rows = ["| voltage [V] | largest abs(F) [N] | signed peaks max F / min F [N] | force at peak velocity [N] |",
+            "|---|---|---|---|"]
     for volts in [0.0, 0.75, 1.5, 2.25]:
         r = sh.zhao2003()
         r.effects.mr_damper, r.mr_voltage = True, volts
@@ -128,7 +131,8 @@ def mr_table() -> str:
         late = sol.t >= T / 2
         at_vmax = np.abs(np.cos(w * sol.t)) > 0.9999
         rows.append(f"| {volts:g} | {np.max(np.abs(F[late])):.0f} | "
-                    f"{np.mean(np.abs(F[late & at_vmax])):.0f} |")
+                    f"+{np.max(F[late]):.0f} / {np.min(F[late]):.0f} | {np.mean(np.abs(F[late & at_vmax])):.0f} |")
+    rows.append(f"\n(the accumulator's offset k1 x0 = {r.mr_k1 * r.mr_x0:.1f} N)")
     return "\n".join(rows)
 
 
@@ -145,7 +149,12 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--write", type=Path, help="Markdown file whose marked tables to replace")
     ap.add_argument("--no-progress", action="store_true")
+    ap.add_argument("--only", choices=["step_time", "pade", "mr"], help="print one table only")
     a = ap.parse_args()
+    if a.only:
+        print({"step_time": lambda: step_time_table(a.steps, a.repeat, not a.no_progress), "pade": pade_table,
+               "mr": mr_table}[a.only]())
+        return
     machine = f"{platform.machine()}, {platform.python_implementation()} {platform.python_version()}"
     step = step_time_table(a.steps, a.repeat, not a.no_progress)
     step += f"\n\n({a.steps} steps of dt = {DT * 1e3:g} ms, fastest of {a.repeat}; {machine})"

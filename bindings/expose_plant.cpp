@@ -38,16 +38,27 @@ py::tuple state_table(const Dynamics& d) {
   }
   return t;
 }
+// num_states, each element's first state index (by its switch's name, -1: off) and each active
+// appended state's index (by its name).
 py::dict layout_dict(const Dynamics& d) {
   const StateLayout& L = d.layout();
   py::dict out;
   out["num_states"] = L.num_states;
-  out["bw_z"] = L.bw_z;
-  out["mr_y"] = L.mr_y;
-  out["mr_z"] = L.mr_y >= 0 ? L.mr_y + 1 : -1;
-  out["pade"] = L.pade;
-  out["pade_order"] = L.pade_order;
+  for (std::size_t e = 0; e < kNumElements; ++e) out[kElementNames[e]] = L.offset[e];
+  for (int i = kNumStates; i < L.num_states; ++i) out[d.state_info(i).name] = i;
   return out;
+}
+
+// The kinematic driver: the specimen force along a measured motion (Dynamics::specimen_forces).
+py::array_t<double> specimen_forces(const Dynamics& d, const py::array_t<double, py::array::c_style | py::array::forcecast>& x,
+                                    const py::array_t<double, py::array::c_style | py::array::forcecast>& v, double dt,
+                                    int substeps) {
+  if (x.ndim() != 1 || v.ndim() != 1 || x.size() != v.size())
+    throw py::value_error("invalid x, v (shape): two 1-D arrays of one length expected, got " +
+                          std::to_string(x.size()) + " and " + std::to_string(v.size()) + " samples");
+  py::array_t<double> F(x.size());
+  d.specimen_forces(x.data(), v.data(), static_cast<std::size_t>(x.size()), dt, substeps, F.mutable_data());
+  return F;
 }
 }  // namespace
 
@@ -155,7 +166,11 @@ void expose_plant(py::module_& m) {
              const State y = to_state(d, yv);
              return d.specimen_force(y.data());
            },
-           py::arg("y"), "Force of the Bouc-Wen and MR damper specimens at state y [N] (0 when off)")
+           py::arg("y"), "Force of the switched-on specimen elements at state y [N] (0 when none is on)")
+      .def("specimen_forces", &specimen_forces, py::arg("x"), py::arg("v"), py::arg("dt"), py::arg("substeps") = 0,
+           "The kinematic driver: the specimen elements' force [N] along a given motion x(t) [m], v(t) [m/s] "
+           "sampled at dt [s], their states starting at rest at x[0] and integrated by RK4 with `substeps` per "
+           "sample (0: from their rate bound), the motion interpolated linearly between samples")
       .def("equilibrium", [](const Dynamics& d, double x0) { return from_state(d, d.equilibrium(x0)); },
            py::arg("x0"))
       .def("operating_point",
@@ -169,7 +184,8 @@ void expose_plant(py::module_& m) {
                              "active length of the state vector (base states and the switched-on elements')")
       .def_property_readonly("states", &state_table, "((name, unit, doc), ...) of the active states, in order")
       .def_property_readonly("layout", &layout_dict,
-                             "indices of the elements' states: bw_z, mr_y, mr_z, pade (first), pade_order; -1: off")
+                             "num_states, each element's first state (by its effects switch; -1: off) and each "
+                             "appended state's index (by its name: bw_z, mr_y, mr_z, delay_1, ...)")
       .def_property_readonly("pade",
                              [](const Dynamics& d) {
                                const Dynamics::Pade& P = d.pade();

@@ -1,64 +1,17 @@
 // Right-hand side, analytic Jacobian and outputs of the plant, Eqs (1)-(5).
+#include "servohydraulics/dynamics.hpp"
+
 #include <algorithm>
 #include <cmath>
 
-#include "servohydraulics/dynamics.hpp"
+#include "detail/math.hpp"
 
 namespace servohydraulics {
 
-namespace {
-constexpr double kPi = 3.14159265358979323846;
-// Width of the C1 polynomial patch of the signed square root near 0 (Eq 3).
-constexpr double kSqrtEps = 1e-3;
-
-// Signed square root sign(r) sqrt(|r|), replaced by a C1 odd cubic for |r| < eps
-// so that the Jacobian stays finite when the load pressure reaches p_s.  Past
-// p_s the flow reverses through the open port, which bounds p by the supply.
-double ssqrt(double r) noexcept {
-  const double a = std::fabs(r);
-  if (a >= kSqrtEps) return std::copysign(std::sqrt(a), r);
-  const double se = std::sqrt(kSqrtEps);
-  return 1.25 * r / se - 0.25 * r * r * r / (kSqrtEps * kSqrtEps * se);
-}
-double ssqrt_slope(double r) noexcept {
-  const double a = std::fabs(r);
-  if (a >= kSqrtEps) return 0.5 / std::sqrt(a);
-  const double se = std::sqrt(kSqrtEps);
-  return 1.25 / se - 0.75 * r * r / (kSqrtEps * kSqrtEps * se);
-}
-double sgn(double v) noexcept { return v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0); }
-
-// The Bouc-Wen evolution law (Wen 1976) and its partial derivatives:
-//   z' = A w - b |w| |z|^(n-1) z - g w |z|^n,  w the deformation rate.
-// Spencer et al. (1997) write the same law with their gamma on the |w| term and
-// their beta on the w term: call it with (A, gamma_S, beta_S).
-struct Hysteretic {
-  double f = 0.0, df_dw = 0.0, df_dz = 0.0;
-};
-Hysteretic hysteretic_rate(double w, double z, double A, double b, double g, double n) noexcept {
-  const double az = std::fabs(z);
-  const double p = n == 1.0 ? 1.0 : std::pow(az, n - 1.0);  // |z|^(n-1)
-  const double zn = p * az;                                   // |z|^n
-  Hysteretic h;
-  h.f = A * w - b * std::fabs(w) * p * z - g * w * zn;
-  h.df_dw = A - b * sgn(w) * p * z - g * zn;
-  h.df_dz = -n * p * (b * std::fabs(w) + g * w * sgn(z));
-  return h;
-}
-
-double factorial(int k) noexcept {
-  double f = 1.0;
-  for (int i = 2; i <= k; ++i) f *= i;
-  return f;
-}
-}  // namespace
-
-void pade_coefficients(int N, double* num, double* den) noexcept {
-  for (int k = 0; k <= N; ++k) {
-    den[k] = factorial(2 * N - k) * factorial(N) / (factorial(2 * N) * factorial(k) * factorial(N - k));
-    num[k] = (k % 2 ? -1.0 : 1.0) * den[k];
-  }
-}
+using detail::kPi;
+using detail::sgn;
+using detail::ssqrt;
+using detail::ssqrt_slope;
 
 Dynamics::Dynamics(const Rig& rig, ControlMode mode) : rig_(rig), mode_(mode) {
   rig_.validate();
@@ -70,81 +23,71 @@ Dynamics::Dynamics(const Rig& rig, ControlMode mode) : rig_(rig), mode_(mode) {
   CF_ = mode == ControlMode::Force ? rig_.C_F_force : rig_.C_F_disp;
   wv_ = 2.0 * kPi * rig_.f_v;
   lugre_ = rig_.effects.coulomb_friction && rig_.effects.lugre_friction && rig_.F_c > 0.0;
-  // Appended states, in a fixed order: Bouc-Wen z, MR damper (y, z), Pade loop delay.
+  // The elements' states are appended in the order of Elements, each only when it is on.
   int n = kNumStates;
-  if (rig_.effects.bouc_wen_hysteresis) layout_.bw_z = n++;
-  if (rig_.effects.mr_damper) {
-    layout_.mr_y = n;
-    n += 2;
-    const double u = rig_.mr_voltage;
-    mr_alpha_ = rig_.mr_alpha_a + rig_.mr_alpha_b * u;
-    mr_c0_ = rig_.mr_c0_a + rig_.mr_c0_b * u;
-    mr_c1_ = rig_.mr_c1_a + rig_.mr_c1_b * u;
-  }
-  if (actuator && rig_.effects.loop_delay) {
-    const int N = static_cast<int>(rig_.loop_delay_order);
-    layout_.pade = n;
-    layout_.pade_order = N;
-    n += N;
-    double num[kMaxPadeOrder + 1], den[kMaxPadeOrder + 1];
-    pade_coefficients(N, num, den);
-    pade_.order = N;
-    pade_.tau = rig_.loop_delay;
-    pade_.d = num[N] / den[N];
-    for (int k = 0; k < N; ++k) {
-      pade_.a[k] = den[k] / den[N];
-      pade_.c[k] = (num[k] - pade_.d * den[k]) / den[N];
-    }
-  }
+  std::size_t idx = 0;
+  std::apply(
+      [&](auto&... e) {
+        auto place = [&](auto& slot) {
+          using E = typename std::decay_t<decltype(slot)>::value_type;
+          slot = E::from(rig_, mode_);
+          if (slot) {
+            layout_.offset[idx] = n;
+            layout_.count[idx] = slot->count();
+            n += slot->count();
+            if constexpr (E::kPort == Port::Structure) specimen_on_ = true;
+          }
+          ++idx;
+        };
+        (place(e), ...);
+      },
+      elements_);
   layout_.num_states = n;
   ku_ = n;
   ng_ = n + 1;
 }
 
 const StateInfo& Dynamics::state_info(int i) const noexcept {
-  const StateLayout& L = layout_;
-  if (i == L.bw_z) return kBoucWenState;
-  if (L.mr_y >= 0 && (i == L.mr_y || i == L.mr_y + 1)) return kMrStates[i - L.mr_y];
-  if (L.pade >= 0 && i >= L.pade && i < L.pade + L.pade_order) return kPadeStates[i - L.pade];
-  return kStates[i >= 0 && i < kNumStates ? i : 0];
+  const StateInfo* info = &kStates[i >= 0 && i < kNumStates ? i : 0];
+  each([&](const auto& e, int off) {
+    if (i >= off && i < off + e.count()) info = &e.states()[i - off];
+  });
+  return *info;
 }
 
 double Dynamics::state_scale(int i) const noexcept {
-  const StateLayout& L = layout_;
-  if (i == L.bw_z) return 1e-6;                  // [m], as the LuGre bristle
-  if (i == L.mr_y) return 1e-3;                  // [m], as x
-  if (L.mr_y >= 0 && i == L.mr_y + 1) return 1e-6;  // [m]
-  if (L.pade >= 0 && i >= L.pade && i < L.pade + L.pade_order) {
-    // Pade state q_k [V]: the full-scale drive (the one that opens the valve fully)
-    // over the largest coefficient through which q_k acts (the denominator a_k on the
-    // chain, the output row c_k on the drive), so that its tolerance weighs the drive
-    // error it makes, as the valve states' tolerances do.
-    const int k = i - L.pade;
-    const double drive = rig_.x_v_max / rig_.K_s;
-    return drive / std::max({1.0, std::fabs(pade_.a[k]), std::fabs(pade_.c[k])});
-  }
-  return 1e-3;
+  double scale = 1e-3;
+  each([&](const auto& e, int off) {
+    if (i >= off && i < off + e.count()) scale = e.scale(i - off);
+  });
+  return scale;
 }
 
 double Dynamics::static_force(double x) const noexcept {
-  const double f = spring_force(x);
-  return layout_.mr_y >= 0 ? f + rig_.mr_k1 * (x - rig_.mr_x0) : f;  // at rest y = x, z = 0: F_mr = k1 (x - x0)
+  double f = spring_force(x);
+  each([&](const auto& e, int) {
+    if constexpr (std::decay_t<decltype(e)>::kPort == Port::Structure) {
+      const double fe = e.static_force(x);
+      if (fe != 0.0) f += fe;
+    }
+  });
+  return f;
 }
 
-double Dynamics::hysteretic_rate_bound(double v_ref) const noexcept {
-  // |dz'/dz| <= n (beta + gamma) |z|^(n-1) |w|, with |z| below its ultimate (A / (beta + gamma))^(1/n).
-  auto bound = [v_ref](double A, double bg, double n) {
-    if (bg <= 0.0) return 0.0;
-    return n * bg * std::pow(A / bg, (n - 1.0) / n) * v_ref;
-  };
-  const Rig& r = rig_;
+double Dynamics::element_rate_bound(double v_ref) const noexcept {
   double rho = 0.0;
-  if (layout_.bw_z >= 0) rho = std::max(rho, bound(r.bw_A, r.bw_beta + r.bw_gamma, r.bw_n));
-  if (layout_.mr_y >= 0) {
-    const double cs = mr_c0_ + mr_c1_;
-    rho = std::max(rho, bound(r.mr_A, r.mr_beta + r.mr_gamma, r.mr_n) + (r.mr_A * mr_alpha_ + r.mr_k0) / cs);
-  }
+  each([&](const auto& e, int) { rho = std::max(rho, e.rate_bound(v_ref)); });
   return rho;
+}
+
+double Dynamics::no_load_speed() const noexcept {
+  return rig_.K_v * flow_gain(std::min(rig_.x_v_max, 1.0)) / rig_.A;
+}
+
+const Dynamics::Pade& Dynamics::pade() const noexcept {
+  static const Pade off{};
+  const Pade* p = element<PadeDelay>();
+  return p ? *p : off;
 }
 
 double Dynamics::spring_force(double x) const noexcept {
@@ -193,34 +136,7 @@ double Dynamics::pressure_factor_dp(double s, double p) const noexcept {
 // Gradients have the active states' columns 0..n-1 and one more, index ku_ = n, for the
 // derivative by the command u (n = num_states(): the width stays the paper plant's 7 when no
 // element is appended).  Arrays are sized for the capacity; evaluate<W> runs over W = n + 1.
-constexpr int kCap = kMaxStates + 1;
-
-struct Dynamics::Algebra {
-  double a = 0, da[kCap];          // acceleration and its gradient
-  double F = 0, dF[kCap];          // load-cell force
-  double drive = 0, ddrive[kCap];  // valve drive after saturation
-  double s = 0, ds[kCap];          // metering opening after saturation
-  double Q = 0, dQ[kCap];          // valve flow
-  double pdot = 0, dpdot[kCap];
-  double xvdd = 0, dxvdd[kCap];
-  double zdot = 0, dzdot[kCap];    // LuGre bristle rate
-  double Fsp = 0, dFsp[kCap];      // specimen force (Bouc-Wen + MR damper)
-  double bw_zdot = 0, dbw_zdot[kCap];  // Bouc-Wen rate
-  double mr_ydot = 0, dmr_ydot[kCap];  // MR damper y' and z'
-  double mr_zdot = 0, dmr_zdot[kCap];
-  double vdrive = 0, dvdrive[kCap];    // the drive as the valve sees it (after the Pade loop delay)
-  double qdot = 0, dqdot[kCap];        // the last Pade state's rate
-  bool drive_sat = false, spool_sat = false;
-  // Zeroes the first W entries of the gradients of the paper plant (and of the specimen force,
-  // read by outputs()); the appended elements zero theirs when on.
-  template <int W>
-  void zero() noexcept {
-    for (int j = 0; j < W; ++j) {
-      da[j] = dF[j] = ddrive[j] = ds[j] = dQ[j] = 0.0;
-      dpdot[j] = dxvdd[j] = dzdot[j] = dFsp[j] = 0.0;
-    }
-  }
-};
+constexpr int kCap = Algebra::kCap;
 
 struct Dynamics::Friction {
   double F = 0, dF_dv = 0, dF_dz = 0;           // friction force and its gradient
@@ -248,7 +164,7 @@ Dynamics::Friction Dynamics::friction(double v, double z) const noexcept {
 }
 
 double Dynamics::specimen_force(const double* y) const noexcept {
-  if (layout_.bw_z < 0 && layout_.mr_y < 0) return 0.0;
+  if (!specimen_on_) return 0.0;
   Algebra g;
   g.zero<kCap>();
   specimen<kCap>(y, g);
@@ -259,69 +175,34 @@ double Dynamics::structure_force(double x, double v, double z) const noexcept {
   return friction(v, z).F + rig_.c * v + spring_force(x);
 }
 
-// Specimen elements in parallel with the structure: their force and state rates.
-// Bouc-Wen (Wen 1976): F = bw_k z.  MR damper (Spencer et al. 1997):
-// y' = (alpha z + c0 x' + k0 (x - y)) / (c0 + c1), z' = BW(x' - y', z), F = c1 y' + k1 (x - x0).
+// The structure elements (specimens in parallel with the structure): their force and state rates.
 template <int W>
 void Dynamics::specimen(const double* y, Algebra& g) const noexcept {
-  const Rig& r = rig_;
-  const double x = y[kX], v = y[kV];
-  if (layout_.bw_z >= 0) {
-    const int iz = layout_.bw_z;
-    std::fill(g.dbw_zdot, g.dbw_zdot + W, 0.0);
-    const Hysteretic h = hysteretic_rate(v, y[iz], r.bw_A, r.bw_beta, r.bw_gamma, r.bw_n);
-    g.bw_zdot = h.f;
-    g.dbw_zdot[kV] = h.df_dw;
-    g.dbw_zdot[iz] = h.df_dz;
-    g.Fsp += r.bw_k * y[iz];
-    g.dFsp[iz] += r.bw_k;
-  }
-  if (layout_.mr_y >= 0) {
-    const int iy = layout_.mr_y, iz = iy + 1;
-    const double cs = mr_c0_ + mr_c1_;
-    std::fill(g.dmr_ydot, g.dmr_ydot + W, 0.0);
-    g.mr_ydot = (mr_alpha_ * y[iz] + mr_c0_ * v + r.mr_k0 * (x - y[iy])) / cs;
-    g.dmr_ydot[kX] = r.mr_k0 / cs;
-    g.dmr_ydot[kV] = mr_c0_ / cs;
-    g.dmr_ydot[iy] = -r.mr_k0 / cs;
-    g.dmr_ydot[iz] = mr_alpha_ / cs;
-    const Hysteretic h = hysteretic_rate(v - g.mr_ydot, y[iz], r.mr_A, r.mr_gamma, r.mr_beta, r.mr_n);
-    g.mr_zdot = h.f;
-    for (int j = 0; j < W; ++j) g.dmr_zdot[j] = -h.df_dw * g.dmr_ydot[j];
-    g.dmr_zdot[kV] += h.df_dw;
-    g.dmr_zdot[iz] += h.df_dz;
-    g.Fsp += mr_c1_ * g.mr_ydot + r.mr_k1 * (x - r.mr_x0);
-    for (int j = 0; j < W; ++j) g.dFsp[j] += mr_c1_ * g.dmr_ydot[j];
-    g.dFsp[kX] += r.mr_k1;
-  }
+  each([&](const auto& e, int off) {
+    if constexpr (std::decay_t<decltype(e)>::kPort == Port::Structure) e.template eval<W>(y, off, g);
+  });
 }
 
-// The Pade loop delay on the valve drive w: q' = (A' q + e_N w) / tau, w_delayed = C' q + d w.
+// The drive elements (the Pade loop delay): the drive as the valve sees it, in g.vdrive.
 template <int W>
-void Dynamics::loop_delay(const double* y, Algebra& g) const noexcept {
-  const Pade& P = pade_;
-  const int i0 = layout_.pade, N = P.order;
-  g.vdrive = P.d * g.drive;
-  for (int j = 0; j < W; ++j) g.dvdrive[j] = P.d * g.ddrive[j];
-  double last = g.drive;
-  for (int k = 0; k < N; ++k) {
-    g.vdrive += P.c[k] * y[i0 + k];
-    g.dvdrive[i0 + k] += P.c[k];
-    last -= P.a[k] * y[i0 + k];
-  }
-  g.qdot = last / P.tau;
-  for (int j = 0; j < W; ++j) g.dqdot[j] = g.ddrive[j] / P.tau;
-  for (int k = 0; k < N; ++k) g.dqdot[i0 + k] -= P.a[k] / P.tau;
+bool Dynamics::delay_drive(const double* y, Algebra& g) const noexcept {
+  bool on = false;
+  each([&](const auto& e, int off) {
+    if constexpr (std::decay_t<decltype(e)>::kPort == Port::Drive) {
+      e.template eval<W>(y, off, g);
+      on = true;
+    }
+  });
+  return on;
 }
 
+// Structure, Eq (5), with friction (the static law or LuGre, see friction()) and the structure
+// elements: the acceleration and its gradient.
 template <int W>
-void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noexcept {
-  g.zero<W>();
+void Dynamics::structure(const double* y, const Input& in, Algebra& g) const noexcept {
   const Rig& r = rig_;
   const bool actuator = mode_ != ControlMode::Free;
   const double x = y[kX], v = y[kV], p = y[kP];
-
-  // Friction (the static law or LuGre, see friction()).
   const Friction f = friction(v, y[kZ]);
   const double Ff = f.F, dFf_dv = f.dF_dv, dFf_dz = f.dF_dz;
   if (lugre_) {
@@ -330,10 +211,9 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
     g.dzdot[kZ] = f.dzdot_dz;
   }
 
-  // Structure, Eq (5) with the piston riding along: M a = pA - F_f - c v - f_s(x).
+  // M a = pA - F_f - c v - f_s(x) - F_sp, the piston riding along.
   const double applied = actuator ? p * r.A : in.u;  // Free: the command is an ideal force
-  const bool specimen_on = layout_.bw_z >= 0 || layout_.mr_y >= 0;
-  if (!specimen_on) {
+  if (!specimen_on_) {
     g.a = (applied - Ff - r.c * v - spring_force(x)) / M_;
     g.da[kX] = -spring_stiffness(x) / M_;
     g.da[kV] = -(dFf_dv + r.c) / M_;
@@ -347,22 +227,18 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
   g.da[kZ] = -dFf_dz / M_;
   g.da[kP] = actuator ? r.A / M_ : 0.0;
   g.da[ku_] = actuator ? 0.0 : 1.0 / M_;
-  if (!actuator) {
-    g.dF[ku_] = 1.0;
-    g.F = in.u;
-    return;
-  }
-  // Load cell between piston and structure: F = pA - m_p a.
-  g.F = p * r.A - mp_ * g.a;
-  for (int j = 0; j < W; ++j) g.dF[j] = -mp_ * g.da[j];
-  g.dF[kP] += r.A;
+}
 
-  // Servo controller, Eq (1).
+// Servo controller, Eq (1), the drive saturation and the drive elements (the Pade loop delay):
+// true when the valve sees the delayed drive g.vdrive rather than g.drive.
+template <int W>
+bool Dynamics::servo_controller(const double* y, const Input& in, Algebra& g) const noexcept {
+  const Rig& r = rig_;
   double raw;
   double draw[kCap];
   std::fill(draw, draw + W, 0.0);
   if (mode_ == ControlMode::Displacement) {
-    raw = CF_ * (r.G_p * (in.u - x) + r.G_d * (in.u_rate - v));
+    raw = CF_ * (r.G_p * (in.u - y[kX]) + r.G_d * (in.u_rate - y[kV]));
     draw[kX] = -CF_ * r.G_p;
     draw[kV] = -CF_ * r.G_d;
     draw[ku_] = CF_ * r.G_p;
@@ -374,16 +250,16 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
   g.drive_sat = r.effects.drive_saturation && std::fabs(raw) >= r.v_max;
   g.drive = g.drive_sat ? std::copysign(r.v_max, raw) : raw;
   for (int j = 0; j < W; ++j) g.ddrive[j] = g.drive_sat ? 0.0 : draw[j];
-  // The drive the valve sees: delayed by the Pade loop delay when it is on.
-  double vdrive = g.drive;
-  const double* dvdrive = g.ddrive;
-  if (layout_.pade >= 0) {
-    loop_delay<W>(y, g);
-    vdrive = g.vdrive;
-    dvdrive = g.dvdrive;
-  }
+  return delay_drive<W>(y, g);
+}
 
-  // Servovalve: Eq (2) as x_v'' = w_v^2 (K_s v - x_v) - 2 zeta_v w_v x_v', or Eq (6).
+// Servovalve (Eqs 2, 6), spool end stops, valve flow (Eq 3, or Eq 7 with the effects off) and
+// actuator continuity (Eq 4), driven by the drive the valve sees.
+template <int W>
+void Dynamics::valve(const double* y, double vdrive, const double* dvdrive, Algebra& g) const noexcept {
+  const Rig& r = rig_;
+  const double v = y[kV], p = y[kP];
+  // Eq (2) as x_v'' = w_v^2 (K_s v - x_v) - 2 zeta_v w_v x_v', or Eq (6).
   double xv;
   double dxv[kCap];
   std::fill(dxv, dxv + W, 0.0);
@@ -403,7 +279,7 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
   g.s = g.spool_sat ? std::copysign(r.x_v_max, xv) : xv;
   for (int j = 0; j < W; ++j) g.ds[j] = g.spool_sat ? 0.0 : dxv[j];
 
-  // Valve flow, Eq (3) (Eq 7 with the effects off).
+  // Valve flow, Eq (3).
   const double gs = flow_gain(g.s), R = pressure_factor(g.s, p);
   g.Q = r.K_v * gs * R;
   const double dQds = r.K_v * flow_gain_slope(g.s) * R;
@@ -415,6 +291,23 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
   for (int j = 0; j < W; ++j) g.dpdot[j] = g.dQ[j] / r.K_a;
   g.dpdot[kP] -= r.C_l / r.K_a;
   g.dpdot[kV] -= r.A / r.K_a;
+}
+
+template <int W>
+void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noexcept {
+  g.zero<W>();
+  structure<W>(y, in, g);
+  if (mode_ == ControlMode::Free) {
+    g.dF[ku_] = 1.0;
+    g.F = in.u;
+    return;
+  }
+  // Load cell between piston and structure: F = pA - m_p a.
+  g.F = y[kP] * rig_.A - mp_ * g.a;
+  for (int j = 0; j < W; ++j) g.dF[j] = -mp_ * g.da[j];
+  g.dF[kP] += rig_.A;
+  const bool delayed = servo_controller<W>(y, in, g);
+  valve<W>(y, delayed ? g.vdrive : g.drive, delayed ? g.dvdrive : g.ddrive, g);
 }
 
 // Dispatch on the gradient width num_states() + 1, a compile-time constant in each case.
@@ -446,17 +339,7 @@ void Dynamics::rhs(const double* y, const Input& in, double* ydot) const noexcep
   ydot[kXv] = valve ? y[kXvDot] : 0.0;
   ydot[kXvDot] = valve ? g.xvdd : 0.0;
   ydot[kZ] = lugre_ ? g.zdot : 0.0;
-  const StateLayout& L = layout_;
-  if (L.bw_z >= 0) ydot[L.bw_z] = g.bw_zdot;
-  if (L.mr_y >= 0) {
-    ydot[L.mr_y] = g.mr_ydot;
-    ydot[L.mr_y + 1] = g.mr_zdot;
-  }
-  if (L.pade >= 0) {
-    const int N = L.pade_order;
-    for (int k = 0; k + 1 < N; ++k) ydot[L.pade + k] = y[L.pade + k + 1] / pade_.tau;
-    ydot[L.pade + N - 1] = g.qdot;
-  }
+  for (int i = kNumStates; i < layout_.num_states; ++i) ydot[i] = g.rate[i];
 }
 
 void Dynamics::jacobian(const double* y, const Input& in, Jacobian& J, State* B) const noexcept {
@@ -481,24 +364,9 @@ void Dynamics::jacobian(const double* y, const Input& in, Jacobian& J, State* B)
   }
 }
 
-// The rows of the appended states (specimen elements and the Pade loop delay).
+// The rows of the elements' states.
 void Dynamics::jacobian_appended(const Algebra& g, Jacobian& J, State* B) const noexcept {
-  const StateLayout& L = layout_;
-  const int n = L.num_states;
-  auto row = [&](int i, const double* grad) {
-    for (int j = 0; j < n; ++j) J[i][j] = grad[j];
-    if (B) (*B)[i] = grad[ku_];
-  };
-  if (L.bw_z >= 0) row(L.bw_z, g.dbw_zdot);
-  if (L.mr_y >= 0) {
-    row(L.mr_y, g.dmr_ydot);
-    row(L.mr_y + 1, g.dmr_zdot);
-  }
-  if (L.pade >= 0) {
-    const int N = L.pade_order;
-    for (int k = 0; k + 1 < N; ++k) J[L.pade + k][L.pade + k + 1] = 1.0 / pade_.tau;
-    row(L.pade + N - 1, g.dqdot);
-  }
+  each([&](const auto& e, int off) { e.jacobian(g, off, layout_.num_states, ku_, J, B); });
 }
 
 void Dynamics::outputs(const double* y, const Input& in, Output& out, OutputGradients* grad) const noexcept {
@@ -545,8 +413,10 @@ void Dynamics::outputs(const double* y, const Input& in, Output& out, OutputGrad
 State Dynamics::equilibrium(double x0) const noexcept {
   State y{};
   y[kX] = x0;
-  if (layout_.mr_y >= 0) y[layout_.mr_y] = x0;  // the MR damper at rest: y = x, z = 0
-  if (mode_ == ControlMode::Free) return y;
+  if (mode_ == ControlMode::Free) {
+    each([&](const auto& e, int off) { e.rest(RestPoint{x0, 0.0}, &y[off]); });
+    return y;
+  }
   const double p = static_force(x0) / rig_.A;
   y[kP] = p;
   // Spool opening whose flow feeds the leakage C_l p (a few fixed-point passes
@@ -558,8 +428,72 @@ State Dynamics::equilibrium(double x0) const noexcept {
     s = rig_.effects.flow_nonlinearity ? rig_.flow_curve.inverse(q) : q;
   }
   y[kXv] = rig_.effects.servovalve_dynamics ? s : 0.0;
-  if (layout_.pade >= 0) y[layout_.pade] = s / (rig_.K_s * pade_.a[0]);  // q_1 = w / a_0 holds w = s / K_s
+  each([&](const auto& e, int off) { e.rest(RestPoint{x0, s}, &y[off]); });
   return y;
+}
+
+namespace {
+// The kinematic driver's automatic RK4 substeps: h rho <= 1, rho the elements' rate bound at the
+// motion's largest speed.
+int driver_substeps(const Dynamics& d, const double* v, std::size_t n, double dt) {
+  double vmax = 0.0;
+  for (std::size_t k = 0; k < n; ++k) vmax = std::max(vmax, std::fabs(v[k]));
+  const double steps = std::ceil(dt * d.element_rate_bound(vmax));
+  require(std::isfinite(steps) && steps <= 100000, "substeps (automatic)", steps,
+          "exceeds 100000 per sample: give substeps, or a finer dt");
+  return std::max(1, static_cast<int>(steps));
+}
+}  // namespace
+
+void Dynamics::specimen_forces(const double* x, const double* v, std::size_t n, double dt, int substeps,
+                               double* F) const {
+  require(std::isfinite(dt) && dt > 0.0, "dt", dt, "sample time must be finite and > 0 [s]");
+  require(substeps >= 0 && substeps <= 100000, "substeps", substeps, "must be in 1..100000, or 0 for automatic");
+  if (n == 0) return;
+  // The structure elements' states (the drive elements do not see the motion).
+  int idx[kMaxStates];
+  int m = 0;
+  State y{};
+  y[kX] = x[0];
+  y[kV] = v[0];
+  each([&](const auto& e, int off) {
+    if constexpr (std::decay_t<decltype(e)>::kPort == Port::Structure) {
+      e.rest(RestPoint{x[0], 0.0}, &y[off]);
+      for (int k = 0; k < e.count(); ++k) idx[m++] = off + k;
+    }
+  });
+  if (substeps == 0) substeps = driver_substeps(*this, v, n, dt);
+  // Rates of those states at (xt, vt, s) into r[0..m-1]; returns the specimen force.
+  auto rates = [&](double xt, double vt, const State& s, double* r) {
+    State at = s;
+    at[kX] = xt;
+    at[kV] = vt;
+    Algebra g;
+    g.zero<kCap>();
+    specimen<kCap>(at.data(), g);
+    for (int i = 0; i < m; ++i) r[i] = g.rate[idx[i]];
+    return g.Fsp;
+  };
+  double k1[kMaxStates], k2[kMaxStates], k3[kMaxStates], k4[kMaxStates];
+  const double h = 1.0 / substeps;
+  State tmp;
+  for (std::size_t k = 0;; ++k) {
+    F[k] = rates(x[k], v[k], y, k1);
+    if (k + 1 == n) break;
+    const double x0 = x[k], dx = x[k + 1] - x[k], v0 = v[k], dv = v[k + 1] - v[k];
+    for (int j = 0; j < substeps; ++j) {
+      const double w0 = j * h, wm = (j + 0.5) * h, w1 = (j + 1) * h;
+      if (j > 0) rates(x0 + w0 * dx, v0 + w0 * dv, y, k1);
+      tmp = y;
+      for (int i = 0; i < m; ++i) tmp[idx[i]] = y[idx[i]] + 0.5 * h * dt * k1[i];
+      rates(x0 + wm * dx, v0 + wm * dv, tmp, k2);
+      for (int i = 0; i < m; ++i) tmp[idx[i]] = y[idx[i]] + 0.5 * h * dt * k2[i];
+      rates(x0 + wm * dx, v0 + wm * dv, tmp, k3);
+      for (int i = 0; i < m; ++i) tmp[idx[i]] = y[idx[i]] + h * dt * k3[i];
+      rates(x0 + w1 * dx, v0 + w1 * dv, tmp, k4);
+      for (int i = 0; i < m; ++i) y[idx[i]] += h * dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+    }
+  }
 }
 
 Dynamics::OperatingPoint Dynamics::operating_point(double x0) const noexcept {

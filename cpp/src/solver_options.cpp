@@ -5,6 +5,7 @@
 
 #include "servohydraulics/dynamics.hpp"
 #include "servohydraulics/error.hpp"
+#include "detail/math.hpp"
 
 namespace servohydraulics {
 
@@ -41,7 +42,7 @@ double state_scale(const Dynamics& dyn, int i) noexcept {
   switch (i) {
     case kX: return r.stroke;
     case kV: {
-      if (!free) return r.K_v * dyn.flow_gain(std::min(r.x_v_max, 1.0)) / r.A;
+      if (!free) return dyn.no_load_speed();
       const double w = std::sqrt(r.k / dyn.moving_mass());
       return w > 0.0 ? r.stroke * w : 1.0;
     }
@@ -50,7 +51,7 @@ double state_scale(const Dynamics& dyn, int i) noexcept {
       return force > 0.0 ? std::min(r.p_s, force / r.A) : r.p_s;
     }
     case kXv: return r.x_v_max;
-    case kXvDot: return 2.0 * 3.14159265358979323846 * r.f_v * r.x_v_max;
+    case kXvDot: return 2.0 * detail::kPi * r.f_v * r.x_v_max;
     case kZ: return r.F_c > 0.0 ? r.F_c / r.sigma_0 : 1e-6;
     default: return dyn.state_scale(i);  // the specimen and in-loop delay states (Dynamics::state_scale)
   }

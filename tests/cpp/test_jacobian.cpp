@@ -1,8 +1,8 @@
 // Analytic Jacobian df/dy, input gradient df/du and the linearised output
 // matrices (C, D) against central finite differences of Dynamics::rhs and
 // Dynamics::outputs, at many fixed-seed random states, in every control mode
-// and for every combination of the twelve effect switches (the nine of the
-// paper's plant, the Bouc-Wen and MR damper specimens and the Pade loop delay,
+// and for every combination of the thirteen effect switches (the nine of the
+// paper's plant, the Bouc-Wen, MR damper and fluid damper specimens and the Pade loop delay,
 // whose states are appended: every loop runs over Dynamics::num_states()).
 //
 // States are drawn away from the model's kinks (where the derivative is not
@@ -38,13 +38,11 @@ namespace {
 
 constexpr double kScale[kNumStates] = {1e-2, 1e-1, 1e6, 1e-1, 1e1, 1e-4};  // x [m], v [m/s], p [Pa], x_v [-], x_v' [1/s], z [m]
 
-// Scale of state j of this plant: the base states above; Bouc-Wen z and the MR damper's y, z [m];
-// the Pade states [V].
+// Scale of state j of this plant: the base states above; the elements' states in m (Bouc-Wen z,
+// the MR damper's y, z) 1e-3; the Pade states [V] 1.
 double scale(const Dynamics& dyn, int j) {
-  const StateLayout& L = dyn.layout();
   if (j < kNumStates) return kScale[j];
-  if (j == L.bw_z || j == L.mr_y || (L.mr_y >= 0 && j == L.mr_y + 1)) return 1e-3;
-  return 1.0;
+  return std::string(dyn.state_info(j).unit) == "m" ? 1e-3 : 1.0;
 }
 // Ultimate |z| of a Bouc-Wen law, (A / (beta + gamma))^(1/n).
 double ultimate(double A, double bg, double n) { return bg > 0.0 ? std::pow(A / bg, 1.0 / n) : 0.01; }
@@ -68,6 +66,7 @@ void set_effects(Effects& e, unsigned mask) {
   e.bouc_wen_hysteresis = mask & 512u;
   e.mr_damper = mask & 1024u;
   e.loop_delay = mask & 2048u;
+  e.fluid_damper = mask & 4096u;
 }
 
 struct Draw {
@@ -84,17 +83,20 @@ bool away_from_kinks(const Dynamics& dyn, const Draw& d) {
   if (dyn.lugre() && std::fabs(y[kV]) < 1e-6) return false;  // |v| in the bristle equation
   // Bouc-Wen laws: |w| (w the deformation rate) and, with n = 1, |z|.
   const StateLayout& L = dyn.layout();
-  if (L.bw_z >= 0) {
+  if (const int iz = L.offset_of<BoucWen>(); iz >= 0) {
     if (std::fabs(y[kV]) < margin_v) return false;
-    if (r.bw_n == 1.0 && std::fabs(y[L.bw_z]) < 1e-6) return false;
+    if (r.bw_n == 1.0 && std::fabs(y[iz]) < 1e-6) return false;
   }
-  if (L.mr_y >= 0) {
+  if (const int iy = L.offset_of<MrDamper>(); iy >= 0) {
     const double cs = (r.mr_c0_a + r.mr_c0_b * r.mr_voltage) + (r.mr_c1_a + r.mr_c1_b * r.mr_voltage);
-    const double ydot = ((r.mr_alpha_a + r.mr_alpha_b * r.mr_voltage) * y[L.mr_y + 1] +
-                         (r.mr_c0_a + r.mr_c0_b * r.mr_voltage) * y[kV] + r.mr_k0 * (y[kX] - y[L.mr_y])) / cs;
+    const double ydot = ((r.mr_alpha_a + r.mr_alpha_b * r.mr_voltage) * y[iy + 1] +
+                         (r.mr_c0_a + r.mr_c0_b * r.mr_voltage) * y[kV] + r.mr_k0 * (y[kX] - y[iy])) / cs;
     if (std::fabs(y[kV] - ydot) < margin_v) return false;
-    if (r.mr_n == 1.0 && std::fabs(y[L.mr_y + 1]) < 1e-6) return false;
+    if (r.mr_n == 1.0 && std::fabs(y[iy + 1]) < 1e-6) return false;
   }
+  // Fluid damper: its rate (|F| / c)^(1/alpha) has a kink in its slope at F = 0 for alpha < 1.
+  if (const int iu = L.offset_of<FluidDamper>(); iu >= 0 && r.fd_alpha < 1.0)
+    if (std::fabs(y[kX] - y[iu]) < 1e-8) return false;
   if (dyn.mode() == ControlMode::Free) return true;
   Output o;
   dyn.outputs(y, d.in, o);
@@ -128,12 +130,15 @@ Draw draw(sh_test::Randomizer& rnd, const Dynamics& dyn) {
   d.y[kXvDot] = rnd.signed_uniform(0.0, 50.0);
   d.y[kZ] = rnd.signed_uniform(0.0, 1.5 * r.stribeck_ratio * r.F_c / r.sigma_0);  // bristle deflection [m]
   const StateLayout& L = dyn.layout();
-  if (L.bw_z >= 0) d.y[L.bw_z] = rnd.signed_uniform(0.0, 1.5 * ultimate(r.bw_A, r.bw_beta + r.bw_gamma, r.bw_n));
-  if (L.mr_y >= 0) {
-    d.y[L.mr_y] = d.y[kX] + rnd.signed_uniform(0.0, 0.01);
-    d.y[L.mr_y + 1] = rnd.signed_uniform(0.0, 1.5 * ultimate(r.mr_A, r.mr_beta + r.mr_gamma, r.mr_n));
+  if (const int iz = L.offset_of<BoucWen>(); iz >= 0)
+    d.y[iz] = rnd.signed_uniform(0.0, 1.5 * ultimate(r.bw_A, r.bw_beta + r.bw_gamma, r.bw_n));
+  if (const int iy = L.offset_of<MrDamper>(); iy >= 0) {
+    d.y[iy] = d.y[kX] + rnd.signed_uniform(0.0, 0.01);
+    d.y[iy + 1] = rnd.signed_uniform(0.0, 1.5 * ultimate(r.mr_A, r.mr_beta + r.mr_gamma, r.mr_n));
   }
-  for (int k = 0; k < L.pade_order; ++k) d.y[L.pade + k] = rnd.signed_uniform(0.0, 5.0);
+  // The fluid damper's series spring deflected by up to 1 mm (20 kN at the default fd_k).
+  if (const int iu = L.offset_of<FluidDamper>(); iu >= 0) d.y[iu] = d.y[kX] + rnd.signed_uniform(0.0, 1e-3);
+  for (int k = 0; k < L.count_of<PadeDelay>(); ++k) d.y[L.offset_of<PadeDelay>() + k] = rnd.signed_uniform(0.0, 5.0);
   if (dyn.mode() == ControlMode::Displacement) {
     d.in.u = rnd.signed_uniform(0.0, 0.06);
     d.in.u_rate = rnd.signed_uniform(0.0, 0.5);
@@ -304,8 +309,8 @@ int main() {
     worst = std::max(worst, st.worst_scaled);
   };
 
-  // Every combination of the twelve effect switches, calibrated preset.
-  for (unsigned mask = 0; mask < 4096; ++mask)
+  // Every combination of the thirteen effect switches, calibrated preset.
+  for (unsigned mask = 0; mask < 8192; ++mask)
     for (ControlMode mode : modes) {
       Rig rig = zhao2003();
       set_effects(rig.effects, mask);
@@ -351,6 +356,15 @@ int main() {
       run(spec, mode, 40, "specimens, n 2.5 / 1, Pade order " + std::to_string(order));
     }
   }
+  // The fluid damper linear (alpha = 1, a Maxwell element) and at alpha 0.3, with the specimens.
+  for (ControlMode mode : modes)
+    for (double alpha : {1.0, 0.3}) {
+      Rig fd = zhao2003();
+      fd.effects.fluid_damper = fd.effects.bouc_wen_hysteresis = fd.effects.loop_delay = true;
+      fd.fd_alpha = alpha;
+      fd.fd_k = 5e6;
+      run(fd, mode, 100, "fluid damper, alpha " + std::to_string(alpha));
+    }
   Rig underdamped = zhao2003();
   underdamped.zeta_v = 0.3;
   underdamped.f_v = 30.0;

@@ -1,4 +1,4 @@
-// Specimens (Bouc-Wen, MR damper) and delays inside the loop (command, measurement,
+// Specimens (Bouc-Wen, MR damper, fluid damper) and delays inside the loop (command, measurement,
 // Pade loop delay): the state layout, the digital command delay against the closed
 // form of a linear oscillator, the exact split of a sample at a fractional delay,
 // equilibria with every element on, zero allocations in step, and bad input.
@@ -21,7 +21,7 @@ constexpr double kPi = 3.14159265358979323846;
 
 Rig all_on() {
   Rig r = zhao2003();
-  r.effects.bouc_wen_hysteresis = r.effects.mr_damper = r.effects.loop_delay = true;
+  r.effects.bouc_wen_hysteresis = r.effects.mr_damper = r.effects.loop_delay = r.effects.fluid_damper = true;
   return r;
 }
 
@@ -29,19 +29,23 @@ Rig all_on() {
 void check_layout() {
   const Dynamics paper(zhao2003(), ControlMode::Displacement);
   CHECK(paper.num_states() == kNumStates);
-  CHECK(paper.layout().bw_z == -1 && paper.layout().mr_y == -1 && paper.layout().pade == -1);
+  CHECK(paper.layout().offset_of<BoucWen>() == -1 && paper.layout().offset_of<MrDamper>() == -1 &&
+        paper.layout().offset_of<PadeDelay>() == -1);
   const Dynamics d(all_on(), ControlMode::Displacement);
-  CHECK(d.num_states() == kNumStates + 1 + 2 + 3);
-  CHECK(d.layout().bw_z == 6 && d.layout().mr_y == 7 && d.layout().pade == 9 && d.layout().pade_order == 3);
+  CHECK(d.num_states() == kNumStates + 1 + 2 + 3 + 1);
+  CHECK(d.layout().offset_of<FluidDamper>() == 12 && std::string(d.state_info(12).name) == "fd_u");
+  CHECK(d.layout().offset_of<BoucWen>() == 6 && d.layout().offset_of<MrDamper>() == 7 &&
+        d.layout().offset_of<PadeDelay>() == 9 && d.layout().count_of<PadeDelay>() == 3);
   CHECK(std::string(d.state_info(6).name) == "bw_z" && std::string(d.state_info(8).name) == "mr_z");
   CHECK(std::string(d.state_info(11).name) == "delay_3");
   // No actuator in free mode: no loop delay.
   const Dynamics f(all_on(), ControlMode::Free);
-  CHECK(f.num_states() == kNumStates + 3 && f.layout().pade == -1);
+  CHECK(f.num_states() == kNumStates + 4 && f.layout().offset_of<PadeDelay>() == -1);
+  CHECK(f.layout().offset_of<FluidDamper>() == kNumStates + 3);
   Rig mr = zhao2003();
   mr.effects.mr_damper = true;
   const Dynamics m(mr, ControlMode::Force);
-  CHECK(m.layout().mr_y == kNumStates && m.num_states() == kNumStates + 2);
+  CHECK(m.layout().offset_of<MrDamper>() == kNumStates && m.num_states() == kNumStates + 2);
 }
 
 // The operating point holds the plant at rest with every element on (incl. the
@@ -217,6 +221,17 @@ void check_bad_input() {
                "invalid loop_delay_order = 2.5");
   expect_error([&] { rig_with([](Rig& r) { r.loop_delay_order = 7.0; }).validate(); }, "invalid loop_delay_order = 7");
   expect_error([&] { rig_with([](Rig& r) { r.loop_delay = 0.0; }).validate(); }, "invalid loop_delay = 0");
+  expect_error([&] { rig_with([](Rig& r) { r.fd_alpha = 0.0; }).validate(); }, "invalid fd_alpha = 0");
+  expect_error([&] { rig_with([](Rig& r) { r.fd_k = -1.0; }).validate(); }, "invalid fd_k = -1");
+  expect_error(
+      [&] {
+        Dynamics d(rig_with([](Rig& r) {
+                     r.effects.fluid_damper = true;
+                     r.fd_alpha = 1.5;
+                   }),
+                   ControlMode::Displacement);
+      },
+      "invalid fd_alpha = 1.5: must be in (0, 1]");
   // Longer than kMaxDelaySamples samples of the plant's dt.
   const double dt = 1.0 / 1024.0;
   expect_error([&] { Plant p(rig_with([dt](Rig& r) { r.command_delay = 65 * dt; }), ControlMode::Displacement, dt); },

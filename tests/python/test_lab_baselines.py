@@ -1,4 +1,5 @@
-"""The thesis' Spencer (modified Bouc-Wen) baseline against a closed form."""
+"""The thesis' Spencer (modified Bouc-Wen) baseline, the core's MR element driven along the
+motion, against a closed form and an independent NumPy transcription (spencer_oracle.py)."""
 
 from __future__ import annotations
 
@@ -6,6 +7,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from spencer_oracle import spencer_force_lsoda, spencer_force_rk4
 
 from servohydraulics.identification import baselines as b
 
@@ -34,15 +36,19 @@ def test_thesis_parameters_follow_the_readme():
 
 
 @pytest.mark.parametrize("current", [0.0, 1.0])
-def test_rk4_baseline_equals_lsoda(current):
-    """The fast fixed-step baseline against SciPy's LSODA (rtol 1e-6) on a 2 mm chirp to
-    15 Hz (peak 90 mm/s, the records' range) with the thesis' 0 A (stiffest z) and 1 A
-    parameters: within 2e-3 of the force's std everywhere."""
+def test_core_baseline_equals_the_numpy_oracle(current):
+    """The core element through the kinematic driver against the NumPy transcription on a 2 mm
+    chirp to 15 Hz (peak 90 mm/s, the records' range) with the thesis' 0 A (stiffest z) and 1 A
+    parameters: the same RK4 scheme agrees to round-off (1e-9 of the force's std; the core runs
+    in SI, the oracle in mm), and SciPy's LSODA (rtol 1e-6) within 2e-3 of it everywhere."""
     dt = 1e-3
     t = np.arange(8000) * dt
     x_m = 2e-3 * np.sin(2 * np.pi * (0.5 * t + 0.9 * t**2))
     p = b.thesis_mr_parameters(current)
-    fast, ref = b.spencer_force(x_m, dt, p), b.spencer_force(x_m, dt, p, method="lsoda")
-    assert np.max(np.abs(fast - ref)) < 2e-3 * np.std(ref)
-    with pytest.raises(ValueError, match="invalid method = 'euler'"):
-        b.spencer_force(x_m, dt, p, method="euler")
+    core = b.spencer_force(x_m, dt, p)
+    x, v = b.smoothed_motion(x_m, dt)
+    same_scheme, lsoda = spencer_force_rk4(x, v, dt, p, 10), spencer_force_lsoda(x, v, dt, p)
+    assert np.max(np.abs(core - same_scheme)) < 1e-9 * np.std(lsoda)
+    assert np.max(np.abs(core - lsoda)) < 2e-3 * np.std(lsoda)
+    with pytest.raises(ValueError, match="invalid substeps = -1"):
+        b.spencer_force(x_m, dt, p, substeps=-1)

@@ -270,7 +270,12 @@ def test_states_table_and_simulate_with_every_element(tmp_path):
     names = [s[0] for s in dyn.states]
     assert names == ["x", "v", "p", "x_v", "x_v_dot", "z", "bw_z", "mr_y", "mr_z",
                      "delay_1", "delay_2", "delay_3", "delay_4"]
-    assert dyn.layout == dict(num_states=13, bw_z=6, mr_y=7, mr_z=8, pade=9, pade_order=4)
+    # each element's first state by its switch (-1: off, as every other element), and each
+    # appended state by its name
+    on = {k: i for k, i in dyn.layout.items() if i >= 0}
+    assert on == dict(num_states=13, bouc_wen_hysteresis=6, mr_damper=7, loop_delay=9, bw_z=6, mr_y=7,
+                      mr_z=8, delay_1=9, delay_2=10, delay_3=11, delay_4=12)
+    assert set(dyn.layout.values()) - set(on.values()) <= {-1}
     path = save_rig(r, tmp_path / "spec.toml")
     text = path.read_text()
     assert "[specimen]" in text and "[delays]" in text

@@ -4,7 +4,10 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
+#include <utility>
 
+#include "servohydraulics/elements.hpp"
 #include "servohydraulics/output.hpp"
 #include "servohydraulics/rig.hpp"
 #include "servohydraulics/state.hpp"
@@ -51,32 +54,39 @@ class Dynamics {
   OperatingPoint operating_point(double x0) const noexcept;
 
   //! The active length of the state vector: the base states plus those of the
-  //! switched-on elements (Bouc-Wen, MR damper, Pade loop delay).
+  //! switched-on elements (elements.hpp).
   int num_states() const noexcept { return layout_.num_states; }
-  //! Where the switchable elements' states are (-1: off).
+  //! Where the switched-on elements' states are (offset -1: off).
   const StateLayout& layout() const noexcept { return layout_; }
   //! Name, unit and meaning of state i < num_states().
   const StateInfo& state_info(int i) const noexcept;
-  //! Absolute scale of an appended state i >= kNumStates (specimen, in-loop delay); the base
+  //! Absolute scale of an appended state i >= kNumStates (an element's); the base
   //! states' scales follow the rig (servohydraulics::state_scale in solver_options.hpp, which
   //! calls this for the appended ones).
   double state_scale(int i) const noexcept;
-  //! Force of the switched-on specimen elements (Bouc-Wen and MR damper) at state y [N]
-  //! (0 when both are off); part of the structure's force against the applied one.
+  //! Force of the switched-on structure elements (the specimens) at state y [N] (0 when
+  //! none is on); part of the structure's force against the applied one.
   double specimen_force(const double* y) const noexcept;
-  //! Upper estimate of |d z'/d z| of the hysteretic states (Bouc-Wen, MR damper) when
-  //! sliding at v_ref [m/s]: their stiffness for an explicit integrator [1/s].
-  double hysteretic_rate_bound(double v_ref) const noexcept;
-  //! The Pade loop delay's realisation: dq/dt = (A' q + e_N w) / tau, out = C' q + d w, with
-  //! A' a companion matrix whose last row is -a[0..N-1] (a monic denominator in s tau).
-  struct Pade {
-    int order = 0;
-    double tau = 0.0;
-    double a[kMaxPadeOrder] = {};  //!< denominator coefficients over the leading one
-    double c[kMaxPadeOrder] = {};  //!< output row C'
-    double d = 0.0;                //!< feedthrough (-1)^N
-  };
-  const Pade& pade() const noexcept { return pade_; }
+  //! The kinematic driver: the specimen force [N] along a given motion x[k], v[k] [m, m/s] sampled
+  //! at dt [s], the elements' states starting at rest at x[0] and integrated by RK4 with
+  //! `substeps` steps per sample (0: from the elements' rate bound at the largest |v|), the motion
+  //! interpolated linearly between samples.  Writes F[0..n-1].
+  void specimen_forces(const double* x, const double* v, std::size_t n, double dt, int substeps,
+                       double* F) const;
+  //! Upper estimate of |d rate / d state| of the elements' states when sliding at v_ref [m/s]:
+  //! their stiffness for an explicit integrator [1/s] (0 when no element bounds it).
+  double element_rate_bound(double v_ref) const noexcept;
+  //! The actuator's no-load speed K_v g(min(x_v_max, 1)) / A [m/s].
+  double no_load_speed() const noexcept;
+  //! The switched-on element E, or nullptr when it is off.
+  template <class E>
+  const E* element() const noexcept {
+    const auto& e = std::get<element_index<E>>(elements_);
+    return e ? &*e : nullptr;
+  }
+  //! The Pade loop delay's realisation (order 0 when it is off).
+  using Pade = PadeDelay;
+  const Pade& pade() const noexcept;
 
   const Rig& rig() const noexcept { return rig_; }
   ControlMode mode() const noexcept { return mode_; }
@@ -99,7 +109,6 @@ class Dynamics {
   double pressure_factor_dp(double s, double p) const noexcept;     //!< its derivative by p [1/Pa]
 
  private:
-  struct Algebra;  // intermediate quantities of one evaluation
   struct Friction;  // friction force, bristle rate and their gradients
   // W: the gradient width the loops run over, a constant so that they unroll (the paper
   // plant's kNumStates + 1, or the capacity with appended states).
@@ -107,10 +116,25 @@ class Dynamics {
   void evaluate(const double* y, const Input& in, Algebra& a) const noexcept;
   void evaluate_any(const double* y, const Input& in, Algebra& a) const noexcept;
   template <int W>
+  void structure(const double* y, const Input& in, Algebra& a) const noexcept;
+  template <int W>
+  bool servo_controller(const double* y, const Input& in, Algebra& a) const noexcept;
+  template <int W>
+  void valve(const double* y, double vdrive, const double* dvdrive, Algebra& a) const noexcept;
+  template <int W>
   void specimen(const double* y, Algebra& a) const noexcept;
   template <int W>
-  void loop_delay(const double* y, Algebra& a) const noexcept;
+  bool delay_drive(const double* y, Algebra& a) const noexcept;
   void jacobian_appended(const Algebra& g, Jacobian& J, State* B) const noexcept;
+  // f(element, offset) for each switched-on element, in the order of Elements.
+  template <class F>
+  void each(F&& f) const {
+    each_impl(f, std::make_index_sequence<kNumElements>{});
+  }
+  template <class F, std::size_t... I>
+  void each_impl(F& f, std::index_sequence<I...>) const {
+    ((std::get<I>(elements_) ? f(*std::get<I>(elements_), layout_.offset[I]) : void()), ...);
+  }
   Friction friction(double v, double z) const noexcept;
   double static_force(double x) const noexcept;  // the structure's force at rest at x
 
@@ -124,12 +148,8 @@ class Dynamics {
   StateLayout layout_;
   int ku_ = kNumStates;      // gradient column of the command u (= num_states())
   int ng_ = kNumStates + 1;  // gradient width
-  double mr_alpha_ = 0.0, mr_c0_ = 0.0, mr_c1_ = 0.0;  // MR damper coefficients at the run's voltage
-  Pade pade_;
+  bool specimen_on_ = false;  // a structure element is on
+  detail::Optionals<Elements>::type elements_;
 };
-
-//! Coefficients of the (N, N) Pade approximant of exp(-s tau) in s tau, lowest power first:
-//! den[k] = (2N-k)! N! / ((2N)! k! (N-k)!), num[k] = (-1)^k den[k].  1 <= N <= kMaxPadeOrder.
-void pade_coefficients(int order, double* num, double* den) noexcept;
 
 }  // namespace servohydraulics

@@ -121,6 +121,12 @@ inline constexpr ParameterInfo kRigParameters[] = {
      "not in the paper: 2 ms", Bound::Positive, &Rig::loop_delay},
     {"delays", "loop_delay_order", "-", "Pade order of loop_delay", "modelling choice: 3", Bound::PadeOrder,
      &Rig::loop_delay_order},
+    {"specimen", "fd_c", "N (s/m)^alpha", "fluid damper coefficient: F = fd_c abs(u')^fd_alpha sign(u')",
+     "not in the paper: 20 kN at 1 m/s", Bound::Positive, &Rig::fd_c},
+    {"specimen", "fd_alpha", "-", "fluid damper velocity exponent, in (0, 1]",
+     "not in the paper: 0.5 (fluid viscous dampers: 0.3-1)", Bound::Positive, &Rig::fd_alpha},
+    {"specimen", "fd_k", "N/m", "fluid damper series (Maxwell) stiffness",
+     "not in the paper: 20 MN/m", Bound::Positive, &Rig::fd_k},
 };
 
 struct EffectInfo {
@@ -142,6 +148,7 @@ inline constexpr EffectInfo kEffects[] = {
     {"bouc_wen_hysteresis", "Bouc-Wen hysteretic specimen (state bw_z)", &Effects::bouc_wen_hysteresis},
     {"mr_damper", "MR damper, Spencer et al. 1997 (states mr_y, mr_z)", &Effects::mr_damper},
     {"loop_delay", "Pade transport delay loop_delay on the valve drive", &Effects::loop_delay},
+    {"fluid_damper", "nonlinear viscous fluid damper with a series stiffness (state fd_u)", &Effects::fluid_damper},
 };
 
 //! The requirement of a bound, for messages and docs: "finite and > 0".

@@ -73,6 +73,9 @@ struct Effects {
   //! a transport delay of loop_delay [s] on the valve drive, as a Pade approximant of order
   //! loop_delay_order (states delay_1..N; inactive in free mode)
   bool loop_delay = false;
+  //! a nonlinear viscous fluid damper in series with a Maxwell stiffness, in parallel with the
+  //! structure (state fd_u; docs/specimens.md)
+  bool fluid_damper = false;
 };
 
 //! Parameters of the rig.  Field names follow the paper's symbols (Table I).
@@ -140,6 +143,12 @@ struct Rig {
   double mr_gamma = 363e4;     //!< gamma [1/m^2] (363 cm^-2)
   double mr_n = 2.0;           //!< n >= 1 [-] (2)
   double mr_voltage = 0.0;     //!< command voltage u, constant over a run [V]
+
+  // --- Specimen: nonlinear viscous fluid damper (effects.fluid_damper) ----------
+  // F = fd_k (x - u) = fd_c |u'|^fd_alpha sign(u')  (the dashpot in series with its stiffness)
+  double fd_c = 20e3;       //!< damping coefficient [N (s/m)^alpha]
+  double fd_alpha = 0.5;    //!< velocity exponent, 0 < alpha <= 1 [-]
+  double fd_k = 20e6;       //!< series (Maxwell) stiffness: brace, fluid and seals [N/m]
 
   // --- Delays inside the loop --------------------------------------------------
   //! digital command delay [s] (computation/communication latency): the held command

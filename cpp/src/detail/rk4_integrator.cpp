@@ -46,23 +46,12 @@ int rk4_automatic_substeps(const Dynamics& dyn, double dt, const SolverOptions& 
   require(std::isfinite(dt) && dt > 0.0, "dt", dt, "controller sample time must be finite and > 0 [s]");
   opt.validate();
   double rho = loop_spectral_radius(dyn);
-  // LuGre: the bristle rate sigma_0 |v| / g(v) is 0 at rest and grows with the sliding speed.  Bound
-  // |v| by v_ref: given, or the no-load actuator speed K_v g(x_v_max) / A (1 m/s in free mode, no actuator).
-  if (dyn.lugre()) {
-    const Rig& r = dyn.rig();
-    const double v_no_load =
-        dyn.mode() == ControlMode::Free ? 1.0 : r.K_v * dyn.flow_gain(std::min(r.x_v_max, 1.0)) / r.A;
-    const double v_ref = opt.rk4_v_ref > 0.0 ? opt.rk4_v_ref : v_no_load;
-    rho = std::max(rho, r.sigma_0 * v_ref / r.F_c);
-  }
-  // Hysteretic specimens (Bouc-Wen, MR damper): their z' stiffens with the sliding speed, bounded alike.
-  const StateLayout& L = dyn.layout();
-  if (L.bw_z >= 0 || L.mr_y >= 0) {
-    const Rig& r = dyn.rig();
-    const double v_no_load =
-        dyn.mode() == ControlMode::Free ? 1.0 : r.K_v * dyn.flow_gain(std::min(r.x_v_max, 1.0)) / r.A;
-    rho = std::max(rho, dyn.hysteretic_rate_bound(opt.rk4_v_ref > 0.0 ? opt.rk4_v_ref : v_no_load));
-  }
+  // LuGre and the elements' states (hysteretic specimens, dashpots) stiffen with the sliding speed:
+  // bound |v| by v_ref, given, or the no-load actuator speed (1 m/s in free mode, no actuator).
+  const double v_ref =
+      opt.rk4_v_ref > 0.0 ? opt.rk4_v_ref : (dyn.mode() == ControlMode::Free ? 1.0 : dyn.no_load_speed());
+  if (dyn.lugre()) rho = std::max(rho, dyn.rig().sigma_0 * v_ref / dyn.rig().F_c);
+  rho = std::max(rho, dyn.element_rate_bound(v_ref));
   const double n = std::ceil(dt * rho / opt.rk4_h_rho);
   require(std::isfinite(n) && n <= SolverOptions::kMaxSubsteps, "rk4_substeps (automatic)", n,
           "exceeds the cap of 100000 per sample: the plant is too stiff for a fixed-step integrator at this dt; "

@@ -15,9 +15,12 @@ Quiroz (2022), MSc thesis, UTFSM; code and data: github.com/DanielMaurelE/vRTHS_
       dz/dt = -gamma |dx/dt - dy/dt| |z|^(n-1) z - beta (dx/dt - dy/dt) |z|^n + A (dx/dt - dy/dt)
       F     = c1 dy/dt + k1 (x - x0)
 
-These are plain NumPy/SciPy and share no code with the simulator's core:
-they are the baselines our identified rigs are measured against, not a model
-of ours.
+The actuator model is plain SciPy; the MR-damper law is the core's own element
+(``_core.Dynamics.specimen_forces``, the kinematic driver: the thesis' parameters
+in SI through :func:`spencer_rig_keys`, the current folded into the ``_a`` terms),
+so the law is written once.  tests/python/spencer_oracle.py keeps an independent
+NumPy transcription as the oracle it is checked against.  These are the baselines
+our identified rigs are measured against, not a fit of ours.
 """
 
 from __future__ import annotations
@@ -27,7 +30,10 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy import integrate, signal
+from scipy import signal
+
+from .. import _core
+from ..rig import zhao2003
 
 #: The thesis' command -> displacement model: numerator gain [1/s^2] and poles [rad/s].
 THESIS_ACTUATOR = {"gain": 9045.99, "poles": (-183.83, -48.58)}
@@ -95,73 +101,20 @@ def smoothed_motion(displacement: ArrayLike, dt: float, cutoff_hz: float = 200.0
     return x, np.gradient(x, dt)
 
 
-def _spencer_rates(p: SpencerParameters, xt: float, vt: float, y: float, z: float) -> tuple[float, float]:
-    ydot = (p.alpha * z + p.k0 * (xt - y) + p.c0 * vt) / (p.c0 + p.c1)
-    r = vt - ydot
-    az = abs(z)
-    return ydot, -p.gamma * abs(r) * az ** (p.n - 1.0) * z - p.beta * r * az**p.n + p.A * r
-
-
 def spencer_force(displacement: ArrayLike, dt: float, p: SpencerParameters, cutoff_hz: float = 200.0,
-                  method: str = "rk4", substeps: int = 10) -> np.ndarray:
+                  substeps: int = 10) -> np.ndarray:
     """Damper force [N] of the modified Bouc-Wen model driven by a measured
     displacement [m] sampled at dt [s] (smoothed as :func:`smoothed_motion`),
-    starting with y = x and z = 0, the motion interpolated linearly between samples.
-
-    ``method="rk4"``: classical RK4 with ``substeps`` steps per sample (a plain
-    Python loop, a few seconds for 60 000 samples); ``"lsoda"``: SciPy's LSODA
-    (rtol 1e-6, at most one sample per step; ten times slower), the reference
-    the RK4 is checked against (tests/python/test_lab_baselines.py)."""
-    x_m, v_m = smoothed_motion(displacement, dt, cutoff_hz)
-    x, v = 1e3 * x_m, 1e3 * v_m  # mm, mm/s
-    if method == "lsoda":
-        y, z = _spencer_lsoda(x, v, dt, p)
-    elif method == "rk4":
-        y, z = _spencer_rk4(x, v, dt, p, int(substeps))
-    else:
-        raise ValueError(f"invalid method = {method!r}: expected 'rk4' or 'lsoda'")
-    ydot = (p.alpha * z + p.k0 * (x - y) + p.c0 * v) / (p.c0 + p.c1)
-    return p.c1 * ydot + p.k1 * (x - p.x0)
-
-
-def _spencer_rk4(x: np.ndarray, v: np.ndarray, dt: float, p: SpencerParameters,
-                 substeps: int) -> tuple[np.ndarray, np.ndarray]:
-    if substeps < 1:
-        raise ValueError(f"invalid substeps = {substeps!r}: must be >= 1")
-    n, h = x.size, 1.0 / substeps
-    ys, zs = np.empty(n), np.empty(n)
-    y, z = float(x[0]), 0.0
-    ys[0], zs[0] = y, z
-    xl, vl = x.tolist(), v.tolist()
-    rates = _spencer_rates
-    for k in range(n - 1):
-        x0, dx, v0, dv = xl[k], xl[k + 1] - xl[k], vl[k], vl[k + 1] - vl[k]
-        for j in range(substeps):
-            w0, wm, w1 = j * h, (j + 0.5) * h, (j + 1) * h
-            a1, b1 = rates(p, x0 + w0 * dx, v0 + w0 * dv, y, z)
-            a2, b2 = rates(p, x0 + wm * dx, v0 + wm * dv, y + 0.5 * h * dt * a1, z + 0.5 * h * dt * b1)
-            a3, b3 = rates(p, x0 + wm * dx, v0 + wm * dv, y + 0.5 * h * dt * a2, z + 0.5 * h * dt * b2)
-            a4, b4 = rates(p, x0 + w1 * dx, v0 + w1 * dv, y + h * dt * a3, z + h * dt * b3)
-            y += h * dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
-            z += h * dt / 6.0 * (b1 + 2.0 * b2 + 2.0 * b3 + b4)
-        ys[k + 1], zs[k + 1] = y, z
-    return ys, zs
-
-
-def _spencer_lsoda(x: np.ndarray, v: np.ndarray, dt: float, p: SpencerParameters) -> tuple[np.ndarray, np.ndarray]:
-    n = x.size
-
-    def rhs(t: float, s: np.ndarray) -> list[float]:
-        k = min(int(t / dt), n - 2)
-        w = t / dt - k
-        return list(_spencer_rates(p, x[k] + w * (x[k + 1] - x[k]), v[k] + w * (v[k + 1] - v[k]), s[0], s[1]))
-
-    t = np.arange(n) * dt
-    sol = integrate.solve_ivp(rhs, (0.0, t[-1]), [x[0], 0.0], method="LSODA", t_eval=t, rtol=1e-6,
-                              atol=[1e-6, 1e-6], max_step=dt)
-    if not sol.success:
-        raise RuntimeError(f"the Bouc-Wen baseline failed at t = {sol.t[-1]:.4g} s: {sol.message}")
-    return sol.y[0], sol.y[1]
+    starting with y = x and z = 0, the motion interpolated linearly between samples:
+    the core's MR-damper element along that motion, integrated by classical RK4 with
+    ``substeps`` steps per sample (0: from the element's rate bound)."""
+    x, v = smoothed_motion(displacement, dt, cutoff_hz)
+    rig = zhao2003()
+    rig.effects.mr_damper = True
+    for key, value in spencer_rig_keys(p).items():
+        setattr(rig, key, value)
+    dyn = _core.Dynamics(rig, _core.ControlMode.Free)
+    return dyn.specimen_forces(x, v, float(dt), int(substeps))
 
 
 def thesis_mr_force(displacement: ArrayLike, dt: float, current: float) -> np.ndarray:
@@ -169,5 +122,5 @@ def thesis_mr_force(displacement: ArrayLike, dt: float, current: float) -> np.nd
     return spencer_force(displacement, dt, thesis_mr_parameters(current))
 
 
-__all__ = ["THESIS_ACTUATOR", "SpencerParameters", "smoothed_motion", "spencer_rig_keys", "spencer_force", "thesis_actuator_tf",
-           "thesis_displacement", "thesis_mr_force", "thesis_mr_parameters"]
+__all__ = ["THESIS_ACTUATOR", "SpencerParameters", "smoothed_motion", "spencer_rig_keys", "spencer_force",
+           "thesis_actuator_tf", "thesis_displacement", "thesis_mr_force", "thesis_mr_parameters"]
