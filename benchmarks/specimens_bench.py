@@ -119,14 +119,14 @@ def mr_table() -> str:
         dyn = _core.Dynamics(r, _core.ControlMode.Free)
         iy = dyn.layout["mr_y"]
 
-        def state(t, s):
+        def state(t, s, dyn=dyn, iy=iy):
             y = np.zeros(dyn.num_states)
             y[0], y[1], y[iy], y[iy + 1] = X * np.sin(w * t), X * w * np.cos(w * t), s[0], s[1]
             return y
 
         t = np.arange(0, T, 1e-4)
-        sol = solve_ivp(lambda t, s: dyn.rhs(state(t, s), 0.0)[iy:iy + 2], (0, T), [0.0, 0.0], method="Radau",
-                        t_eval=t, rtol=1e-10, atol=1e-14)
+        sol = solve_ivp(lambda t, s, dyn=dyn, iy=iy: dyn.rhs(state(t, s), 0.0)[iy:iy + 2], (0, T), [0.0, 0.0],
+                        method="Radau", t_eval=t, rtol=1e-10, atol=1e-14)
         F = np.array([dyn.specimen_force(state(ti, si)) for ti, si in zip(sol.t, sol.y.T)])
         late = sol.t >= T / 2
         at_vmax = np.abs(np.cos(w * sol.t)) > 0.9999

@@ -160,7 +160,8 @@ def test_parameters_come_from_the_core_tables(fmus):
         assert [int(e) for _, e in table] == list(range(len(table)))
     assert {f["name"] for f in _core.SOLVER_OPTION_FIELDS} == {n[len("solver."):] for n in v if n.startswith("solver.")}
     for key, table in (("eft", {"eft.compensation": _core.COMPENSATION_NAMES}),
-                       ("rpsd", {"rpsd.scheme": _core.SCHEME_NAMES[:2], "rpsd.restoring_force": _core.RESTORING_FORCE_NAMES,
+                       ("rpsd", {"rpsd.scheme": _core.SCHEME_NAMES[:2],
+                                 "rpsd.restoring_force": _core.RESTORING_FORCE_NAMES,
                                  "rpsd.force_measurement": _core.FORCE_MEASUREMENT_NAMES})):
         cv = {x.name: x for x in read_model_description(str(fmus[key])).modelVariables}
         for name, names in table.items():

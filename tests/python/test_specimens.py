@@ -11,7 +11,6 @@ import math
 import numpy as np
 import pytest
 from scipy.integrate import quad, solve_ivp
-from scipy.optimize import brentq
 
 import servohydraulics as sh
 from servohydraulics import _core

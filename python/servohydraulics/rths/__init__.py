@@ -13,12 +13,42 @@ The C++ blocks (plants, converters, substructures, controllers, the loop) are
 """
 
 from .. import _core
-from .benchmark import (CONTROLLERS, FORCE_LIMIT, NOISE_GENERATORS, Trial, as_controller, case_psi, case_reference,
-                        controller_label, load_controller, make_controller, nominal_plant, partition, perturbed_plant,
-                        run_case, run_trial, trial_seed)
-from .data import (CASES, DT, EQ_INTENSITY, FS, RECORDS, BenchmarkCase, Record, chirp_record, embedded_case, load_case,
-                   load_record, modal_damping, reference_stiffness, shear_building, synthetic_record)
-from .evaluation import J_LABELS, J_NAMES, critical_delay, criteria, evaluate, matlab_round, psi, reference_response
+from .benchmark import (
+    CONTROLLERS,
+    FORCE_LIMIT,
+    NOISE_GENERATORS,
+    Trial,
+    as_controller,
+    case_psi,
+    case_reference,
+    controller_label,
+    load_controller,
+    make_controller,
+    nominal_plant,
+    partition,
+    perturbed_plant,
+    run_case,
+    run_trial,
+    trial_seed,
+)
+from .data import (
+    CASES,
+    DT,
+    EQ_INTENSITY,
+    FS,
+    RECORDS,
+    BenchmarkCase,
+    Record,
+    chirp_record,
+    embedded_case,
+    load_case,
+    load_record,
+    modal_damping,
+    reference_stiffness,
+    shear_building,
+    synthetic_record,
+)
+from .evaluation import J_LABELS, J_NAMES, criteria, critical_delay, evaluate, matlab_round, psi, reference_response
 from .opensees import OpenSeesSubstructure, spring_model
 
 core = _core.rths
@@ -27,10 +57,12 @@ TrackingController = core.TrackingController
 #: Wraps any object with reset() and command(...) as a TrackingController (rths.as_controller does it).
 PythonController = core.PythonController
 
-__all__ = ["CONTROLLERS", "FORCE_LIMIT", "Trial", "case_psi", "case_reference", "make_controller", "load_controller",
-           "as_controller", "controller_label", "TrackingController", "PythonController", "J_LABELS", "criteria",
-           "nominal_plant",
-           "partition", "perturbed_plant", "run_case", "run_trial", "trial_seed", "NOISE_GENERATORS", "CASES", "DT", "EQ_INTENSITY",
-           "FS", "RECORDS", "BenchmarkCase", "Record", "embedded_case", "load_case", "load_record",
-           "modal_damping", "reference_stiffness", "shear_building", "synthetic_record", "chirp_record", "J_NAMES", "critical_delay", "evaluate",
-           "matlab_round", "psi", "reference_response", "core", "OpenSeesSubstructure", "spring_model"]
+__all__ = [
+    "CONTROLLERS", "FORCE_LIMIT", "Trial", "case_psi", "case_reference", "make_controller", "load_controller",
+    "as_controller", "controller_label", "TrackingController", "PythonController", "J_LABELS", "criteria",
+    "nominal_plant", "partition", "perturbed_plant", "run_case", "run_trial", "trial_seed", "NOISE_GENERATORS",
+    "CASES", "DT", "EQ_INTENSITY", "FS", "RECORDS", "BenchmarkCase", "Record", "embedded_case", "load_case",
+    "load_record", "modal_damping", "reference_stiffness", "shear_building", "synthetic_record", "chirp_record",
+    "J_NAMES", "critical_delay", "evaluate", "matlab_round", "psi", "reference_response", "core",
+    "OpenSeesSubstructure", "spring_model",
+]

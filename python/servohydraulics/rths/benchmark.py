@@ -26,7 +26,7 @@ STROKE_LIMIT = 7e-3   #: paper limit (not checked by the code) [m]
 VELOCITY_LIMIT = 0.3  #: paper limit (not checked by the code) [m/s]
 
 
-def nominal_plant(csi_derivative_block: bool = False) -> "R.BenchmarkPlantParameters":
+def nominal_plant(csi_derivative_block: bool = False) -> R.BenchmarkPlantParameters:
     """The code values of F1_input_file.m (the C++ defaults).  ``csi_derivative_block``: the CSI
     term as the code's Simulink Derivative block instead of the exact a2 x' (BENCHMARK.md 2.1:
     optional; docs/rths-benchmark.md, "The J5 gap")."""
@@ -41,13 +41,15 @@ def trial_seed(seed: int, *parts: Any) -> int:
     return int.from_bytes(h[:8], "little")
 
 
-def perturbed_plant(seed: int, case: int, trial: int, csi_derivative_block: bool = False) -> "R.BenchmarkPlantParameters":
+def perturbed_plant(seed: int, case: int, trial: int,
+                    csi_derivative_block: bool = False) -> R.BenchmarkPlantParameters:
     """Trial ``trial`` >= 1 of the perturbed plants of one case: ke, beta1, beta2,
     a3 drawn from the official distributions (F1 L67, L119-121), untruncated."""
-    return R.BenchmarkPlantUncertainty().draw(nominal_plant(csi_derivative_block), trial_seed(seed, "plant", case, trial))
+    return R.BenchmarkPlantUncertainty().draw(nominal_plant(csi_derivative_block),
+                                              trial_seed(seed, "plant", case, trial))
 
 
-def partition(case: BenchmarkCase, specimen) -> "R.LinearSubstructureModel":
+def partition(case: BenchmarkCase, specimen) -> R.LinearSubstructureModel:
     """Mn = Mr - Me, Cn = Cr - Ce, Kn = Kr - Ke at the first floor; the ground load
     is the whole Mr iota; the interface is the first floor (BENCHMARK.md 5.1)."""
     n = case.n
@@ -226,7 +228,7 @@ class Trial:
         return self.ok and math.isfinite(self.J[1]) and self.J[1] < STABLE_J2_PCT
 
 
-def _ground_motion(record: Record, scale: float) -> "R.GroundMotion":
+def _ground_motion(record: Record, scale: float) -> R.GroundMotion:
     return R.GroundMotion(record.time, record.acceleration, scale)
 
 
@@ -235,7 +237,7 @@ NOISE_GENERATORS = ("simulink", "mersenne")
 STABLE_J2_PCT = 100.0
 
 
-def noise_generator(noise: str) -> "R.NoiseGenerator":
+def noise_generator(noise: str) -> R.NoiseGenerator:
     """The core's generator for a ``noise`` name (``simulink`` or ``mersenne``)."""
     if noise == "simulink":
         return R.NoiseGenerator.SimulinkRandomNumber

@@ -25,7 +25,8 @@ behind); only the predictive compensators read them.
 from __future__ import annotations
 
 import math
-from typing import Any, Callable, Sequence
+from collections.abc import Sequence
+from typing import Any, Callable
 
 import numpy as np
 
@@ -41,7 +42,8 @@ def _opensees():
     try:
         import openseespy.opensees as ops
     except ImportError as e:  # pragma: no cover - openseespy is a dependency of the venv
-        raise ImportError("OpenSeesSubstructure needs the PyPI package openseespy (pip install servohydraulics[opensees])") from e
+        raise ImportError("OpenSeesSubstructure needs the PyPI package openseespy "
+                          "(pip install servohydraulics[opensees])") from e
     return ops
 
 

@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -141,7 +142,7 @@ def j_table(results: dict[str, Any]) -> str:
     return head + "\n".join(rows) + "\n"
 
 
-def _plots(run: dict[str, Any], out: Path, files_out: "FileSet") -> list[str]:
+def _plots(run: dict[str, Any], out: Path, files_out: FileSet) -> list[str]:
     from matplotlib.figure import Figure
     files = []
     trials = run["trials"]
