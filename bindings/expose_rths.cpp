@@ -307,6 +307,10 @@ void expose_rths(py::module_& m) {
          py::arg("measured_pressure") = 0.0,
          "The command from the desired value (displacement [m] in RPsD/RTHS, force [N] in EFT), its velocity and "
          "acceleration, and the measured displacement [m], force [N], velocity [m/s] and pressure [Pa].")
+      .def("raise_stored_error", [](const TrackingController& c, double dt) { bindings::raise_controller_error(c, dt); },
+           py::arg("dt"),
+           "After a loop ran this controller (GIL held): re-raise what a Python controller raised in it, naming the "
+           "sample and its time (dt [s]); nothing for a C++ controller or a clean run.")
       .def("command", [](TrackingController& c, const TrackingInput& in) {
         bindings::require_idle(&c, "TrackingController.command");
         const double u = c.command(in);

@@ -212,8 +212,9 @@ def run_eft(rig: Rig, ground_acceleration: ArrayLike | None = None, effective_fo
     m = rig.m if cfg.mass is None else cfg.mass
     ag = (_array("ground_acceleration", ground_acceleration) if effective_force is None
           else -_array("effective_force", effective_force) / m)
-    test = _core.EffectiveForceTest(rig, cfg, model, _converters(converters), _tracking(tracking))
-    d, s = test.run(ag)
+    tr = _tracking(tracking)
+    test = _core.EffectiveForceTest(rig, cfg, model, _converters(converters), tr)
+    d, s = _run_with(tr, cfg.dt, lambda: test.run(ag))
     return finish(Response(d, kind="eft", mode="force", dt=cfg.dt, rig=rig, work=s), raise_on_failure)
 
 
@@ -264,10 +265,28 @@ def _substructure(sub):
 
 
 def _tracking(t):
-    if t is not None and not isinstance(t, _core.rths.TrackingController):
-        raise ValueError(f"invalid tracking = {t!r}: expected a TrackingController "
-                         "(e.g. _core.rths.AdaptiveTimeSeries)")
-    return t
+    """The loop's tracking controller: None (the paper's), a TrackingController (C++ or a Python
+    subclass) or any object with reset() and command(...) (wrapped, docs/rths-benchmark.md)."""
+    if t is None or isinstance(t, _core.rths.TrackingController):
+        return t
+    if callable(getattr(t, "reset", None)) and callable(getattr(t, "command", None)):
+        return _core.rths.PythonController(t)
+    raise ValueError(f"invalid tracking = {t!r}: expected a TrackingController (e.g. _core.rths.AdaptiveTimeSeries) "
+                     "or an object with reset() and command(...)")
+
+
+def _run_with(tracking, dt: float, run):
+    """run(), then what a Python tracking controller raised during it (RuntimeError naming the
+    sample and its time, from the controller's own exception) before any failure it caused."""
+    try:
+        out = run()
+    except Exception:
+        if tracking is not None:
+            tracking.raise_stored_error(dt)
+        raise
+    if tracking is not None:
+        tracking.raise_stored_error(dt)
+    return out
 
 
 def rpsd_config(dt: float | None = None, m_m: float | None = None, c_m: float | None = None,
@@ -367,8 +386,9 @@ def run_rpsd(rig: Rig, ground_acceleration: ArrayLike | None = None, external_fo
                       physical_mass_fraction, force_measurement, subtract_mass, subtract_damping, compute_delay,
                       opts or _solver_options())
     sub = _substructure(substructure)
-    test = _core.RealTimePseudoDynamicTest(rig, cfg, _converters(converters), _tracking(tracking), sub)
-    d, s = test.run(ag, pe, fe)
+    tr = _tracking(tracking)
+    test = _core.RealTimePseudoDynamicTest(rig, cfg, _converters(converters), tr, sub)
+    d, s = _run_with(tr, cfg.dt, lambda: test.run(ag, pe, fe))
     if isinstance(sub, _core.rths.PythonSubstructure) and sub.error:
         raise RuntimeError(f"numerical substructure failed: {sub.error}")
     phys = _core.RealTimePseudoDynamicTest.physical_rig(rig, cfg)
