@@ -11,6 +11,7 @@
 #include <pybind11/stl.h>
 
 #include "busy.hpp"
+#include "channels_py.hpp"
 #include "tracking_trampoline.hpp"
 #include "servohydraulics/rths/loop.hpp"
 
@@ -106,30 +107,25 @@ py::dict run_loop(RthsLoop& loop, const NumericalSubstructure& num, const Ground
     throw Error("invalid numerical: expected the loop's own numerical substructure (the one it was built with)");
   const auto nd = static_cast<py::ssize_t>(num.dof_count());
   const auto N = static_cast<py::ssize_t>(n);
-  Arr measured(N), displacement(N), force(N), command(N), fin(N), numerical({N, nd}), steps(timing ? N : 0);
-  RthsRecord rec{measured.mutable_data(), displacement.mutable_data(), force.mutable_data(), command.mutable_data(),
-                 fin.mutable_data(), numerical.mutable_data(), timing ? steps.mutable_data() : nullptr};
+  std::vector<RthsOutput> rows(n);
+  Arr numerical({N, nd}), steps(timing ? N : 0);
   RthsSummary s;
   {
     bindings::BusyGuard busy({&loop, &loop.experimental(), &loop.numerical(), &loop.controller(), &ag},
                              "RthsLoop.run");
     py::gil_scoped_release release;
     loop.reset();
-    s = loop.run(ag, n, rec);
+    s = loop.run(ag, n, rows.data(), numerical.mutable_data(), timing ? steps.mutable_data() : nullptr);
   }
   bindings::raise_controller_error(loop.controller(), loop.config().dt);
   if (const auto* p = dynamic_cast<const PythonSubstructure*>(&num); p && !p->error().empty())
     throw std::runtime_error("numerical substructure failed at t = " + std::to_string(s.failure_time) +
                              " s: " + p->error());
-  const auto rows = static_cast<py::ssize_t>(s.rows);
+  const auto m = static_cast<py::ssize_t>(s.rows);
   py::dict out;
-  out["measured"] = measured[py::slice(0, rows, 1)];
-  out["displacement"] = displacement[py::slice(0, rows, 1)];
-  out["actuator_force"] = force[py::slice(0, rows, 1)];
-  out["command"] = command[py::slice(0, rows, 1)];
-  out["feedback_force"] = fin[py::slice(0, rows, 1)];
-  out["numerical"] = numerical[py::slice(0, rows, 1)];
-  if (timing) out["step_seconds"] = steps[py::slice(0, rows, 1)];
+  sh_py::rows_to_dict(out, kRthsChannels, rows, s.rows);
+  out["numerical"] = numerical[py::slice(0, m, 1)];
+  if (timing) out["step_seconds"] = steps[py::slice(0, m, 1)];
   out["rows"] = s.rows;
   out["ok"] = s.ok;
   out["failure_time"] = s.failure_time;
@@ -381,6 +377,7 @@ void expose_rths(py::module_& m) {
       .def_readwrite("seed", &RthsLoopConfig::seed)
       .def_readwrite("generator", &RthsLoopConfig::generator)
       .def("validate", &RthsLoopConfig::validate);
+  r.attr("RTHS_CHANNELS") = sh_py::channel_units(kRthsChannels);
   py::class_<RthsLoop>(r, "RthsLoop")
       .def(py::init<ExperimentalSubstructure&, NumericalSubstructure&, TrackingController&, const RthsLoopConfig&>(),
            py::arg("experimental"), py::arg("numerical"), py::arg("controller"), py::arg("config") = RthsLoopConfig{},
@@ -390,5 +387,6 @@ void expose_rths(py::module_& m) {
              return run_loop(loop, num, ag, n, timing);
            },
            py::arg("numerical"), py::arg("ground_motion"), py::arg("n"), py::arg("timing") = false,
-           "Reset, then run n samples; numerical: the loop's numerical substructure (for the row width).");
+           "Reset, then run n samples; numerical: the loop's numerical substructure (for the row width). Returns a dict: "
+           "one column per RTHS_CHANNELS entry, numerical (rows x dofs), step_seconds (if timing) and the summary.");
 }

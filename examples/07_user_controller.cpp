@@ -57,7 +57,8 @@ rths::LinearSubstructureModel partitioned_building(const rths::SpecimenModel& sp
 }
 
 struct Run {
-  std::vector<double> command, displacement, step_seconds;
+  std::vector<rths::RthsOutput> rows;  //!< one per sample, channels as rths::kRthsChannels
+  std::vector<double> step_seconds;
   rths::RthsSummary summary;
 };
 
@@ -74,15 +75,10 @@ Run run(rths::TrackingController& controller, double seconds) {
   const rths::GroundMotion ag(t, a);
   const auto n = static_cast<std::size_t>(seconds / dt);
   Run out;
-  out.command.resize(n);
-  out.displacement.resize(n);
+  out.rows.resize(n);
   out.step_seconds.resize(n);
-  rths::RthsRecord record;
-  record.command = out.command.data();
-  record.displacement = out.displacement.data();
-  record.step_seconds = out.step_seconds.data();
   loop.reset();
-  out.summary = loop.run(ag, n, record);
+  out.summary = loop.run(ag, n, out.rows.data(), nullptr, out.step_seconds.data());
   return out;
 }
 
@@ -103,15 +99,15 @@ int main(int argc, char** argv) {
   PiLead mine;
   const Run b = run(builtin, seconds), p = run(mine, seconds);
   double diff = 0.0, peak = 0.0, steady = 0.0;
-  const std::size_t last = b.command.size() - std::min(b.command.size(), static_cast<std::size_t>(2 * 4096));
-  for (std::size_t k = 0; k < b.command.size(); ++k) {
-    diff = std::max(diff, std::fabs(b.command[k] - p.command[k]));
-    peak = std::max(peak, std::fabs(b.command[k]));
-    if (k >= last) steady = std::max(steady, std::fabs(b.displacement[k]));  // the last 2 s
+  const std::size_t last = b.rows.size() - std::min(b.rows.size(), static_cast<std::size_t>(2 * 4096));
+  for (std::size_t k = 0; k < b.rows.size(); ++k) {
+    diff = std::max(diff, std::fabs(b.rows[k].command - p.rows[k].command));
+    peak = std::max(peak, std::fabs(b.rows[k].command));
+    if (k >= last) steady = std::max(steady, std::fabs(b.rows[k].displacement));  // the last 2 s
   }
   std::printf("samples=%zu\nok=%d\npeak_command_mm=%.6f\nsteady_peak_displacement_mm=%.6f\n"
               "max_command_difference_m=%.3e\n",
-              b.command.size(), b.summary.ok && p.summary.ok ? 1 : 0, 1e3 * peak, 1e3 * steady, diff);
+              b.rows.size(), b.summary.ok && p.summary.ok ? 1 : 0, 1e3 * peak, 1e3 * steady, diff);
   std::printf("builtin_step_us_median=%.3f\nbuiltin_step_us_p99=%.3f\n", percentile_us(b.step_seconds, 0.5),
               percentile_us(b.step_seconds, 0.99));
   std::printf("pilead_step_us_median=%.3f\npilead_step_us_p99=%.3f\n", percentile_us(p.step_seconds, 0.5),

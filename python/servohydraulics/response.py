@@ -34,7 +34,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from .rig import Rig
 
-KINDS = ("plant", "eft", "rpsd", "tracking", "record")
+KINDS = ("plant", "eft", "rpsd", "tracking", "record", "rths")
 
 #: Columns a record file must have (the diagnosis needs them).
 REQUIRED = ("time", "command", "displacement", "force")
@@ -62,10 +62,14 @@ def channel_units(kind: str = "record", mode: str | None = None) -> dict[str, st
     ``"plant"``/``"tracking"``: the plant's channels, the held command (unit
     from ``mode``) and the per-row counts.  ``"eft"``/``"rpsd"``: the plant's
     channels, the flags and the method's channels.  ``"record"``: the union of
-    all of them (what a record file may hold).
+    all of them (what a record file may hold).  ``"rths"``: the RTHS loop's
+    channels (``_core.rths.RTHS_CHANNELS``) and its optional ``step_seconds``
+    (the per-DOF channels of a trial carry their units with them: ``rths.Trial``).
     """
     if kind not in KINDS:
         raise ValueError(f"invalid kind = {kind!r}: expected one of {list(KINDS)}")
+    if kind == "rths":
+        return {**dict(map(tuple, _core.rths.RTHS_CHANNELS)), "step_seconds": "s"}
     plant, eft, rpsd = _core_tables()
     out = dict(plant)
     if kind in ("plant", "tracking", "record"):
@@ -198,7 +202,8 @@ class Response:
         channels: read-only mapping name -> array (also attributes:
             ``res.displacement``); it includes ``time``.
         units: name -> SI unit of each channel.
-        kind: ``"plant"`` (simulate), ``"eft"``, ``"rpsd"``, ``"tracking"`` or ``"record"``.
+        kind: ``"plant"`` (simulate), ``"eft"``, ``"rpsd"``, ``"tracking"``, ``"record"`` or
+            ``"rths"`` (``rths.run_trial``: the RTHS benchmark loop).
         mode: control mode (``"displacement"``, ``"force"``, ``"free"``), None if unknown.
         dt: controller sample time [s].
         rig: the rig the run used (RPsD: the physical rig), None for a record.
@@ -285,7 +290,9 @@ class Response:
 
     def _warning_list(self, rig: Rig | None) -> list[str]:
         rig = self.rig if rig is None else rig
-        peak = self.work.peak_force if self.work is not None else float(np.max(np.abs(self.force), initial=0.0))
+        peak = getattr(self.work, "peak_force", None)
+        if peak is None:
+            peak = float(np.max(np.abs(self.channels.get("force", np.zeros(0))), initial=0.0))
         out = limit_warnings(self.flags, self.time, peak, rig)
         out += solver_warnings(self.work)
         if not self.success:
@@ -323,7 +330,8 @@ class Response:
         return path
 
 
-_LABELS = {"plant": "simulation", "eft": "EFT", "rpsd": "RPsD", "tracking": "tracking", "record": "record"}
+_LABELS = {"plant": "simulation", "eft": "EFT", "rpsd": "RPsD", "tracking": "tracking", "record": "record",
+           "rths": "RTHS"}
 
 
 def _failure_message(kind: str, status: SimpleNamespace) -> str:

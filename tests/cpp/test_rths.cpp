@@ -247,8 +247,8 @@ void no_allocation() {
   LinearSubstructure num(three_storey(), kH);
   RthsLoop loop(plant, num, sample);
   const std::size_t n = 8192;
-  std::vector<double> xm(n), x(n), f(n), u(n), fin(n), nd(3 * n);
-  const RthsRecord rec{xm.data(), x.data(), f.data(), u.data(), fin.data(), nd.data(), nullptr};
+  std::vector<RthsOutput> rec(n);
+  std::vector<double> nd(3 * n);
   LoopConverters lc;
   lc.force.noise.sigma = 5.0;
   lc.displacement.converter = benchmark_converter(Converter::Kind::AnalogToDigital);
@@ -282,7 +282,7 @@ void no_allocation() {
     }
     counts[1] = counter.count();
     counter.restart();
-    sum = loop.run(gm, n, rec);
+    sum = loop.run(gm, n, rec.data(), nd.data());
     counts[2] = counter.count();
     counter.restart();
     rs = run_rpsd(rpsd, ag.data(), nullptr, nullptr, ag.size(), rows.data());

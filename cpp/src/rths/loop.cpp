@@ -36,14 +36,15 @@ void RthsLoop::reset() noexcept {
   delay_.reset();
 }
 
-RthsSummary RthsLoop::run(const GroundMotion& ag, std::size_t n, const RthsRecord& rec) noexcept {
+RthsSummary RthsLoop::run(const GroundMotion& ag, std::size_t n, RthsOutput* rows, double* numerical,
+                          double* step_seconds) noexcept {
   using clock = std::chrono::steady_clock;
   RthsSummary sum;
   const double h = cfg_.dt;
   const SpecimenModel sp = exp_.specimen();
   const Eigen::Index nd = num_.dof_count(), dof = num_.interface_dof();
   for (std::size_t k = 0; k < n; ++k) {
-    const auto t0 = rec.step_seconds ? clock::now() : clock::time_point{};
+    const auto t0 = step_seconds ? clock::now() : clock::time_point{};
     const double t = static_cast<double>(k) * h;
     const double x = exp_.displacement(), y1 = num_.dof_displacement(dof);
     const double w = wx_.next();
@@ -57,20 +58,16 @@ RthsSummary RthsLoop::run(const GroundMotion& ag, std::size_t n, const RthsRecor
     in.measured_velocity = v;  // the backward difference of the specimen displacement
     const double u = ctrl_.command(in);
     const double f = exp_.actuator_force();
-    if (rec.measured) rec.measured[k] = xm;
-    if (rec.displacement) rec.displacement[k] = x;
-    if (rec.actuator_force) rec.actuator_force[k] = f;
-    if (rec.command) rec.command[k] = u;
-    if (rec.feedback_force) rec.feedback_force[k] = fin;
-    if (rec.numerical)
-      for (Eigen::Index i = 0; i < nd; ++i) rec.numerical[k * nd + i] = num_.dof_displacement(i);
+    if (rows) rows[k] = RthsOutput{t, ag0, xm, x, f, u, fin};
+    if (numerical)
+      for (Eigen::Index i = 0; i < nd; ++i) numerical[k * nd + i] = num_.dof_displacement(i);
     sum.rows = k + 1;
     sum.peak_actuator_force = std::fmax(sum.peak_actuator_force, std::fabs(f));
     sum.peak_displacement = std::fmax(sum.peak_displacement, std::fabs(x));
     sum.peak_velocity = std::fmax(sum.peak_velocity, std::fabs(exp_.velocity()));
     const Status st = exp_.step(u);
     num_.step(ag0, ag(t + 0.5 * h), ag(t + h), fin);
-    if (rec.step_seconds) rec.step_seconds[k] = std::chrono::duration<double>(clock::now() - t0).count();
+    if (step_seconds) step_seconds[k] = std::chrono::duration<double>(clock::now() - t0).count();
     if (!st.ok() || !std::isfinite(xm) || !std::isfinite(u) || !num_.healthy()) {
       sum.ok = false;
       sum.failure_time = t;

@@ -6,20 +6,22 @@ from __future__ import annotations
 import hashlib
 import math
 import time
-from dataclasses import dataclass, field
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
 from typing import Any, Callable
 
 import numpy as np
 
 from .. import _core
+from ..response import Response, Work
 from .data import DT, EQ_INTENSITY, BenchmarkCase, Record
 from .evaluation import J_NAMES, criteria, evaluate, psi, reference_response
 
 R = _core.rths
 
 __all__ = ["CONTROLLERS", "make_controller", "load_controller", "as_controller", "controller_label",
-           "nominal_plant", "perturbed_plant", "partition", "Trial", "run_trial", "run_case", "trial_seed",
-           "FORCE_LIMIT", "NOISE_GENERATORS", "noise_generator", "polynomial_controller"]
+           "nominal_plant", "perturbed_plant", "partition", "Trial", "TrialSignals", "run_trial", "run_case",
+           "trial_seed", "FORCE_LIMIT", "NOISE_GENERATORS", "noise_generator", "polynomial_controller"]
 
 FORCE_LIMIT = 8900.0  #: the benchmark's actuator capacity check on max|f| [N] (F4_evaluation.m L60-62)
 STROKE_LIMIT = 7e-3   #: paper limit (not checked by the code) [m]
@@ -190,9 +192,42 @@ def controller_label(controller) -> tuple[str, str]:
 
 # ----------------------------------------------------------------------------- one trial
 
+class TrialSignals(Mapping):
+    """A trial's signals, a read-only mapping onto its :class:`Response`'s channels: each
+    channel by name, and the per-DOF channels ``numerical_i`` / ``reference_i`` also
+    stacked as ``numerical`` / ``reference`` (rows x DOFs).  Empty without a response."""
+
+    __slots__ = ("_response", "_stacked")
+
+    def __init__(self, response: Response | None):
+        self._response = response
+        names = list(response.channels) if response is not None else []
+        self._stacked = {p: [n for n in names if n.rpartition("_")[0] == p and n.rpartition("_")[2].isdigit()]
+                         for p in ("numerical", "reference")}
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        cols = self._stacked.get(name)
+        if cols:
+            return np.column_stack([self._response.channels[c] for c in cols])
+        if self._response is None or name not in self._response.channels:
+            raise KeyError(name)
+        return self._response.channels[name]
+
+    def __iter__(self) -> Iterator[str]:
+        if self._response is not None:
+            yield from self._response.channels
+        yield from (p for p, cols in self._stacked.items() if cols)
+
+    def __len__(self) -> int:
+        return sum(1 for _ in self)
+
+
 @dataclass
 class Trial:
-    """One benchmark trial: J1-J9 and the limits (plus the signals if kept)."""
+    """One benchmark trial: J1-J9 and the limits, plus (``keep_signals``) the run's record as
+    ``response``: a :class:`Response` of kind ``"rths"`` whose channels are the loop's
+    (``_core.rths.RTHS_CHANNELS``), ``numerical_i`` and ``reference_i`` per DOF i [m] and
+    ``step_seconds`` [s] (``timing``).  ``signals`` reads the same data (:class:`TrialSignals`)."""
     J: list[float]
     max_force_N: float
     max_displacement_m: float
@@ -200,7 +235,12 @@ class Trial:
     ok: bool
     failure_time: float
     wall_time: float
-    signals: dict[str, np.ndarray] = field(default_factory=dict)
+    response: Response | None = None
+
+    @property
+    def signals(self) -> TrialSignals:
+        """The response's channels by name, ``numerical`` and ``reference`` as (rows x DOFs)."""
+        return TrialSignals(self.response)
 
     @property
     def criteria(self) -> dict[str, float]:
@@ -295,11 +335,26 @@ def run_trial(case: BenchmarkCase, record: Record, controller: Any = "sample", p
     trial = Trial(J, float(out["peak_actuator_force"]), float(out["peak_displacement"]),
                   float(out["peak_velocity"]), bool(out["ok"]), float(out["failure_time"]), wall)
     if keep_signals:
-        trial.signals = {k: out[k] for k in ("measured", "displacement", "actuator_force", "command", "numerical",
-                                              "feedback_force") + (("step_seconds",) if timing else ())}
-        trial.signals["reference"] = reference
-        trial.signals["time"] = np.arange(out["rows"]) * DT
+        trial.response = _response(out, reference)
     return trial
+
+
+def _response(out: dict[str, Any], reference: np.ndarray) -> Response:
+    """The loop's output (RthsLoop.run) and the reference (up to the rows run) as a Response."""
+    rows = int(out["rows"])
+    names = [n for n, _ in R.RTHS_CHANNELS] + (["step_seconds"] if "step_seconds" in out else [])
+    channels = {n: out[n] for n in names}
+    for prefix, data in (("numerical", np.asarray(out["numerical"])), ("reference", np.asarray(reference)[:rows])):
+        channels.update((f"{prefix}_{i}", data[:, i]) for i in range(data.shape[1]))
+    units = {n: "m" for n in channels if n.startswith(("numerical_", "reference_"))}
+    status = Work.from_core(out["status"])  # the experimental substructure's, or non_finite (the loop's own)
+    if not out["ok"]:
+        status.t = float(out["failure_time"])  # the loop's sample time, not the substructure's clock
+    work = Work(rows=rows, ok=bool(out["ok"]), failure_time=float(out["failure_time"]),
+                peak_force=float(out["peak_actuator_force"]), peak_actuator_force=float(out["peak_actuator_force"]),
+                peak_displacement=float(out["peak_displacement"]), peak_velocity=float(out["peak_velocity"]),
+                status=status)
+    return Response(channels, kind="rths", dt=DT, work=work, units=units)
 
 
 def _numerical(numerical, case: BenchmarkCase, exp, scheme: str):

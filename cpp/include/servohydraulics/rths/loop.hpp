@@ -12,12 +12,13 @@
 //   7. experimental substructure: one sample with u_k held; numerical substructure:
 //      one sample with a_g at t_k, t_k + h/2, t_k + h and f_in held.
 // Construction validates (throws Error); run() is noexcept and allocation-free
-// (the caller provides the row buffers).
+// (the caller provides the row buffers: RthsOutput rows described by kRthsChannels).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 
+#include "servohydraulics/channels.hpp"
 #include "servohydraulics/rths/benchmark_plant.hpp"
 #include "servohydraulics/rths/converters.hpp"
 #include "servohydraulics/rths/substructure.hpp"
@@ -35,16 +36,30 @@ struct RthsLoopConfig {
   void validate() const;
 };
 
-//! Row buffers of a run (each n long; numerical is n x dofs, row-major).  Any may be nullptr.
-struct RthsRecord {
-  double* measured = nullptr;        //!< X_m [m]
-  double* displacement = nullptr;    //!< true specimen displacement X_int [m]
-  double* actuator_force = nullptr;  //!< Force_act [N]
-  double* command = nullptr;         //!< y_gc [m]
-  double* feedback_force = nullptr;  //!< f_in into the numerical substructure [N]
-  double* numerical = nullptr;       //!< numerical substructure displacements [m]
-  double* step_seconds = nullptr;    //!< wall time of each sample's computation [s]
+//! Every channel of one RTHS sample (row k: the signals at t_k, before u_k is applied).
+struct RthsOutput {
+  double time = 0.0;                 //!< t_k [s]
+  double ground_acceleration = 0.0;  //!< a_g(t_k), scaled [m/s^2]
+  double measured = 0.0;             //!< X_m [m]
+  double displacement = 0.0;         //!< true specimen displacement X_int [m]
+  double actuator_force = 0.0;       //!< Force_act [N]
+  double command = 0.0;              //!< y_gc [m]
+  double feedback_force = 0.0;       //!< f_in into the numerical substructure [N]
 };
+
+//! The channels of RthsOutput (one table: the bindings' columns and rths.Trial's Response units).
+inline constexpr ChannelInfoOf<RthsOutput> kRthsChannels[] = {
+    {"time", "s", "time of the sample t_k", &RthsOutput::time},
+    {"ground_acceleration", "m/s^2", "ground acceleration a_g(t_k), scaled", &RthsOutput::ground_acceleration},
+    {"measured", "m", "measured specimen displacement X_m (with sensor noise)", &RthsOutput::measured},
+    {"displacement", "m", "true specimen displacement X_int", &RthsOutput::displacement},
+    {"actuator_force", "N", "actuator force Force_act", &RthsOutput::actuator_force},
+    {"command", "m", "the controller's command y_gc", &RthsOutput::command},
+    {"feedback_force", "N", "f_in into the numerical substructure (measured force, one sample late)",
+     &RthsOutput::feedback_force},
+};
+static_assert(sizeof(RthsOutput) == sizeof(kRthsChannels) / sizeof(kRthsChannels[0]) * sizeof(double),
+              "every RthsOutput member is a channel of kRthsChannels");
 
 struct RthsSummary {
   std::size_t rows = 0;      //!< rows written
@@ -62,8 +77,11 @@ class RthsLoop {
   RthsLoop(ExperimentalSubstructure& experimental, NumericalSubstructure& numerical, TrackingController& controller,
            const RthsLoopConfig& config = {});
   void reset() noexcept;
-  //! n samples t_k = k dt, k = 0..n-1, ground acceleration from ag (already scaled).
-  RthsSummary run(const GroundMotion& ag, std::size_t n, const RthsRecord& record) noexcept;
+  //! n samples t_k = k dt, k = 0..n-1, ground acceleration from ag (already scaled).  Each
+  //! buffer may be nullptr: rows (n), numerical (n x dofs, row-major: the numerical
+  //! substructure's displacements [m]), step_seconds (n: each sample's wall time [s]).
+  RthsSummary run(const GroundMotion& ag, std::size_t n, RthsOutput* rows, double* numerical = nullptr,
+                  double* step_seconds = nullptr) noexcept;
 
   const RthsLoopConfig& config() const noexcept { return cfg_; }
   const ExperimentalSubstructure& experimental() const noexcept { return exp_; }
