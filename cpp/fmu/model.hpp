@@ -1,8 +1,9 @@
 // The FMU's model: what one servohydraulics FMU is (its kind, its settings) and
 // its variable table (name, value reference, type, causality, variability,
 // unit, and how to read and write the value), generated from the core's tables
-// (kRigParameters, kEffects, kPlantChannels, kEftChannels, kRpsdChannels), so a
-// new rig key or channel appears in the FMU by itself.
+// (kRigParameters, kEffects, kPlantChannels, kEftChannels, kRpsdChannels,
+// kEftConfigFields, kRpsdConfigFields), so a new rig key, channel or config field
+// appears in the FMU by itself.
 //
 // The table is the one home of the FMU's interface: the fmi2 functions
 // (fmi2_functions.cpp) serve it and the Python exporter writes

@@ -101,6 +101,8 @@ def _optional_nonneg(name: str, v: float | None) -> float | None:
     return None if v is None else _nonneg(name, v)
 
 
+#: the keywords of eft_config / rpsd_config that set a field not of their own name
+FIELD_KEYWORDS = {"plant_options": ("solver_options",), "model": ("m_m", "c_m")}
 #: the config fields a name selects, by field name (the enum name tables above)
 _FIELD_CHOICES = {"compensation": COMPENSATION, "scheme": SCHEMES, "restoring_force": RESTORING_FORCE,
                   "force_measurement": FORCE_MEASUREMENT}

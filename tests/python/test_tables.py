@@ -102,6 +102,7 @@ CONFIGS = {
 }
 #: the Python keywords of a field whose keyword is not its name (the signatures predate the tables)
 KEYWORDS = {"plant_options": ["solver_options"], "model": [n for n, _, _ in _core.MODEL_SDOF_FIELDS]}
+assert {k: list(v) for k, v in loops.FIELD_KEYWORDS.items()} == KEYWORDS
 
 
 def _writable(cls) -> list[str]:
@@ -143,6 +144,10 @@ def test_config_table_is_the_fmus_parameters(kind):
     for x, (name, unit, meaning) in zip(got, expected):
         assert x["causality"] == "parameter" and x["description"] == meaning, name
         assert x["unit"] == unit or x["type"] != "Real", name  # FMI 2 units are on Reals only
+    # export_fmu's settings are the FMU's parameters (the keywords of their fields)
+    from servohydraulics import fmu
+
+    assert sorted(n.split(".", 1)[1] for n, _, _ in expected) == sorted(fmu.settings(kind))
     # the skipped fields: dt is the FMU's own parameter; the plant's are not a controller's
     assert "dt" in {x["name"] for x in _core.fmu_variables(kind, "displacement", sh.zhao2003(), 5e-4, 0.0,
                                                            _core.SolverOptions(), _core.EftConfig(),
