@@ -252,10 +252,9 @@ def export_fmu(rig: Rig, path: str | os.PathLike, kind: str = "plant", mode: str
         solver_options: the plant's ODE integrator (``sh.solver_options(...)``).
         name: the FMU's modelIdentifier (default ``servohydraulics_<kind>``; a C identifier of at
             most ``MAX_NAME`` characters).
-        **config: the controller's settings, as ``run_eft`` / ``run_rpsd`` take them
-            (EFT: compensation, lead_T, alpha, mass, compute_delay; RPsD: m_m, c_m,
-            k_m, scheme, restoring_force, amplitude_T, delay_T, alpha,
-            force_measurement, subtract_mass, subtract_damping, compute_delay).
+        **config: the controller's settings, as ``run_eft`` / ``run_rpsd`` take them:
+            ``settings(kind)``, the keywords of the config table's fields that are FMU
+            parameters (``_core.EFT_CONFIG_FIELDS`` / ``RPSD_CONFIG_FIELDS``, docs/fmu.md).
 
     Returns:
         The path written.  Raises ValueError naming a bad argument, FileNotFoundError
