@@ -112,10 +112,9 @@ void expose_loops(py::module_& m) {
   py::class_<ModelSDOF> model(m, "ModelSDOF", "Modelled SDOF system of Eq (15): m_m [kg], c_m [N s/m]");
   model.def(py::init<>())
       .def(py::init([](double m_m, double c_m) { return ModelSDOF{m_m, c_m}; }), py::arg("m_m"), py::arg("c_m"))
-      .def_readwrite("m_m", &ModelSDOF::m_m)
-      .def_readwrite("c_m", &ModelSDOF::c_m)
       .def("validate", &ModelSDOF::validate);
-  add_protocol(model, {"m_m", "c_m"});
+  add_protocol(model, def_fields(model, kModelSdofFields));
+  m.attr("MODEL_SDOF_FIELDS") = field_table(kModelSdofFields);
   py::class_<IntegratorState>(m, "IntegratorState")
       .def_readonly("displacement", &IntegratorState::displacement)
       .def_readonly("velocity", &IntegratorState::velocity)

@@ -4,6 +4,8 @@
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <string_view>
+#include <tuple>
 #include <type_traits>
 #include <variant>
 
@@ -257,53 +259,69 @@ void add_plant(std::vector<Variable>& out, ControlMode mode) {
   add_solver(out);
 }
 
+//! A config field of an enum type as an Enumeration parameter: the enum's name table, its FMU type name.
+template <class E>
+Variable enum_parameter(std::string name, std::string doc, std::function<E&(Values&)> ref) {
+  if constexpr (std::is_same_v<E, VelocityFeedbackCompensator::Kind>) {
+    return enumeration<E>(std::move(name), "Compensation", kCompensationNames, std::move(doc), ref);
+  } else if constexpr (std::is_same_v<E, StructuralScheme>) {
+    // Eq (15)'s schemes only: the RPsD controller's one-degree-of-freedom integrator
+    return enumeration<E>(std::move(name), "IntegrationScheme", kSchemeNames, std::move(doc), ref, kEq15Schemes);
+  } else if constexpr (std::is_same_v<E, RestoringForce>) {
+    return enumeration<E>(std::move(name), "RestoringForce", kRestoringForceNames, std::move(doc), ref);
+  } else if constexpr (std::is_same_v<E, ForceMeasurement>) {
+    return enumeration<E>(std::move(name), "ForceMeasurement", kForceMeasurementNames, std::move(doc), ref);
+  } else {
+    static_assert(!std::is_same_v<E, E>, "a config field of an enum the FMU generator has no name table for");
+  }
+}
+
+bool not_in_fmu(const char* field) noexcept {
+  for (const SkippedConfigField& s : kConfigFieldsNotInFmu)
+    if (std::string_view(s.name) == field) return true;
+  return false;
+}
+
+//! One row of a config's field table (config_fields.hpp) as the parameter "<prefix><name>" (its unit
+//! and meaning), read and written through `path` (the config inside Values); a nested struct's
+//! fields are flattened under the same prefix (rpsd.model.m_m is "rpsd.m_m").
+template <class Config, class T, class Path>
+void add_field(std::vector<Variable>& out, const std::string& prefix, const ConfigField<Config, T>& f, Path path) {
+  if (not_in_fmu(f.name)) return;  // kConfigFieldsNotInFmu says why
+  const auto member = f.member;
+  auto ref = [path, member](Values& v) -> T& { return path(v).*member; };
+  std::string name = prefix + f.name;
+  if constexpr (std::is_same_v<T, double>) {
+    out.push_back(parameter(std::move(name), f.unit, f.meaning, ref));
+  } else if constexpr (std::is_same_v<T, std::optional<double>>) {
+    out.push_back(resolved(std::move(name), f.unit, f.meaning, ref));  // "none = from the rig": resolve_defaults
+  } else if constexpr (std::is_same_v<T, int>) {
+    out.push_back(integer<int>(std::move(name), f.meaning, ref));
+  } else if constexpr (std::is_enum_v<T>) {
+    out.push_back(enum_parameter<T>(std::move(name), f.meaning, ref));
+  } else if constexpr (std::is_same_v<T, ModelSDOF>) {
+    std::apply([&](const auto&... g) { (add_field(out, prefix, g, ref), ...); }, kModelSdofFields);
+  } else if constexpr (std::is_same_v<T, SolverOptions>) {
+    // A solver is the plant's: a plant FMU has its own solver.* parameters (add_solver).
+    throw Error("config field " + name + " (SolverOptions) is not an FMU parameter: list it in kConfigFieldsNotInFmu");
+  } else {
+    static_assert(!std::is_same_v<T, T>, "a config field of a type the FMU generator has no rule for");
+  }
+}
+
+//! Every field of a config's table (kEftConfigFields, kRpsdConfigFields) but kConfigFieldsNotInFmu.
+template <class Table, class Path>
+void add_config(std::vector<Variable>& out, const std::string& prefix, const Table& table, Path path) {
+  std::apply([&](const auto&... f) { (add_field(out, prefix, f, path), ...); }, table);
+}
+
 void add_eft(std::vector<Variable>& out) {
   out.push_back(real("ground_acceleration", "m/s^2", "ground acceleration a_g(t_k)", Causality::Input,
                      Variability::Continuous, [](Values& v) -> double& { return v.ground_acceleration; }));
   add_sensors(out);
   add_outputs(out, kEftChannels, &Values::eft_out);
   add_dt(out);
-  out.push_back(resolved("eft.mass", "kg", "m in P_eff = -m a_g",
-                         [](Values& v) -> std::optional<double>& { return v.settings.eft.mass; }));
-  out.push_back(enumeration<VelocityFeedbackCompensator::Kind>(
-      "eft.compensation", "Compensation", kCompensationNames, "velocity feedback compensation",
-      [](Values& v) -> VelocityFeedbackCompensator::Kind& { return v.settings.eft.compensation; }));
-  out.push_back(parameter("eft.lead_T", "s", "phase lead on the compensation (0 = none)",
-                          [](Values& v) -> double& { return v.settings.eft.lead_T; }));
-  out.push_back(parameter("eft.alpha", "", "phase-lead constant",
-                          [](Values& v) -> double& { return v.settings.eft.alpha; }));
-  out.push_back(integer<int>("eft.compute_delay", "samples of compute delay on the command",
-                             [](Values& v) -> int& { return v.settings.eft.compute_delay; }));
-}
-
-void add_rpsd_config(std::vector<Variable>& out) {
-  using Opt = std::optional<double>;
-  out.push_back(parameter("rpsd.m_m", "kg", "modelled mass of Eq (15)",
-                          [](Values& v) -> double& { return v.settings.rpsd.model.m_m; }));
-  out.push_back(parameter("rpsd.c_m", "N s/m", "modelled damping of Eq (15)",
-                          [](Values& v) -> double& { return v.settings.rpsd.model.c_m; }));
-  out.push_back(resolved("rpsd.k_m", "N/m", "stiffness of the displacement-based restoring forces",
-                         [](Values& v) -> Opt& { return v.settings.rpsd.k_m; }));
-  out.push_back(enumeration<IntegrationScheme>(
-      "rpsd.scheme", "IntegrationScheme", kSchemeNames, "integration scheme of Eq (15)",
-      [](Values& v) -> IntegrationScheme& { return v.settings.rpsd.scheme; }, kEq15Schemes));
-  out.push_back(enumeration<RestoringForce>(
-      "rpsd.restoring_force", "RestoringForce", kRestoringForceNames, "restoring force option (a)-(d)", [](Values& v) -> RestoringForce& { return v.settings.rpsd.restoring_force; }));
-  out.push_back(enumeration<ForceMeasurement>(
-      "rpsd.force_measurement", "ForceMeasurement", kForceMeasurementNames, "measured force: load cell or p A",
-      [](Values& v) -> ForceMeasurement& { return v.settings.rpsd.force_measurement; }));
-  out.push_back(parameter("rpsd.amplitude_T", "s", "amplitude compensation T_d on the command (0 = none)",
-                          [](Values& v) -> double& { return v.settings.rpsd.amplitude_T; }));
-  out.push_back(parameter("rpsd.delay_T", "s", "delay compensation T_ld on the restoring force (0 = none)",
-                          [](Values& v) -> double& { return v.settings.rpsd.delay_T; }));
-  out.push_back(parameter("rpsd.alpha", "", "phase-lead constant of both networks",
-                          [](Values& v) -> double& { return v.settings.rpsd.alpha; }));
-  out.push_back(resolved("rpsd.subtract_mass", "kg", "option (d): mass times measured acceleration removed",
-                         [](Values& v) -> Opt& { return v.settings.rpsd.subtract_mass; }));
-  out.push_back(resolved("rpsd.subtract_damping", "N s/m", "option (d): damping times measured velocity removed",
-                         [](Values& v) -> Opt& { return v.settings.rpsd.subtract_damping; }));
-  out.push_back(integer<int>("rpsd.compute_delay", "samples of compute delay on the command",
-                             [](Values& v) -> int& { return v.settings.rpsd.compute_delay; }));
+  add_config(out, "eft.", kEftConfigFields, [](Values& v) -> EftConfig& { return v.settings.eft; });
 }
 
 void add_rpsd(std::vector<Variable>& out) {
@@ -316,7 +334,7 @@ void add_rpsd(std::vector<Variable>& out) {
   add_sensors(out);
   add_outputs(out, kRpsdChannels, &Values::rpsd_out);
   add_dt(out);
-  add_rpsd_config(out);
+  add_config(out, "rpsd.", kRpsdConfigFields, [](Values& v) -> RpsdConfig& { return v.settings.rpsd; });
 }
 
 }  // namespace

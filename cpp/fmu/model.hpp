@@ -1,8 +1,9 @@
 // The FMU's model: what one servohydraulics FMU is (its kind, its settings) and
 // its variable table (name, value reference, type, causality, variability,
 // unit, and how to read and write the value), generated from the core's tables
-// (kRigParameters, kEffects, kPlantChannels, kEftChannels, kRpsdChannels), so a
-// new rig key or channel appears in the FMU by itself.
+// (kRigParameters, kEffects, kPlantChannels, kEftChannels, kRpsdChannels,
+// kEftConfigFields, kRpsdConfigFields), so a new rig key, channel or config field
+// appears in the FMU by itself.
 //
 // The table is the one home of the FMU's interface: the fmi2 functions
 // (fmi2_functions.cpp) serve it and the Python exporter writes
@@ -58,6 +59,20 @@ void check_dt(double dt);
 //! Fills the configs' "none = from the rig" fields with the values the core
 //! would use (validates, dt too; throws Error), and copies dt into the configs.
 void resolve_defaults(Settings& s);
+
+//! The fields of the controllers' config tables (kEftConfigFields, kRpsdConfigFields) that are
+//! not FMU parameters, and why.  Every other field is the parameter "eft.<name>" or
+//! "rpsd.<name>" (a nested struct's fields flattened: "rpsd.m_m"), with the table's unit and
+//! meaning, in table order; a field of a type the generator has no rule for does not compile.
+struct SkippedConfigField {
+  const char* name;
+  const char* reason;
+};
+inline constexpr SkippedConfigField kConfigFieldsNotInFmu[] = {
+    {"dt", "the FMU's own parameter dt (doStep sizes are whole multiples of it), copied into the config"},
+    {"plant_options", "the simulated plant's ODE integrator: a controller FMU has no plant (a plant FMU: solver.*)"},
+    {"physical_mass_fraction", "the simulated loop's plant mass: a controller FMU has no plant"},
+};
 
 //! The values a variable reads and writes: settings, inputs, outputs.
 struct Values {

@@ -20,7 +20,7 @@ examples/02_rpsd_controller.py wires it the way a laboratory would.
 from __future__ import annotations
 
 from . import _core
-from .loops import eft_config, rpsd_config
+from .loops import _document_fields, eft_config, rpsd_config
 from .rig import Rig
 
 
@@ -61,6 +61,9 @@ class EftController:
     def mass(self) -> float:
         """m in P_eff = -m a_g [kg]."""
         return self._core.mass
+
+
+_document_fields(EftController, "EFT_CONFIG_FIELDS")
 
 
 class RpsdController:
@@ -125,5 +128,7 @@ class RpsdController:
     def subtract_damping(self) -> float:
         return self._core.subtract_damping
 
+
+_document_fields(RpsdController, "RPSD_CONFIG_FIELDS")
 
 __all__ = ["EftController", "RpsdController"]

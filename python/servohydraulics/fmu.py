@@ -29,7 +29,7 @@ from xml.etree import ElementTree as ET
 import numpy as np
 
 from . import _core
-from .loops import eft_config, rpsd_config
+from .loops import FIELD_KEYWORDS, eft_config, rpsd_config
 from .response import Response
 from .rig import Rig, load_rig, rig_to_dict
 from .simulate import MODES, check_x0
@@ -190,7 +190,8 @@ def settings(kind: str) -> list[str]:
     if kind == "plant":
         return []
     maker = eft_config if kind == "eft" else rpsd_config
-    skip = {"dt", "solver_options", "physical_mass_fraction"}  # dt is its own argument; the others are the loop's
+    # the config fields that are not FMU parameters (fmu::kConfigFieldsNotInFmu): dt is its own argument
+    skip = {k for f in _core.FMU_CONFIG_FIELDS_SKIPPED for k in FIELD_KEYWORDS.get(f, (f,))}
     return [p for p in inspect.signature(maker).parameters if p not in skip]
 
 
@@ -251,10 +252,9 @@ def export_fmu(rig: Rig, path: str | os.PathLike, kind: str = "plant", mode: str
         solver_options: the plant's ODE integrator (``sh.solver_options(...)``).
         name: the FMU's modelIdentifier (default ``servohydraulics_<kind>``; a C identifier of at
             most ``MAX_NAME`` characters).
-        **config: the controller's settings, as ``run_eft`` / ``run_rpsd`` take them
-            (EFT: compensation, lead_T, alpha, mass, compute_delay; RPsD: m_m, c_m,
-            k_m, scheme, restoring_force, amplitude_T, delay_T, alpha,
-            force_measurement, subtract_mass, subtract_damping, compute_delay).
+        **config: the controller's settings, as ``run_eft`` / ``run_rpsd`` take them:
+            ``settings(kind)``, the keywords of the config table's fields that are FMU
+            parameters (``_core.EFT_CONFIG_FIELDS`` / ``RPSD_CONFIG_FIELDS``, docs/fmu.md).
 
     Returns:
         The path written.  Raises ValueError naming a bad argument, FileNotFoundError

@@ -97,6 +97,49 @@ def _choice(name: str, v: str, table: dict):
     return table[v]
 
 
+def _optional_nonneg(name: str, v: float | None) -> float | None:
+    return None if v is None else _nonneg(name, v)
+
+
+#: the keywords of eft_config / rpsd_config that set a field not of their own name
+FIELD_KEYWORDS = {"plant_options": ("solver_options",), "model": ("m_m", "c_m")}
+#: the config fields a name selects, by field name (the enum name tables above)
+_FIELD_CHOICES = {"compensation": COMPENSATION, "scheme": SCHEMES, "restoring_force": RESTORING_FORCE,
+                  "force_measurement": FORCE_MEASUREMENT}
+
+
+def _fill(cfg, table, **values):
+    """Set every field of a core config from its field table (``_core.EFT_CONFIG_FIELDS``,
+    ``RPSD_CONFIG_FIELDS``: controllers.hpp), in table order, and validate it.  ``values`` must
+    name exactly the table's fields (a field added to the table and not here is a TypeError at
+    every call); None keeps the core's default, a choice field takes its name, a field counted
+    in samples a whole number."""
+    names = [name for name, _, _ in table]
+    if sorted(values) != sorted(names):
+        raise TypeError(f"{type(cfg).__name__}: the keywords {sorted(values)} are not the core's fields {names}")
+    for name, unit, _ in table:
+        v = values[name]
+        if v is not None and name in _FIELD_CHOICES:
+            v = _choice(name, v, _FIELD_CHOICES[name])
+        elif v is not None and unit == "samples":
+            v = _integer(name, v)
+        _set(cfg, **{name: v})
+    cfg.validate()
+    return cfg
+
+
+def fields_doc(table) -> str:
+    """The fields of a config table as docstring lines: ``name [unit]: meaning``."""
+    return "\n".join(f"    {name}{f' [{unit}]' if unit else ''}: {meaning}" for name, unit, meaning in table)
+
+
+def _document_fields(obj, table_name: str):
+    """Appends the fields of ``_core.<table_name>`` (name, unit, meaning) to obj's docstring."""
+    if obj.__doc__:  # None under python -OO
+        obj.__doc__ += f"\n\n    Fields (_core.{table_name}):\n\n{fields_doc(getattr(_core, table_name))}\n"
+    return obj
+
+
 def sensor_channel(sigma: float = 0.0, quantum: float = 0.0, range: tuple[float, float] | None = None,
                    unit_delay: bool = False, gain: float = 1.0) -> _core.SensorChannel:
     """One measured channel of ``loop_converters``: y_k = AD(gain x_k + sigma w_k), w_k ~ N(0, 1)
@@ -161,14 +204,14 @@ def eft_config(dt: float | None = None, compensation: str = "linear", lead_T: fl
                alpha: float | None = None, mass: float | None = None, compute_delay: int = 0,
                solver_options: _core.SolverOptions | None = None) -> _core.EftConfig:
     """The core's EftConfig (validated); a keyword left at None keeps the core's default
-    (mass: None = the rig's m)."""
+    (mass: None = the rig's m).  ``solver_options`` is the field ``plant_options``."""
     cfg = _core.EftConfig()
-    _set(cfg, dt=dt, alpha=alpha, mass=mass, plant_options=solver_options)
-    cfg.compensation = _choice("compensation", compensation, COMPENSATION)
-    cfg.lead_T = _nonneg("lead_T", _default(lead_T, cfg, "lead_T"))
-    _set(cfg, compute_delay=_integer("compute_delay", compute_delay))
-    cfg.validate()
-    return cfg
+    return _fill(cfg, _core.EFT_CONFIG_FIELDS, dt=dt, mass=mass, compensation=compensation,
+                 lead_T=_nonneg("lead_T", _default(lead_T, cfg, "lead_T")), alpha=alpha,
+                 compute_delay=compute_delay, plant_options=solver_options)
+
+
+_document_fields(eft_config, "EFT_CONFIG_FIELDS")
 
 
 def run_eft(rig: Rig, ground_acceleration: ArrayLike | None = None, effective_force: ArrayLike | None = None,
@@ -300,22 +343,21 @@ def rpsd_config(dt: float | None = None, m_m: float | None = None, c_m: float | 
     (delay_T: 11.2 ms, or 0 for ``"calculated_displacement"``; k_m, subtract_mass,
     subtract_damping: None = from the physical rig)."""
     cfg = _core.RpsdConfig()
-    _set(cfg, dt=dt, alpha=alpha, plant_options=solver_options)
-    cfg.model = _core.ModelSDOF(_default(m_m, cfg.model, "m_m"), _default(c_m, cfg.model, "c_m"))
-    cfg.k_m = None if k_m is None else _nonneg("k_m", k_m)
-    cfg.scheme = _choice("scheme", scheme, SCHEMES)
-    cfg.restoring_force = _choice("restoring_force", restoring_force, RESTORING_FORCE)
-    cfg.force_measurement = _choice("force_measurement", force_measurement, FORCE_MEASUREMENT)
-    cfg.amplitude_T = _nonneg("amplitude_T", _default(amplitude_T, cfg, "amplitude_T"))
     if delay_T is None and restoring_force == "calculated_displacement":
         delay_T = 0.0
-    cfg.delay_T = _nonneg("delay_T", _default(delay_T, cfg, "delay_T"))
-    _set(cfg, physical_mass_fraction=physical_mass_fraction)
-    cfg.subtract_mass = None if subtract_mass is None else _nonneg("subtract_mass", subtract_mass)
-    cfg.subtract_damping = None if subtract_damping is None else _nonneg("subtract_damping", subtract_damping)
-    _set(cfg, compute_delay=_integer("compute_delay", compute_delay))
-    cfg.validate()
-    return cfg
+    return _fill(cfg, _core.RPSD_CONFIG_FIELDS, dt=dt,
+                 model=_core.ModelSDOF(_default(m_m, cfg.model, "m_m"), _default(c_m, cfg.model, "c_m")),
+                 k_m=_optional_nonneg("k_m", k_m), scheme=scheme, restoring_force=restoring_force,
+                 force_measurement=force_measurement,
+                 amplitude_T=_nonneg("amplitude_T", _default(amplitude_T, cfg, "amplitude_T")),
+                 delay_T=_nonneg("delay_T", _default(delay_T, cfg, "delay_T")), alpha=alpha,
+                 physical_mass_fraction=physical_mass_fraction,
+                 subtract_mass=_optional_nonneg("subtract_mass", subtract_mass),
+                 subtract_damping=_optional_nonneg("subtract_damping", subtract_damping),
+                 compute_delay=compute_delay, plant_options=solver_options)
+
+
+_document_fields(rpsd_config, "RPSD_CONFIG_FIELDS")
 
 
 def run_rpsd(rig: Rig, ground_acceleration: ArrayLike | None = None, external_force: ArrayLike | None = None,

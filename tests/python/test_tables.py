@@ -92,3 +92,103 @@ def test_cli_accepts_and_lists_every_method(capsys):
         build_parser().parse_args(["fmu", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert all(name in text for name, _ in _core.METHOD_NAMES)
+
+
+# ----------------------------------------------------------------- the loop configs' field tables
+#: (config class, its field table, the FMU's prefix, the Python builder)
+CONFIGS = {
+    "eft": (_core.EftConfig, _core.EFT_CONFIG_FIELDS, loops.eft_config),
+    "rpsd": (_core.RpsdConfig, _core.RPSD_CONFIG_FIELDS, loops.rpsd_config),
+}
+#: the Python keywords of a field whose keyword is not its name (the signatures predate the tables)
+KEYWORDS = {"plant_options": ["solver_options"], "model": [n for n, _, _ in _core.MODEL_SDOF_FIELDS]}
+assert {k: list(v) for k, v in loops.FIELD_KEYWORDS.items()} == KEYWORDS
+
+
+def _writable(cls) -> list[str]:
+    return sorted(n for n in dir(cls) if isinstance(getattr(cls, n), property) and getattr(cls, n).fset is not None)
+
+
+@pytest.mark.parametrize("kind", CONFIGS)
+def test_config_table_is_the_bindings_attributes(kind):
+    """Every field of kEftConfigFields / kRpsdConfigFields is a read-write attribute of the
+    binding's config, and the config has no other (the same for ModelSDOF's table)."""
+    cls, table, _ = CONFIGS[kind]
+    assert _writable(cls) == sorted(n for n, _, _ in table)
+    assert _writable(_core.ModelSDOF) == sorted(n for n, _, _ in _core.MODEL_SDOF_FIELDS)
+
+
+def _fmu_parameters(kind: str) -> list[dict]:
+    v = _core.fmu_variables(kind, "displacement", sh.zhao2003(), 5e-4, 0.0, _core.SolverOptions(),
+                            _core.EftConfig(), _core.RpsdConfig())
+    return [x for x in v if x["name"].startswith(kind + ".")]
+
+
+@pytest.mark.parametrize("kind", CONFIGS)
+def test_config_table_is_the_fmus_parameters(kind):
+    """The controller FMU's "<kind>.*" parameters are the table's fields in table order (a nested
+    struct's fields flattened: rpsd.m_m), with the table's unit and meaning, less exactly the
+    fields _core.FMU_CONFIG_FIELDS_SKIPPED names with a reason (cpp/fmu/model.hpp)."""
+    _, table, _ = CONFIGS[kind]
+    skipped = _core.FMU_CONFIG_FIELDS_SKIPPED
+    all_fields = {n for t in (_core.EFT_CONFIG_FIELDS, _core.RPSD_CONFIG_FIELDS) for n, _, _ in t}
+    assert set(skipped) <= all_fields and all(skipped.values())  # no stale rule, each says why
+    expected = []
+    for name, unit, meaning in table:
+        if name in skipped:
+            continue
+        rows = _core.MODEL_SDOF_FIELDS if name == "model" else [(name, unit, meaning)]
+        expected += [(f"{kind}.{n}", u, m) for n, u, m in rows]
+    got = _fmu_parameters(kind)
+    assert [x["name"] for x in got] == [n for n, _, _ in expected]
+    for x, (name, unit, meaning) in zip(got, expected):
+        assert x["causality"] == "parameter" and x["description"] == meaning, name
+        assert x["unit"] == unit or x["type"] != "Real", name  # FMI 2 units are on Reals only
+    # export_fmu's settings are the FMU's parameters (the keywords of their fields)
+    from servohydraulics import fmu
+
+    assert sorted(n.split(".", 1)[1] for n, _, _ in expected) == sorted(fmu.settings(kind))
+    # the skipped fields: dt is the FMU's own parameter; the plant's are not a controller's
+    assert "dt" in {x["name"] for x in _core.fmu_variables(kind, "displacement", sh.zhao2003(), 5e-4, 0.0,
+                                                           _core.SolverOptions(), _core.EftConfig(),
+                                                           _core.RpsdConfig())}
+
+
+@pytest.mark.parametrize("kind", CONFIGS)
+def test_config_table_is_the_python_keywords(kind):
+    """eft_config / rpsd_config (and run_eft / run_rpsd, the controllers less the plant's fields)
+    take one keyword per field of the table; a keyword set to a non-default value changes exactly
+    its field; a field added to the table and not to the builder fails every call."""
+    cls, table, build = CONFIGS[kind]
+    keywords = [k for n, _, _ in table for k in KEYWORDS.get(n, [n])]
+    assert sorted(inspect.signature(build).parameters) == sorted(keywords)
+    run = {"eft": sh.run_eft, "rpsd": sh.run_rpsd}[kind]
+    assert set(keywords) <= set(inspect.signature(run).parameters)
+    ctrl = {"eft": sh.EftController, "rpsd": sh.RpsdController}[kind]
+    plant_only = {"solver_options", "physical_mass_fraction"}
+    assert set(keywords) - plant_only <= set(inspect.signature(ctrl).parameters)
+    for name, unit, _ in table:
+        assert f"{name} [{unit}]" in build.__doc__ if unit else f"    {name}: " in build.__doc__
+        assert f"    {name}" in ctrl.__doc__
+    opts = _core.SolverOptions()
+    opts.rtol = 1e-9
+    changed = {"dt": 1e-3, "mass": 100.0, "compensation": "nonlinear", "lead_T": 0.01, "alpha": 0.2,
+               "compute_delay": 1, "solver_options": opts, "m_m": 100.0, "c_m": 10.0, "k_m": 1e6,
+               "scheme": "explicit_newmark", "restoring_force": "measured_force",
+               "force_measurement": "actuator_pressure", "amplitude_T": 0.05, "delay_T": 0.01,
+               "physical_mass_fraction": 0.5, "subtract_mass": 10.0, "subtract_damping": 5.0}
+    default = build()
+    for name, _, _ in table:
+        cfg = build(**{k: changed[k] for k in KEYWORDS.get(name, [name])})
+        differs = [n for n, _, _ in table if getattr(cfg, n) != getattr(default, n)]
+        assert differs == [name], (name, differs)
+
+
+def test_a_field_added_to_the_table_fails_the_python_builders(monkeypatch):
+    extra = ("new_field", "s", "a field no builder knows")
+    monkeypatch.setattr(_core, "EFT_CONFIG_FIELDS", [*_core.EFT_CONFIG_FIELDS, extra])
+    with pytest.raises(TypeError, match="new_field"):
+        loops.eft_config()
+    monkeypatch.setattr(_core, "RPSD_CONFIG_FIELDS", [*_core.RPSD_CONFIG_FIELDS, extra])
+    with pytest.raises(TypeError, match="new_field"):
+        loops.rpsd_config()

@@ -46,7 +46,7 @@ struct EftConfig {
   void validate() const;
 };
 
-//! EftConfig's fields (config_fields.hpp): the binding's attributes and EFT_CONFIG_FIELDS.
+//! EftConfig's fields (config_fields.hpp): the binding's attributes, EFT_CONFIG_FIELDS, the FMU's eft.*.
 inline constexpr auto kEftConfigFields = std::make_tuple(
     config_field("dt", "s", "controller sample time", &EftConfig::dt),
     config_field("mass", "kg", "m in P_eff = -m a_g (none: the rig's m)", &EftConfig::mass),
@@ -154,7 +154,7 @@ struct RpsdConfig {
   void validate() const;
 };
 
-//! RpsdConfig's fields (config_fields.hpp): the binding's attributes and RPSD_CONFIG_FIELDS.
+//! RpsdConfig's fields (config_fields.hpp): the binding's attributes, RPSD_CONFIG_FIELDS, the FMU's rpsd.*.
 inline constexpr auto kRpsdConfigFields = std::make_tuple(
     config_field("dt", "s", "controller sample time", &RpsdConfig::dt),
     config_field("model", "", "m_m [kg], c_m [N s/m] of Eq (15)", &RpsdConfig::model),

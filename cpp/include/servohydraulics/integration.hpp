@@ -8,6 +8,9 @@
 // the displacement d_{k+1} to be reached one controller sample later.
 #pragma once
 
+#include <tuple>
+
+#include "servohydraulics/config_fields.hpp"
 #include "servohydraulics/enum_name.hpp"
 
 namespace servohydraulics {
@@ -19,6 +22,10 @@ struct ModelSDOF {
   double c_m = 0.0;  //!< modelled viscous damping [N s/m]
   void validate() const;
 };
+//! ModelSDOF's fields (config_fields.hpp): RpsdConfig::model's, for the FMU (rpsd.m_m, rpsd.c_m) and MODEL_SDOF_FIELDS.
+inline constexpr auto kModelSdofFields =
+    std::make_tuple(config_field("m_m", "kg", "modelled mass of Eq (15)", &ModelSDOF::m_m),
+                    config_field("c_m", "N s/m", "modelled viscous damping of Eq (15)", &ModelSDOF::c_m));
 
 //! The structural integration schemes of a numerical substructure (substructure.hpp), one
 //! enum for every hybrid loop.  Eq (15) of RPsD takes CentralDifference or ExplicitNewmark
