@@ -8,7 +8,7 @@ namespace {
 // Summary bookkeeping shared by the runners.
 void account(RunSummary& sum, const Output& o, double F_cap) noexcept {
   sum.flags_any |= o.flags;
-  sum.peak_force = std::fmax(sum.peak_force, std::fabs(o.force));
+  sum.peaks(o.force, o.displacement, o.velocity);
   if (sum.first_capacity_time < 0.0 && std::fabs(o.force) > F_cap) sum.first_capacity_time = o.time;
 }
 
@@ -52,9 +52,10 @@ RunSummary run_rows(const Plant& p, std::size_t n, StepRow&& step_row, PlantRow&
   const double F_cap = p.dynamics().rig().F_cap;
   for (std::size_t k = 0; k < n; ++k) {
     const Status st = step_row(k);
-    account(sum, plant_row(k), F_cap);
+    const Output& row = plant_row(k);
+    account(sum, row, F_cap);
     sum.rows = k + 1;
-    if (!sum.count(st)) break;
+    if (!sum.count(st, row.time)) break;
   }
   sum.internal_steps = p.total_internal_steps() - ns0;
   sum.rhs_evals = p.total_rhs_evals() - nf0;

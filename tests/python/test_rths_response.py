@@ -54,8 +54,9 @@ def test_the_response_is_the_loops_output_to_the_bit(short):
     num = R.LinearSubstructure(rths.partition(case, exp.specimen()), rths.DT, R.SubstructureScheme.RungeKutta4)
     cfg = R.RthsLoopConfig()
     cfg.seed, cfg.generator = 3, R.NoiseGenerator.SimulinkRandomNumber
-    out = R.RthsLoop(exp, num, rths.make_controller("sample"), cfg).run(
+    out, summary = R.RthsLoop(exp, num, rths.make_controller("sample"), cfg).run(
         num, R.GroundMotion(rec.time, rec.acceleration, rths.EQ_INTENSITY), rec.samples(), False)
+    assert isinstance(summary, _core.RunSummary) and summary.ok() and summary.rows == rec.samples()
     res = t.response
     for name, _ in R.RTHS_CHANNELS:
         np.testing.assert_array_equal(res.channels[name], out[name], err_msg=name)
