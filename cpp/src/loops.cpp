@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "servohydraulics/error.hpp"
+
 namespace servohydraulics {
 
 namespace {
@@ -20,15 +22,23 @@ EftConfig with_mass(const EftConfig& config, const Rig& rig) {
 }
 }  // namespace
 
+void RpsdLoopOptions::validate() const {
+  plant_options.validate();
+  require(std::isfinite(physical_mass_fraction) && physical_mass_fraction > 0.0, "physical_mass_fraction",
+          physical_mass_fraction, "must be finite and > 0");
+}
+
 EffectiveForceTest::EffectiveForceTest(const Rig& rig, const EftConfig& config, const std::optional<Rig>& model,
-                                       const LoopConverters& converters, TrackingController* tracking)
-    : ClosedLoop(Plant(rig, ControlMode::Force, config.dt, config.plant_options),
+                                       const LoopConverters& converters, TrackingController* tracking,
+                                       const EftLoopOptions& options)
+    : ClosedLoop(Plant(rig, ControlMode::Force, config.dt, (options.validate(), options.plant_options)),
                  EftController(with_mass(config, rig), model.value_or(rig), tracking), converters) {}
 
-Rig RealTimePseudoDynamicTest::physical_rig(const Rig& rig, const RpsdConfig& cfg) {
+Rig RealTimePseudoDynamicTest::physical_rig(const Rig& rig, const RpsdConfig& cfg, const RpsdLoopOptions& options) {
   cfg.validate();
+  options.validate();
   Rig r = rig;
-  r.m = cfg.physical_mass_fraction * cfg.model.m_m;
+  r.m = options.physical_mass_fraction * cfg.model.m_m;
   r.validate();
   return r;
 }
@@ -36,9 +46,11 @@ Rig RealTimePseudoDynamicTest::physical_rig(const Rig& rig, const RpsdConfig& cf
 RealTimePseudoDynamicTest::RealTimePseudoDynamicTest(const Rig& rig, const RpsdConfig& config,
                                                      const LoopConverters& converters,
                                                      TrackingController* tracking,
-                                                     NumericalSubstructure* substructure)
-    : ClosedLoop(Plant(physical_rig(rig, config), ControlMode::Displacement, config.dt, config.plant_options),
-                 RpsdController(config, physical_rig(rig, config), tracking, substructure), converters) {}
+                                                     NumericalSubstructure* substructure,
+                                                     const RpsdLoopOptions& options)
+    : ClosedLoop(Plant(physical_rig(rig, config, options), ControlMode::Displacement, config.dt,
+                       options.plant_options),
+                 RpsdController(config, physical_rig(rig, config, options), tracking, substructure), converters) {}
 
 // -------------------------------------------------------------------- runners
 

@@ -257,8 +257,7 @@ void no_allocation() {
   RpsdConfig rc;
   SolverOptions rk4;
   rk4.method = SolverOptions::Method::Rk4;
-  rc.plant_options = rk4;
-  RealTimePseudoDynamicTest rpsd(zhao2003(), rc, lc);
+  RealTimePseudoDynamicTest rpsd(zhao2003(), rc, lc, nullptr, nullptr, RpsdLoopOptions{rk4});
   std::vector<RpsdOutput> rows(2000);
   std::vector<double> ag(2000);
   for (std::size_t i = 0; i < ag.size(); ++i) ag[i] = std::sin(0.01 * static_cast<double>(i));
