@@ -309,7 +309,16 @@ void expose_rths(py::module_& m) {
   py::class_<bindings::PythonTrackingController, TrackingController>(
       r, "PythonController", "any object with reset() and command(...) as a tracking controller")
       .def(py::init<py::object>(), py::arg("controller"))
-      .def_property_readonly("controller", &bindings::PythonTrackingController::object);
+      .def_property_readonly("controller", &bindings::PythonTrackingController::object)
+      .def_property_readonly(
+          "keywords",
+          [](const bindings::PythonTrackingController& c) {
+            py::list out;
+            if (c.signature().measured_velocity) out.append("measured_velocity");
+            if (c.signature().measured_pressure) out.append("measured_pressure");
+            return py::tuple(out);
+          },
+          "The optional inputs command() receives as keywords (read once from its signature, when wrapped)");
   py::class_<SampleControllerConfig> sc(r, "SampleControllerConfig");
   sc.def(py::init<>()).def_readwrite("lead_b1", &SampleControllerConfig::lead_b1)
       .def_readwrite("lead_b0", &SampleControllerConfig::lead_b0)

@@ -118,8 +118,10 @@ def make_controller(name: str, dt: float = DT, plant=None):
     perturbed plant), or a user's class as ``"module:Class"``, imported from PYTHONPATH and
     built with no arguments (:func:`load_controller`).  The built-ins are
     ``rths.core.TrackingController`` objects with ``reset()`` and
-    ``command(desired, desired_velocity, desired_acceleration, measured, measured_force)``, the
-    interface a user's controller implements (docs/rths-benchmark.md, "Bring your own controller")."""
+    ``command(desired, desired_velocity, desired_acceleration, measured, measured_force,
+    measured_velocity=0, measured_pressure=0)``, the interface a user's controller implements
+    (the last two optional: passed as keywords when its command() names them; docs/rths-benchmark.md,
+    "Bring your own controller")."""
     if isinstance(name, str) and ":" in name:
         return load_controller(name)
     if name not in CONTROLLERS:
