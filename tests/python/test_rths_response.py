@@ -104,3 +104,6 @@ def test_without_keep_signals_there_is_no_response_and_a_failure_is_said():
     assert not bad.ok and not res.success and res.status == "non_finite" and len(res) == 6
     assert res.message.startswith(f"RTHS failed at t = {5 * rths.DT:.6g} s")
     assert res.to_pandas().shape[0] == 6 and res.work.failure_time == 5 * rths.DT
+    # the core's RunSummary, as every loop's (test_run_summary.py): the failure at the loop's sample time
+    assert not res.work.ok and res.work.status.t == res.work.failure_time and res.work.rows == 6
+    assert bad.failure_time == res.work.failure_time and bad.max_force_N == res.work.peak_force

@@ -4,8 +4,6 @@ the core's RunSummary (record.hpp), read as ``Response.work``.  Oracle: the peak
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 
@@ -44,23 +42,6 @@ def test_every_loop_returns_the_same_summary(kind, res, force):
     else:
         x = res.displacement
         assert w.peak_velocity == pytest.approx(np.max(np.abs(np.diff(x))) / res.dt, rel=0.05)
-
-
-def test_the_rths_loop_returns_a_run_summary_and_a_failure_names_its_row():
-    case, rec = rths.embedded_case(1), rths.synthetic_record(duration=1.0)
-
-    class NanAt5:
-        def reset(self):
-            self.k = 0
-
-        def command(self, *args):
-            self.k += 1
-            return math.nan if self.k == 6 else 0.0
-
-    t = rths.run_trial(case, rec, NanAt5(), keep_signals=True)
-    w = t.response.work
-    assert not w.ok and w.status.code == "non_finite" and w.failure_time == w.status.t == 5 * rths.DT
-    assert w.rows == 6 and t.failure_time == w.failure_time and t.max_force_N == w.peak_force
 
 
 @pytest.mark.parametrize("kind", ["plant", "eft"])
