@@ -50,6 +50,18 @@ class NoOp:
         return 0.0
 
 
+class NoOpAllInputs:
+    """Python, does nothing, taking all seven inputs: measured_velocity and measured_pressure are
+    passed as keywords (the loop reads command()'s signature once): the cost of the two keywords."""
+
+    def reset(self):
+        pass
+
+    def command(self, desired, desired_velocity, desired_acceleration, measured, measured_force,
+                measured_velocity=0.0, measured_pressure=0.0):
+        return 0.0
+
+
 class DelegatingSubclass(rths.TrackingController):
     """Python, a TrackingController subclass (the trampoline), delegates to the built-in sample controller."""
 
@@ -68,6 +80,7 @@ def controllers() -> dict[str, object]:
     example = _example()
     out: dict[str, object] = {f"C++ built-in `{n}`": n for n in rths.CONTROLLERS}
     out["Python no-op (returns 0)"] = NoOp
+    out["Python no-op taking all seven inputs (two as keywords)"] = NoOpAllInputs
     out["Python, delegating to the built-in `sample` (duck-typed)"] = example.Delegating
     out["Python, delegating to the built-in `sample` (TrackingController subclass)"] = DelegatingSubclass
     out["Python PI + phase lead (examples/07_user_controller.py)"] = example.PiLead

@@ -163,8 +163,9 @@ struct EftSystem {
   const std::vector<double>& ag;
   sh::EftOutput out;
   std::vector<sh::EftOutput> rows;
-  EftSystem(const sh::Rig& rig, const sh::EftConfig& cfg, const std::vector<double>& ag_)
-      : test(rig, cfg), ag(ag_), rows(ag_.size()) {}
+  EftSystem(const sh::Rig& rig, const sh::EftConfig& cfg, const sh::SolverOptions& options,
+            const std::vector<double>& ag_)
+      : test(rig, cfg, std::nullopt, {}, nullptr, sh::EftLoopOptions{options}), ag(ag_), rows(ag_.size()) {}
   void reset() { test.reset(); }
   sh::Status step(std::size_t k, double& x, double& F) {
     const sh::Status st = test.step(ag[k], out);
@@ -181,8 +182,9 @@ struct RpsdSystem {
   const std::vector<double>& ag;
   sh::RpsdOutput out;
   std::vector<sh::RpsdOutput> rows;
-  RpsdSystem(const sh::Rig& rig, const sh::RpsdConfig& cfg, const std::vector<double>& ag_)
-      : test(rig, cfg), ag(ag_), rows(ag_.size()) {}
+  RpsdSystem(const sh::Rig& rig, const sh::RpsdConfig& cfg, const sh::SolverOptions& options,
+             const std::vector<double>& ag_)
+      : test(rig, cfg, {}, nullptr, nullptr, sh::RpsdLoopOptions{options}), ag(ag_), rows(ag_.size()) {}
   void reset() { test.reset(); }
   sh::Status step(std::size_t k, double& x, double& F) {
     const sh::Status st = test.step(ag[k], 0.0, 0.0, out);
@@ -247,8 +249,7 @@ Result run_case(const Case& c, const sh::Rig& rig, const Input& in, std::size_t 
     sh::EftConfig cfg;
     cfg.dt = dt;
     cfg.compensation = sh::VelocityFeedbackCompensator::Kind::Nonlinear;
-    cfg.plant_options = c.options;
-    EftSystem sys(rig, cfg, in.ag);
+    EftSystem sys(rig, cfg, c.options, in.ag);
     return run_system(c, sys, n, repeat);
   }
   if (c.group == "rpsd") {
@@ -262,8 +263,7 @@ Result run_case(const Case& c, const sh::Rig& rig, const Input& in, std::size_t 
     // the record (docs/methods.md); 20 ms keeps it bounded (zeta +3.05 %).
     cfg.restoring_force = sh::RestoringForce::MeasuredDisplacement;
     cfg.delay_T = 20e-3;
-    cfg.plant_options = c.options;
-    RpsdSystem sys(rig, cfg, in.ag);
+    RpsdSystem sys(rig, cfg, c.options, in.ag);
     return run_system(c, sys, n, repeat);
   }
   PlantSystem sys(rig, dt, c.options, in.command);

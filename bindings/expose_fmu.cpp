@@ -51,9 +51,6 @@ void expose_fmu(py::module_& m) {
   py::tuple kinds(std::size(fmu::kKindNames));
   for (std::size_t i = 0; i < kinds.size(); ++i) kinds[i] = fmu::kKindNames[i].name;
   m.attr("FMU_KINDS") = kinds;  // fmu.KINDS, the CLI's --kind choices
-  py::dict skipped;
-  for (const auto& f : fmu::kConfigFieldsNotInFmu) skipped[f.name] = f.reason;
-  m.attr("FMU_CONFIG_FIELDS_SKIPPED") = skipped;  // the loop-config fields that are not FMU parameters, and why
   m.def("fmu_variables", &fmu_variables, py::arg("kind"), py::arg("mode"), py::arg("rig"), py::arg("dt"),
         py::arg("x0"), py::arg("solver"), py::arg("eft"), py::arg("rpsd"),
         "The FMU's variables (name, value_reference, type, causality, variability, unit, description, "

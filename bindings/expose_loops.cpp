@@ -141,6 +141,10 @@ void expose_loops(py::module_& m) {
   eft_config.def(py::init<>()).def("validate", &EftConfig::validate);
   add_protocol(eft_config, def_fields(eft_config, kEftConfigFields));
   m.attr("EFT_CONFIG_FIELDS") = field_table(kEftConfigFields);
+  py::class_<EftLoopOptions> eft_options(m, "EftLoopOptions", "How the EFT loop simulates the plant (loops.hpp)");
+  eft_options.def(py::init<>()).def("validate", &EftLoopOptions::validate);
+  add_protocol(eft_options, def_fields(eft_options, kEftLoopOptionFields));
+  m.attr("EFT_LOOP_OPTION_FIELDS") = field_table(kEftLoopOptionFields);
   expose_row(m, "EftOutput", kEftChannels);
   m.attr("EFT_CHANNELS") = sh_py::channel_units(kEftChannels);
   py::class_<EftController>(m, "EftController",
@@ -169,9 +173,9 @@ void expose_loops(py::module_& m) {
   expose_loop_converters(m);
   py::class_<EffectiveForceTest>(m, "EffectiveForceTest", "Effective force testing loop (force control, Fig 1a)")
       .def(py::init<const Rig&, const EftConfig&, const std::optional<Rig>&, const LoopConverters&,
-                    TrackingController*>(),
+                    TrackingController*, const EftLoopOptions&>(),
            py::arg("rig"), py::arg("config"), py::arg("model") = py::none(), py::arg("converters") = LoopConverters{},
-           py::arg("tracking") = py::none(), py::keep_alive<1, 6>())
+           py::arg("tracking") = py::none(), py::arg("options") = EftLoopOptions{}, py::keep_alive<1, 6>())
       .def_property_readonly("converters", [](const EffectiveForceTest& t) { return t.converters().config(); })
       .def("reset",
            [](EffectiveForceTest& t) {
@@ -220,6 +224,10 @@ void expose_loops(py::module_& m) {
   rpsd_config.def(py::init<>()).def("validate", &RpsdConfig::validate);
   add_protocol(rpsd_config, def_fields(rpsd_config, kRpsdConfigFields));
   m.attr("RPSD_CONFIG_FIELDS") = field_table(kRpsdConfigFields);
+  py::class_<RpsdLoopOptions> rpsd_options(m, "RpsdLoopOptions", "How the RPsD loop simulates the plant (loops.hpp)");
+  rpsd_options.def(py::init<>()).def("validate", &RpsdLoopOptions::validate);
+  add_protocol(rpsd_options, def_fields(rpsd_options, kRpsdLoopOptionFields));
+  m.attr("RPSD_LOOP_OPTION_FIELDS") = field_table(kRpsdLoopOptionFields);
   expose_row(m, "RpsdOutput", kRpsdChannels);
   m.attr("RPSD_CHANNELS") = sh_py::channel_units(kRpsdChannels);
   py::class_<RpsdController>(m, "RpsdController",
@@ -253,10 +261,10 @@ void expose_loops(py::module_& m) {
   py::class_<RealTimePseudoDynamicTest>(m, "RealTimePseudoDynamicTest",
                                         "Real-time pseudodynamic testing loop (displacement control, Figs 1b, 7)")
       .def(py::init<const Rig&, const RpsdConfig&, const LoopConverters&, TrackingController*,
-                    NumericalSubstructure*>(),
+                    NumericalSubstructure*, const RpsdLoopOptions&>(),
            py::arg("rig"), py::arg("config"), py::arg("converters") = LoopConverters{},
-           py::arg("tracking") = py::none(), py::arg("substructure") = py::none(), py::keep_alive<1, 5>(),
-           py::keep_alive<1, 6>(),
+           py::arg("tracking") = py::none(), py::arg("substructure") = py::none(),
+           py::arg("options") = RpsdLoopOptions{}, py::keep_alive<1, 5>(), py::keep_alive<1, 6>(),
            "tracking: a TrackingController in place of the amplitude lead; substructure: a NumericalSubstructure "
            "(e.g. rths.LinearSubstructure, rths.PythonSubstructure) in place of Eq (15)'s 1-DOF model")
       .def_property_readonly("converters", [](const RealTimePseudoDynamicTest& t) { return t.converters().config(); })
@@ -301,7 +309,8 @@ void expose_loops(py::module_& m) {
                              py::return_value_policy::reference_internal)
       .def_property_readonly("integrator_state", &RealTimePseudoDynamicTest::integrator_state)
       .def_static("physical_rig", &RealTimePseudoDynamicTest::physical_rig, py::arg("rig"), py::arg("config"),
-                  "The rig the plant simulates: rig with m = physical_mass_fraction * m_m")
+                  py::arg("options") = RpsdLoopOptions{},
+                  "The rig the plant simulates: rig with m = options.physical_mass_fraction * config.model.m_m")
       .def_property_readonly("k_m", &RealTimePseudoDynamicTest::k_m)
       .def_property_readonly("subtract_mass", &RealTimePseudoDynamicTest::subtract_mass)
       .def_property_readonly("subtract_damping", &RealTimePseudoDynamicTest::subtract_damping);

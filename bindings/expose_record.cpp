@@ -9,7 +9,9 @@ namespace py = pybind11;
 using namespace servohydraulics;
 
 void expose_record(py::module_& m) {
-  py::class_<RunSummary>(m, "RunSummary")
+  py::class_<RunSummary>(m, "RunSummary", "What a run did (record.hpp): every loop's summary (run_record, EFT, "
+                                          "RPsD, rths.RthsLoop)")
+      .def("ok", &RunSummary::ok, "ran every sample without a failure (status.ok())")
       .def_readonly("status", &RunSummary::status)
       .def_readonly("rows", &RunSummary::rows)
       .def_readonly("internal_steps", &RunSummary::internal_steps)
@@ -18,6 +20,9 @@ void expose_record(py::module_& m) {
       .def_readonly("max_internal_steps", &RunSummary::max_internal_steps)
       .def_readonly("flags_any", &RunSummary::flags_any)
       .def_readonly("peak_force", &RunSummary::peak_force)
+      .def_readonly("peak_displacement", &RunSummary::peak_displacement)
+      .def_readonly("peak_velocity", &RunSummary::peak_velocity)
+      .def_readonly("failure_time", &RunSummary::failure_time)
       .def_readonly("first_capacity_time", &RunSummary::first_capacity_time)
       .def_readonly("stiff_samples", &RunSummary::stiff_samples)
       .def_readonly("inaccurate_samples", &RunSummary::inaccurate_samples);

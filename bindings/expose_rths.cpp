@@ -101,15 +101,15 @@ class PythonSubstructure final : public NumericalSubstructure {
   mutable std::string error_;
 };
 
-py::dict run_loop(RthsLoop& loop, const NumericalSubstructure& num, const GroundMotion& ag, std::size_t n,
-                  bool timing) {
+py::tuple run_loop(RthsLoop& loop, const NumericalSubstructure& num, const GroundMotion& ag, std::size_t n,
+                   bool timing) {
   if (&num != &loop.numerical())
     throw Error("invalid numerical: expected the loop's own numerical substructure (the one it was built with)");
   const auto nd = static_cast<py::ssize_t>(num.dof_count());
   const auto N = static_cast<py::ssize_t>(n);
   std::vector<RthsOutput> rows(n);
   Arr numerical({N, nd}), steps(timing ? N : 0);
-  RthsSummary s;
+  RunSummary s;
   {
     bindings::BusyGuard busy({&loop, &loop.experimental(), &loop.numerical(), &loop.controller(), &ag},
                              "RthsLoop.run");
@@ -126,14 +126,7 @@ py::dict run_loop(RthsLoop& loop, const NumericalSubstructure& num, const Ground
   sh_py::rows_to_dict(out, kRthsChannels, rows, s.rows);
   out["numerical"] = numerical[py::slice(0, m, 1)];
   if (timing) out["step_seconds"] = steps[py::slice(0, m, 1)];
-  out["rows"] = s.rows;
-  out["ok"] = s.ok;
-  out["failure_time"] = s.failure_time;
-  out["status"] = s.status;
-  out["peak_actuator_force"] = s.peak_actuator_force;
-  out["peak_displacement"] = s.peak_displacement;
-  out["peak_velocity"] = s.peak_velocity;
-  return out;
+  return py::make_tuple(out, s);
 }
 
 template <class T>
@@ -316,7 +309,16 @@ void expose_rths(py::module_& m) {
   py::class_<bindings::PythonTrackingController, TrackingController>(
       r, "PythonController", "any object with reset() and command(...) as a tracking controller")
       .def(py::init<py::object>(), py::arg("controller"))
-      .def_property_readonly("controller", &bindings::PythonTrackingController::object);
+      .def_property_readonly("controller", &bindings::PythonTrackingController::object)
+      .def_property_readonly(
+          "keywords",
+          [](const bindings::PythonTrackingController& c) {
+            py::list out;
+            if (c.signature().measured_velocity) out.append("measured_velocity");
+            if (c.signature().measured_pressure) out.append("measured_pressure");
+            return py::tuple(out);
+          },
+          "The optional inputs command() receives as keywords (read once from its signature, when wrapped)");
   py::class_<SampleControllerConfig> sc(r, "SampleControllerConfig");
   sc.def(py::init<>()).def_readwrite("lead_b1", &SampleControllerConfig::lead_b1)
       .def_readwrite("lead_b0", &SampleControllerConfig::lead_b0)
@@ -387,6 +389,7 @@ void expose_rths(py::module_& m) {
              return run_loop(loop, num, ag, n, timing);
            },
            py::arg("numerical"), py::arg("ground_motion"), py::arg("n"), py::arg("timing") = false,
-           "Reset, then run n samples; numerical: the loop's numerical substructure (for the row width). Returns a dict: "
-           "one column per RTHS_CHANNELS entry, numerical (rows x dofs), step_seconds (if timing) and the summary.");
+           "Reset, then run n samples; numerical: the loop's numerical substructure (for the row width). Returns "
+           "(channels dict, RunSummary) as the EFT and RPsD loops: one column per RTHS_CHANNELS entry, numerical "
+           "(rows x dofs) and step_seconds (if timing); the summary's peak_force is the actuator force's.");
 }

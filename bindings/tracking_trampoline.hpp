@@ -5,9 +5,13 @@
 //   * any object with reset() and command(...) (PythonTrackingController wraps it).
 // Both call
 //   reset() -> None
-//   command(desired, desired_velocity, desired_acceleration, measured, measured_force) -> float
-// with the TrackingInput fields as five floats in SI units (m, m/s, m/s^2, m, N) and take the
-// returned command [m] (anything float() accepts).
+//   command(desired, desired_velocity, desired_acceleration, measured, measured_force,
+//           [measured_velocity=..., measured_pressure=...]) -> float
+// with the TrackingInput fields as floats in SI units (m, m/s, m/s^2, m, N; m/s, Pa) and take the
+// returned command [m] (anything float() accepts).  The first five are positional; the last two
+// are passed as keywords, each only if command() names it (or takes **kwargs), decided once from
+// its signature (CommandSignature: when the object is wrapped, or at a subclass's reset()), so a
+// five-argument command() keeps working and pays nothing for them.
 //
 // The loop runs without the GIL (bindings/busy.hpp): each call takes it.  reset() and
 // command() are noexcept: a Python exception is stored (with the sample it happened at), the
@@ -31,6 +35,68 @@
 namespace servohydraulics::bindings {
 
 namespace py = pybind11;
+
+//! Which of TrackingInput's two optional inputs a Python command() takes as keywords: those it
+//! names as keyword-accepting parameters, or both when it takes **kwargs (inspect.signature; a
+//! callable whose signature cannot be read gets the five positional ones).  Read once (GIL held);
+//! call() then passes them by vectorcall with the keyword names built here, no dict per sample.
+struct CommandSignature {
+  bool measured_velocity = false, measured_pressure = false;
+  py::object keyword_names;  //!< tuple of the keywords passed, in that order (None: none)
+
+  static CommandSignature of(const py::handle& command) {
+    CommandSignature s;
+    try {
+      const py::module_ inspect = py::module_::import("inspect");
+      const py::object kind = inspect.attr("Parameter");
+      const py::object var_keyword = kind.attr("VAR_KEYWORD"), keyword_only = kind.attr("KEYWORD_ONLY"),
+                       positional = kind.attr("POSITIONAL_OR_KEYWORD");
+      for (const py::handle p : inspect.attr("signature")(command).attr("parameters").attr("values")()) {
+        const py::object k = p.attr("kind");
+        if (k.equal(var_keyword)) {
+          s.measured_velocity = s.measured_pressure = true;
+          break;
+        }
+        if (!k.equal(keyword_only) && !k.equal(positional)) continue;
+        const std::string name = py::str(p.attr("name"));
+        s.measured_velocity |= name == "measured_velocity";
+        s.measured_pressure |= name == "measured_pressure";
+      }
+    } catch (const py::error_already_set&) {  // no signature (a builtin): the five positional inputs
+      s.measured_velocity = s.measured_pressure = false;
+    }
+    py::list names;
+    if (s.measured_velocity) names.append(py::str("measured_velocity"));
+    if (s.measured_pressure) names.append(py::str("measured_pressure"));
+    s.keyword_names = names.empty() ? py::object(py::none()) : py::object(py::tuple(names));
+    return s;
+  }
+
+  //! f([self,] the five inputs, and the keywords it takes) (GIL held; throws error_already_set).
+  py::object call(const py::handle& f, const rths::TrackingInput& in, const py::handle& self = py::handle()) const {
+    const double values[7] = {in.desired,  in.desired_velocity, in.desired_acceleration, in.measured,
+                              in.measured_force, in.measured_velocity, in.measured_pressure};
+    PyObject* args[8];
+    std::size_t n = 0;
+    if (self) args[n++] = self.ptr();  // borrowed
+    const std::size_t first = n, positional = first + 5;
+    bool ok = true;
+    auto push = [&](double v) {
+      PyObject* x = ok ? PyFloat_FromDouble(v) : nullptr;
+      if (x) args[n++] = x;
+      else ok = false;
+    };
+    for (int i = 0; i < 5; ++i) push(values[i]);
+    if (measured_velocity) push(values[5]);
+    if (measured_pressure) push(values[6]);
+    PyObject* r = ok ? PyObject_Vectorcall(f.ptr(), args, positional,
+                                           keyword_names && !keyword_names.is_none() ? keyword_names.ptr() : nullptr)
+                     : nullptr;
+    for (std::size_t i = first; i < n; ++i) Py_DECREF(args[i]);
+    if (r == nullptr) throw py::error_already_set();
+    return py::reinterpret_steal<py::object>(r);
+  }
+};
 
 //! The call discipline shared by the two Python controllers: GIL, error capture, sample count.
 class PythonControllerCalls {
@@ -132,9 +198,10 @@ class PythonControllerCalls {
 };
 
 //! Trampoline: a Python subclass of TrackingController overrides reset() and command(...).
-//! reset() also caches the class's command function; command() then calls it with the
-//! instance (borrowed: the instance owns this object), skipping pybind11's per-call override
-//! lookup.  An override that is not a plain method of the class is looked up on every call.
+//! reset() also caches the class's command function and reads its signature (CommandSignature);
+//! command() then calls it with the instance (borrowed: the instance owns this object), skipping
+//! pybind11's per-call override lookup.  An override that is not a plain method of the class is
+//! looked up on every call.
 class PyTrackingController : public rths::TrackingController, public PythonControllerCalls {
  public:
   using rths::TrackingController::TrackingController;
@@ -144,6 +211,7 @@ class PyTrackingController : public rths::TrackingController, public PythonContr
       self_ = py::handle();
       override_of("reset")();
       const py::function f = override_of("command");
+      signature_ = CommandSignature::of(f);
       if (py::hasattr(f, "__func__") && py::hasattr(f, "__self__")) {
         const py::object self = f.attr("__self__"), func = f.attr("__func__");
         if (py::getattr(py::type::handle_of(self), "command", py::none()).is(func)) {
@@ -155,11 +223,8 @@ class PyTrackingController : public rths::TrackingController, public PythonContr
   }
   double command(const rths::TrackingInput& in) noexcept override {
     return command_call([&] {
-      if (command_)
-        return command_(self_, in.desired, in.desired_velocity, in.desired_acceleration, in.measured,
-                        in.measured_force);
-      return override_of("command")(in.desired, in.desired_velocity, in.desired_acceleration, in.measured,
-                                    in.measured_force);
+      if (command_) return signature_.call(command_, in, self_);  // the class's function, self first
+      return signature_.call(override_of("command"), in);
     });
   }
 
@@ -171,6 +236,7 @@ class PyTrackingController : public rths::TrackingController, public PythonContr
   }
   py::object command_;
   py::handle self_;
+  CommandSignature signature_;
 };
 
 //! Any Python object with reset() and command(...) as a TrackingController.
@@ -185,22 +251,23 @@ class PythonTrackingController final : public rths::TrackingController, public P
       throw py::type_error("invalid controller = " + py::repr(obj_).cast<std::string>() +
                            ": not a tracking controller, it lacks " + missing +
                            " (expected reset() and command(desired, desired_velocity, desired_acceleration, "
-                           "measured, measured_force) -> float)");
+                           "measured, measured_force, [measured_velocity=..., measured_pressure=...]) -> float)");
     reset_ = obj_.attr("reset");
     command_ = obj_.attr("command");
+    signature_ = CommandSignature::of(command_);
   }
   void reset() noexcept override {
     reset_call([&] { reset_(); });
   }
   double command(const rths::TrackingInput& in) noexcept override {
-    return command_call([&] {
-      return command_(in.desired, in.desired_velocity, in.desired_acceleration, in.measured, in.measured_force);
-    });
+    return command_call([&] { return signature_.call(command_, in); });
   }
   const py::object& object() const noexcept { return obj_; }
+  const CommandSignature& signature() const noexcept { return signature_; }
 
  private:
   py::object obj_, reset_, command_;
+  CommandSignature signature_;
 };
 
 //! After a run (GIL held): re-raises what a Python controller raised during it, if anything

@@ -59,7 +59,7 @@ rths::LinearSubstructureModel partitioned_building(const rths::SpecimenModel& sp
 struct Run {
   std::vector<rths::RthsOutput> rows;  //!< one per sample, channels as rths::kRthsChannels
   std::vector<double> step_seconds;
-  rths::RthsSummary summary;
+  servohydraulics::RunSummary summary;  // every loop's summary (record.hpp)
 };
 
 Run run(rths::TrackingController& controller, double seconds) {
@@ -107,10 +107,10 @@ int main(int argc, char** argv) {
   }
   std::printf("samples=%zu\nok=%d\npeak_command_mm=%.6f\nsteady_peak_displacement_mm=%.6f\n"
               "max_command_difference_m=%.3e\n",
-              b.rows.size(), b.summary.ok && p.summary.ok ? 1 : 0, 1e3 * peak, 1e3 * steady, diff);
+              b.rows.size(), b.summary.ok() && p.summary.ok() ? 1 : 0, 1e3 * peak, 1e3 * steady, diff);
   std::printf("builtin_step_us_median=%.3f\nbuiltin_step_us_p99=%.3f\n", percentile_us(b.step_seconds, 0.5),
               percentile_us(b.step_seconds, 0.99));
   std::printf("pilead_step_us_median=%.3f\npilead_step_us_p99=%.3f\n", percentile_us(p.step_seconds, 0.5),
               percentile_us(p.step_seconds, 0.99));
-  return b.summary.ok && p.summary.ok ? 0 : 1;
+  return b.summary.ok() && p.summary.ok() ? 0 : 1;
 }

@@ -276,19 +276,19 @@ Variable enum_parameter(std::string name, std::string doc, std::function<E&(Valu
   }
 }
 
-bool not_in_fmu(const char* field) noexcept {
-  for (const SkippedConfigField& s : kConfigFieldsNotInFmu)
-    if (std::string_view(s.name) == field) return true;
-  return false;
-}
+template <class C, class = void>
+struct has_dt : std::false_type {};
+template <class C>
+struct has_dt<C, std::void_t<decltype(&C::dt)>> : std::true_type {};
 
 //! One row of a config's field table (config_fields.hpp) as the parameter "<prefix><name>" (its unit
 //! and meaning), read and written through `path` (the config inside Values); a nested struct's
 //! fields are flattened under the same prefix (rpsd.model.m_m is "rpsd.m_m").
 template <class Config, class T, class Path>
 void add_field(std::vector<Variable>& out, const std::string& prefix, const ConfigField<Config, T>& f, Path path) {
-  if (not_in_fmu(f.name)) return;  // kConfigFieldsNotInFmu says why
   const auto member = f.member;
+  if constexpr (std::is_same_v<T, double> && has_dt<Config>::value)
+    if (member == &Config::dt) return;  // the FMU's own dt (add_dt), copied into the config
   auto ref = [path, member](Values& v) -> T& { return path(v).*member; };
   std::string name = prefix + f.name;
   if constexpr (std::is_same_v<T, double>) {
@@ -301,15 +301,12 @@ void add_field(std::vector<Variable>& out, const std::string& prefix, const Conf
     out.push_back(enum_parameter<T>(std::move(name), f.meaning, ref));
   } else if constexpr (std::is_same_v<T, ModelSDOF>) {
     std::apply([&](const auto&... g) { (add_field(out, prefix, g, ref), ...); }, kModelSdofFields);
-  } else if constexpr (std::is_same_v<T, SolverOptions>) {
-    // A solver is the plant's: a plant FMU has its own solver.* parameters (add_solver).
-    throw Error("config field " + name + " (SolverOptions) is not an FMU parameter: list it in kConfigFieldsNotInFmu");
   } else {
     static_assert(!std::is_same_v<T, T>, "a config field of a type the FMU generator has no rule for");
   }
 }
 
-//! Every field of a config's table (kEftConfigFields, kRpsdConfigFields) but kConfigFieldsNotInFmu.
+//! Every field of a config's table (kEftConfigFields, kRpsdConfigFields) but dt (the FMU's own).
 template <class Table, class Path>
 void add_config(std::vector<Variable>& out, const std::string& prefix, const Table& table, Path path) {
   std::apply([&](const auto&... f) { (add_field(out, prefix, f, path), ...); }, table);

@@ -60,19 +60,12 @@ void check_dt(double dt);
 //! would use (validates, dt too; throws Error), and copies dt into the configs.
 void resolve_defaults(Settings& s);
 
-//! The fields of the controllers' config tables (kEftConfigFields, kRpsdConfigFields) that are
-//! not FMU parameters, and why.  Every other field is the parameter "eft.<name>" or
-//! "rpsd.<name>" (a nested struct's fields flattened: "rpsd.m_m"), with the table's unit and
-//! meaning, in table order; a field of a type the generator has no rule for does not compile.
-struct SkippedConfigField {
-  const char* name;
-  const char* reason;
-};
-inline constexpr SkippedConfigField kConfigFieldsNotInFmu[] = {
-    {"dt", "the FMU's own parameter dt (doStep sizes are whole multiples of it), copied into the config"},
-    {"plant_options", "the simulated plant's ODE integrator: a controller FMU has no plant (a plant FMU: solver.*)"},
-    {"physical_mass_fraction", "the simulated loop's plant mass: a controller FMU has no plant"},
-};
+//! The controllers' config tables (kEftConfigFields, kRpsdConfigFields) are the FMU's parameters:
+//! every field is "eft.<name>" or "rpsd.<name>" (a nested struct's fields flattened: "rpsd.m_m"),
+//! with the table's unit and meaning, in table order, but the config's dt, which is the FMU's own
+//! parameter dt (doStep sizes are whole multiples of it) copied into the config (resolve_defaults).
+//! A field of a type the generator has no rule for does not compile.  A config holds only what its
+//! controller uses, so no field is skipped (the simulated loops' own settings are loops.hpp's).
 
 //! The values a variable reads and writes: settings, inputs, outputs.
 struct Values {

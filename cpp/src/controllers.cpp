@@ -41,7 +41,6 @@ void EftConfig::validate() const {
   require_lead(lead_T, "lead_T");
   require_alpha(alpha);
   require_delay(compute_delay);
-  plant_options.validate();
 }
 
 EftController::EftController(const EftConfig& config, const Rig& model, TrackingController* tracking)
@@ -82,14 +81,11 @@ void RpsdConfig::validate() const {
   require_lead(amplitude_T, "amplitude_T");
   require_lead(delay_T, "delay_T");
   require_alpha(alpha);
-  require(std::isfinite(physical_mass_fraction) && physical_mass_fraction > 0.0, "physical_mass_fraction",
-          physical_mass_fraction, "must be finite and > 0");
   require_given(subtract_mass, "subtract_mass", false,
                 "must be finite and >= 0 when given (none = the physical mass) [kg]");
   require_given(subtract_damping, "subtract_damping", false,
                 "must be finite and >= 0 when given (none = rig c) [N s/m]");
   require_delay(compute_delay);
-  plant_options.validate();
 }
 
 namespace {

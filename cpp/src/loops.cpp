@@ -2,13 +2,15 @@
 
 #include <cmath>
 
+#include "servohydraulics/error.hpp"
+
 namespace servohydraulics {
 
 namespace {
 // Summary bookkeeping shared by the runners.
 void account(RunSummary& sum, const Output& o, double F_cap) noexcept {
   sum.flags_any |= o.flags;
-  sum.peak_force = std::fmax(sum.peak_force, std::fabs(o.force));
+  sum.peaks(o.force, o.displacement, o.velocity);
   if (sum.first_capacity_time < 0.0 && std::fabs(o.force) > F_cap) sum.first_capacity_time = o.time;
 }
 
@@ -20,15 +22,23 @@ EftConfig with_mass(const EftConfig& config, const Rig& rig) {
 }
 }  // namespace
 
+void RpsdLoopOptions::validate() const {
+  plant_options.validate();
+  require(std::isfinite(physical_mass_fraction) && physical_mass_fraction > 0.0, "physical_mass_fraction",
+          physical_mass_fraction, "must be finite and > 0");
+}
+
 EffectiveForceTest::EffectiveForceTest(const Rig& rig, const EftConfig& config, const std::optional<Rig>& model,
-                                       const LoopConverters& converters, TrackingController* tracking)
-    : ClosedLoop(Plant(rig, ControlMode::Force, config.dt, config.plant_options),
+                                       const LoopConverters& converters, TrackingController* tracking,
+                                       const EftLoopOptions& options)
+    : ClosedLoop(Plant(rig, ControlMode::Force, config.dt, (options.validate(), options.plant_options)),
                  EftController(with_mass(config, rig), model.value_or(rig), tracking), converters) {}
 
-Rig RealTimePseudoDynamicTest::physical_rig(const Rig& rig, const RpsdConfig& cfg) {
+Rig RealTimePseudoDynamicTest::physical_rig(const Rig& rig, const RpsdConfig& cfg, const RpsdLoopOptions& options) {
   cfg.validate();
+  options.validate();
   Rig r = rig;
-  r.m = cfg.physical_mass_fraction * cfg.model.m_m;
+  r.m = options.physical_mass_fraction * cfg.model.m_m;
   r.validate();
   return r;
 }
@@ -36,9 +46,11 @@ Rig RealTimePseudoDynamicTest::physical_rig(const Rig& rig, const RpsdConfig& cf
 RealTimePseudoDynamicTest::RealTimePseudoDynamicTest(const Rig& rig, const RpsdConfig& config,
                                                      const LoopConverters& converters,
                                                      TrackingController* tracking,
-                                                     NumericalSubstructure* substructure)
-    : ClosedLoop(Plant(physical_rig(rig, config), ControlMode::Displacement, config.dt, config.plant_options),
-                 RpsdController(config, physical_rig(rig, config), tracking, substructure), converters) {}
+                                                     NumericalSubstructure* substructure,
+                                                     const RpsdLoopOptions& options)
+    : ClosedLoop(Plant(physical_rig(rig, config, options), ControlMode::Displacement, config.dt,
+                       options.plant_options),
+                 RpsdController(config, physical_rig(rig, config, options), tracking, substructure), converters) {}
 
 // -------------------------------------------------------------------- runners
 
@@ -52,9 +64,10 @@ RunSummary run_rows(const Plant& p, std::size_t n, StepRow&& step_row, PlantRow&
   const double F_cap = p.dynamics().rig().F_cap;
   for (std::size_t k = 0; k < n; ++k) {
     const Status st = step_row(k);
-    account(sum, plant_row(k), F_cap);
+    const Output& row = plant_row(k);
+    account(sum, row, F_cap);
     sum.rows = k + 1;
-    if (!sum.count(st)) break;
+    if (!sum.count(st, row.time)) break;
   }
   sum.internal_steps = p.total_internal_steps() - ns0;
   sum.rhs_evals = p.total_rhs_evals() - nf0;

@@ -12,12 +12,21 @@ void put(T* dst, std::size_t k, T v) noexcept {
 }
 }  // namespace
 
-bool RunSummary::count(const Status& st) noexcept {
+bool RunSummary::count(const Status& st, double t) noexcept {
   if (st.internal_steps > max_internal_steps) max_internal_steps = st.internal_steps;
   stiff_samples += st.stiff ? 1 : 0;
   inaccurate_samples += st.inaccurate ? 1 : 0;
-  if (!st.ok()) status = st;
+  if (!st.ok()) {
+    status = st;
+    failure_time = t;
+  }
   return st.ok();
+}
+
+void RunSummary::peaks(double force, double displacement, double velocity) noexcept {
+  peak_force = std::fmax(peak_force, std::fabs(force));
+  peak_displacement = std::fmax(peak_displacement, std::fabs(displacement));
+  peak_velocity = std::fmax(peak_velocity, std::fabs(velocity));
 }
 
 RunSummary run_record(Plant& plant, const double* command, std::size_t n, const Channels& out) noexcept {
@@ -30,14 +39,15 @@ RunSummary run_record(Plant& plant, const double* command, std::size_t n, const 
     for (std::size_t i = 0; i < kNumPlantChannels; ++i) put(out.channel[i], k, o.*kPlantChannels[i].member);
     put(out.flags, k, o.flags);
     sum.flags_any |= o.flags;
-    sum.peak_force = std::fmax(sum.peak_force, std::fabs(o.force));
+    sum.peaks(o.force, o.displacement, o.velocity);
     if (sum.first_capacity_time < 0.0 && std::fabs(o.force) > F_cap) sum.first_capacity_time = o.time;
     sum.rows = k + 1;
     if (k + 1 == n) break;  // the last command is held but its effect is past the record
+    const double t = o.time;  // the row's (o becomes the next sample's)
     const Status st = plant.step(command[k], o);
     put(out.internal_steps, k, st.internal_steps);
     put(out.rhs_evals, k, st.rhs_evals);
-    if (!sum.count(st)) break;
+    if (!sum.count(st, t)) break;
   }
   sum.internal_steps = plant.total_internal_steps() - ns0;
   sum.rhs_evals = plant.total_rhs_evals() - nf0;

@@ -29,7 +29,7 @@ from xml.etree import ElementTree as ET
 import numpy as np
 
 from . import _core
-from .loops import FIELD_KEYWORDS, eft_config, rpsd_config
+from .loops import eft_config, rpsd_config
 from .response import Response
 from .rig import Rig, load_rig, rig_to_dict
 from .simulate import MODES, check_x0
@@ -190,9 +190,8 @@ def settings(kind: str) -> list[str]:
     if kind == "plant":
         return []
     maker = eft_config if kind == "eft" else rpsd_config
-    # the config fields that are not FMU parameters (fmu::kConfigFieldsNotInFmu): dt is its own argument
-    skip = {k for f in _core.FMU_CONFIG_FIELDS_SKIPPED for k in FIELD_KEYWORDS.get(f, (f,))}
-    return [p for p in inspect.signature(maker).parameters if p not in skip]
+    # every field of the controller's config (cpp/fmu/model.cpp add_config) but dt, its own argument
+    return [p for p in inspect.signature(maker).parameters if p != "dt"]
 
 
 def _configs(kind: str, dt: float | None, config: dict):

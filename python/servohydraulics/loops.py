@@ -101,7 +101,7 @@ def _optional_nonneg(name: str, v: float | None) -> float | None:
     return None if v is None else _nonneg(name, v)
 
 
-#: the keywords of eft_config / rpsd_config that set a field not of their own name
+#: the keywords of eft_config / rpsd_config and the loop options that set a field not of their own name
 FIELD_KEYWORDS = {"plant_options": ("solver_options",), "model": ("m_m", "c_m")}
 #: the config fields a name selects, by field name (the enum name tables above)
 _FIELD_CHOICES = {"compensation": COMPENSATION, "scheme": SCHEMES, "restoring_force": RESTORING_FORCE,
@@ -110,7 +110,8 @@ _FIELD_CHOICES = {"compensation": COMPENSATION, "scheme": SCHEMES, "restoring_fo
 
 def _fill(cfg, table, **values):
     """Set every field of a core config from its field table (``_core.EFT_CONFIG_FIELDS``,
-    ``RPSD_CONFIG_FIELDS``: controllers.hpp), in table order, and validate it.  ``values`` must
+    ``RPSD_CONFIG_FIELDS``: controllers.hpp; ``EFT_LOOP_OPTION_FIELDS``,
+    ``RPSD_LOOP_OPTION_FIELDS``: loops.hpp), in table order, and validate it.  ``values`` must
     name exactly the table's fields (a field added to the table and not here is a TypeError at
     every call); None keeps the core's default, a choice field takes its name, a field counted
     in samples a whole number."""
@@ -201,17 +202,27 @@ def _converters(c: _core.LoopConverters | None) -> _core.LoopConverters:
 
 
 def eft_config(dt: float | None = None, compensation: str = "linear", lead_T: float | None = None,
-               alpha: float | None = None, mass: float | None = None, compute_delay: int = 0,
-               solver_options: _core.SolverOptions | None = None) -> _core.EftConfig:
-    """The core's EftConfig (validated); a keyword left at None keeps the core's default
-    (mass: None = the rig's m).  ``solver_options`` is the field ``plant_options``."""
+               alpha: float | None = None, mass: float | None = None,
+               compute_delay: int = 0) -> _core.EftConfig:
+    """The core's EftConfig (validated): the EFT controller's settings; a keyword left at None
+    keeps the core's default (mass: None = the rig's m).  How the loop simulates the plant is
+    :func:`eft_loop_options`."""
     cfg = _core.EftConfig()
     return _fill(cfg, _core.EFT_CONFIG_FIELDS, dt=dt, mass=mass, compensation=compensation,
                  lead_T=_nonneg("lead_T", _default(lead_T, cfg, "lead_T")), alpha=alpha,
-                 compute_delay=compute_delay, plant_options=solver_options)
+                 compute_delay=compute_delay)
 
 
 _document_fields(eft_config, "EFT_CONFIG_FIELDS")
+
+
+def eft_loop_options(solver_options: _core.SolverOptions | None = None) -> _core.EftLoopOptions:
+    """The simulated EFT loop's own settings (``_core.EftLoopOptions``, loops.hpp; validated):
+    ``solver_options`` is the field ``plant_options`` (None: the core's default)."""
+    return _fill(_core.EftLoopOptions(), _core.EFT_LOOP_OPTION_FIELDS, plant_options=solver_options)
+
+
+_document_fields(eft_loop_options, "EFT_LOOP_OPTION_FIELDS")
 
 
 def run_eft(rig: Rig, ground_acceleration: ArrayLike | None = None, effective_force: ArrayLike | None = None,
@@ -251,12 +262,13 @@ def run_eft(rig: Rig, ground_acceleration: ArrayLike | None = None, effective_fo
     if (ground_acceleration is None) == (effective_force is None):
         raise ValueError("give exactly one of ground_acceleration [m/s^2] or effective_force [N]")
     opts = _renamed("options", options, "solver_options", solver_options)
-    cfg = eft_config(dt, compensation, lead_T, alpha, mass, compute_delay, opts or _solver_options())
+    cfg = eft_config(dt, compensation, lead_T, alpha, mass, compute_delay)
+    loop_options = eft_loop_options(opts or _solver_options())
     m = rig.m if cfg.mass is None else cfg.mass
     ag = (_array("ground_acceleration", ground_acceleration) if effective_force is None
           else -_array("effective_force", effective_force) / m)
     tr = _tracking(tracking)
-    test = _core.EffectiveForceTest(rig, cfg, model, _converters(converters), tr)
+    test = _core.EffectiveForceTest(rig, cfg, model, _converters(converters), tr, loop_options)
     d, s = _run_with(tr, cfg.dt, lambda: test.run(ag))
     return finish(Response(d, kind="eft", mode="force", dt=cfg.dt, rig=rig, work=s), raise_on_failure)
 
@@ -335,13 +347,13 @@ def _run_with(tracking, dt: float, run):
 def rpsd_config(dt: float | None = None, m_m: float | None = None, c_m: float | None = None,
                 k_m: float | None = None, scheme: str = "central_difference",
                 restoring_force: str = "measured_displacement", amplitude_T: float | None = None,
-                delay_T: float | None = None, alpha: float | None = None, physical_mass_fraction: float = 1.0,
-                force_measurement: str = "load_cell", subtract_mass: float | None = None,
-                subtract_damping: float | None = None, compute_delay: int = 0,
-                solver_options: _core.SolverOptions | None = None) -> _core.RpsdConfig:
-    """The core's RpsdConfig (validated); a keyword left at None keeps the core's default
-    (delay_T: 11.2 ms, or 0 for ``"calculated_displacement"``; k_m, subtract_mass,
-    subtract_damping: None = from the physical rig)."""
+                delay_T: float | None = None, alpha: float | None = None, force_measurement: str = "load_cell",
+                subtract_mass: float | None = None, subtract_damping: float | None = None,
+                compute_delay: int = 0) -> _core.RpsdConfig:
+    """The core's RpsdConfig (validated): the RPsD controller's settings; a keyword left at None
+    keeps the core's default (delay_T: 11.2 ms, or 0 for ``"calculated_displacement"``; k_m,
+    subtract_mass, subtract_damping: None = from the physical rig).  How the loop simulates the
+    plant is :func:`rpsd_loop_options`."""
     cfg = _core.RpsdConfig()
     if delay_T is None and restoring_force == "calculated_displacement":
         delay_T = 0.0
@@ -351,13 +363,24 @@ def rpsd_config(dt: float | None = None, m_m: float | None = None, c_m: float | 
                  force_measurement=force_measurement,
                  amplitude_T=_nonneg("amplitude_T", _default(amplitude_T, cfg, "amplitude_T")),
                  delay_T=_nonneg("delay_T", _default(delay_T, cfg, "delay_T")), alpha=alpha,
-                 physical_mass_fraction=physical_mass_fraction,
                  subtract_mass=_optional_nonneg("subtract_mass", subtract_mass),
                  subtract_damping=_optional_nonneg("subtract_damping", subtract_damping),
-                 compute_delay=compute_delay, plant_options=solver_options)
+                 compute_delay=compute_delay)
 
 
 _document_fields(rpsd_config, "RPSD_CONFIG_FIELDS")
+
+
+def rpsd_loop_options(physical_mass_fraction: float = 1.0,
+                      solver_options: _core.SolverOptions | None = None) -> _core.RpsdLoopOptions:
+    """The simulated RPsD loop's own settings (``_core.RpsdLoopOptions``, loops.hpp; validated):
+    the plant's structural mass is ``physical_mass_fraction`` times m_m; ``solver_options`` is
+    the field ``plant_options`` (None: the core's default)."""
+    return _fill(_core.RpsdLoopOptions(), _core.RPSD_LOOP_OPTION_FIELDS, plant_options=solver_options,
+                 physical_mass_fraction=physical_mass_fraction)
+
+
+_document_fields(rpsd_loop_options, "RPSD_LOOP_OPTION_FIELDS")
 
 
 def run_rpsd(rig: Rig, ground_acceleration: ArrayLike | None = None, external_force: ArrayLike | None = None,
@@ -425,15 +448,15 @@ def run_rpsd(rig: Rig, ground_acceleration: ArrayLike | None = None, external_fo
     pe = None if external_force is None else _array("external_force", external_force, n)
     fe = None if restoring_force_error is None else _array("restoring_force_error", restoring_force_error, n)
     cfg = rpsd_config(dt, m_m, c_m, k_m, scheme, restoring_force, amplitude_T, delay_T, alpha,
-                      physical_mass_fraction, force_measurement, subtract_mass, subtract_damping, compute_delay,
-                      opts or _solver_options())
+                      force_measurement, subtract_mass, subtract_damping, compute_delay)
+    loop_options = rpsd_loop_options(physical_mass_fraction, opts or _solver_options())
     sub = _substructure(substructure)
     tr = _tracking(tracking)
-    test = _core.RealTimePseudoDynamicTest(rig, cfg, _converters(converters), tr, sub)
+    test = _core.RealTimePseudoDynamicTest(rig, cfg, _converters(converters), tr, sub, loop_options)
     d, s = _run_with(tr, cfg.dt, lambda: test.run(ag, pe, fe))
     if isinstance(sub, _core.rths.PythonSubstructure) and sub.error:
         raise RuntimeError(f"numerical substructure failed: {sub.error}")
-    phys = _core.RealTimePseudoDynamicTest.physical_rig(rig, cfg)
+    phys = _core.RealTimePseudoDynamicTest.physical_rig(rig, cfg, loop_options)
     return finish(Response(d, kind="rpsd", mode="displacement", dt=cfg.dt, rig=phys, work=s), raise_on_failure)
 
 

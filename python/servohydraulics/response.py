@@ -85,11 +85,12 @@ def channel_units(kind: str = "record", mode: str | None = None) -> dict[str, st
 
 
 class Work(SimpleNamespace):
-    """The run's summary counts, copied from the core's ``RunSummary`` (so a
-    Response pickles): ``rows``, ``internal_steps``, ``rhs_evals``, ``restarts``,
-    ``max_internal_steps``, ``flags_any``, ``peak_force`` [N],
-    ``first_capacity_time`` [s], and ``status`` (``ok``, ``code``, ``message``,
-    ``t`` [s], ``cvode_flag``, ...), whatever fields the core exports."""
+    """The run's summary counts, copied from the core's ``RunSummary`` (record.hpp: every
+    loop's, the RTHS loop's too; so a Response pickles): ``ok``, ``rows``, ``internal_steps``,
+    ``rhs_evals``, ``restarts``, ``max_internal_steps``, ``flags_any``, ``peak_force`` [N],
+    ``peak_displacement`` [m], ``peak_velocity`` [m/s], ``failure_time`` [s] (-1: none),
+    ``first_capacity_time`` [s], and ``status`` (``ok``, ``code``, ``message``, ``t`` [s],
+    ``cvode_flag``, ...), whatever fields the core exports."""
 
     @classmethod
     def from_core(cls, summary: Any) -> Work:
@@ -212,7 +213,7 @@ class Response:
         message: ``"ok"`` or what failed, when and why.
         work: the run's summary counts (:class:`Work`, from the core's
             ``RunSummary``: rows, internal steps, rhs evaluations, restarts,
-            peak force, status); None for a record.
+            peak force, displacement and velocity, failure time, status); None for a record.
         path: the file of a record, else None.
     """
 

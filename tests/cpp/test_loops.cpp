@@ -98,10 +98,11 @@ static void loops_do_not_allocate() {
   const Rig rig = zhao2003();
   for (auto method : {SolverOptions::Method::CvodeBdf, SolverOptions::Method::Rk4}) {
     EftConfig ec;
-    ec.plant_options.method = method;
+    EftLoopOptions eo_options;
+    eo_options.plant_options.method = method;
     ec.compensation = VelocityFeedbackCompensator::Kind::Nonlinear;
     ec.compute_delay = 1;
-    EffectiveForceTest eft(rig, ec);
+    EffectiveForceTest eft(rig, ec, std::nullopt, {}, nullptr, eo_options);
     EftOutput eo;
     std::vector<EftOutput> rows(2000);
     std::vector<double> ag(2000);
@@ -118,11 +119,12 @@ static void loops_do_not_allocate() {
     for (auto rf : {RestoringForce::CalculatedDisplacement, RestoringForce::MeasuredDisplacement,
                     RestoringForce::MeasuredForce, RestoringForce::MeasuredForceCorrected}) {
       RpsdConfig rc;
-      rc.plant_options.method = method;
+      RpsdLoopOptions ro_options;
+      ro_options.plant_options.method = method;
       rc.restoring_force = rf;
       rc.scheme = rf == RestoringForce::MeasuredForce ? IntegrationScheme::ExplicitNewmark : IntegrationScheme::CentralDifference;
       rc.compute_delay = 1;
-      RealTimePseudoDynamicTest rp(rig, rc);
+      RealTimePseudoDynamicTest rp(rig, rc, {}, nullptr, nullptr, ro_options);
       RpsdOutput ro;
       std::vector<RpsdOutput> rrows(2000);
       rp.step(0.0, 100.0, 0.0, ro);

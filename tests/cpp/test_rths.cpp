@@ -257,13 +257,12 @@ void no_allocation() {
   RpsdConfig rc;
   SolverOptions rk4;
   rk4.method = SolverOptions::Method::Rk4;
-  rc.plant_options = rk4;
-  RealTimePseudoDynamicTest rpsd(zhao2003(), rc, lc);
+  RealTimePseudoDynamicTest rpsd(zhao2003(), rc, lc, nullptr, nullptr, RpsdLoopOptions{rk4});
   std::vector<RpsdOutput> rows(2000);
   std::vector<double> ag(2000);
   for (std::size_t i = 0; i < ag.size(); ++i) ag[i] = std::sin(0.01 * static_cast<double>(i));
   long counts[4] = {0, 0, 0, 0};
-  RthsSummary sum;
+  RunSummary sum;
   RunSummary rs;
   {
     sh_test::AllocationCounter counter;
@@ -291,7 +290,7 @@ void no_allocation() {
   std::printf("allocations: controllers %ld, plant+substructures %ld, RthsLoop.run %ld, RPsD with converters %ld\n",
               counts[0], counts[1], counts[2], counts[3]);
   CHECK(counts[0] == 0 && counts[1] == 0 && counts[2] == 0 && counts[3] == 0);
-  CHECK(sum.ok && sum.rows == n);
+  CHECK(sum.ok() && sum.rows == n);
   CHECK(rs.status.ok() && rs.rows == ag.size());
 }
 }  // namespace

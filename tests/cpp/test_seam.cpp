@@ -76,16 +76,17 @@ void rpsd_seam(IntegrationScheme scheme, RestoringForce rf, ForceMeasurement fm,
   cfg.scheme = scheme;
   cfg.restoring_force = rf;
   cfg.force_measurement = fm;
-  cfg.physical_mass_fraction = fraction;
   const auto ag = ground_motion(1.0, 1.1, cfg.dt);
   std::vector<double> pe(kN), fe(kN);
   for (std::size_t k = 0; k < kN; ++k) pe[k] = 2e3 * std::min(1.0, k * cfg.dt), fe[k] = 50.0 * std::cos(0.01 * k);
-  RealTimePseudoDynamicTest loop(rig, cfg);
+  RpsdLoopOptions options;
+  options.physical_mass_fraction = fraction;
+  RealTimePseudoDynamicTest loop(rig, cfg, {}, nullptr, nullptr, options);
   std::vector<RpsdOutput> rows(kN);
   const RunSummary sum = run_rpsd(loop, ag.data(), pe.data(), fe.data(), kN, rows.data());
   CHECK(sum.status.ok() && sum.rows == kN);
 
-  const Rig physical = RealTimePseudoDynamicTest::physical_rig(rig, cfg);
+  const Rig physical = RealTimePseudoDynamicTest::physical_rig(rig, cfg, options);
   RpsdController ctrl(cfg, physical);
   Plant plant(physical, ControlMode::Displacement, cfg.dt);
   std::size_t solver_mismatches = 0;

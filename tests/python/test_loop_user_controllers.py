@@ -83,3 +83,101 @@ def test_a_python_controller_error_stops_the_loop_naming_the_sample(run):
 def test_not_a_controller_is_named():
     with pytest.raises(ValueError, match="invalid tracking"):
         sh.run_rpsd(sh.zhao2003(), ground_motion(), tracking=object())
+
+
+# ------------------------------------------------------------- the two optional inputs
+class PaperVelocityFeedback:
+    """The paper's linear velocity feedback compensation (Eqs 9-10) written in Python from the
+    measured velocity: du = A H(v) / (K_v K_s C_F G_p), H the phase lead (T_d-hat = 5 ms,
+    alpha = 0.1; its discrete coefficients from the core's PhaseLead), command = P_eff + du.
+    It also keeps the measured pressures it was given."""
+
+    def __init__(self, rig, dt):
+        cfg = sh.loops.eft_config()
+        lead = sh._core.PhaseLead(cfg.lead_T, cfg.alpha, dt)
+        self.b0, self.b1, self.a1 = lead.b0, lead.b1, lead.a1
+        self.A, self.Kf = rig.A, rig.K_v * (rig.K_s * rig.C_F_force * rig.G_p)
+        self.pressures, self.velocities = [], []
+
+    def reset(self):
+        self.u1 = self.y1 = 0.0
+        self.pressures, self.velocities = [], []
+
+    def command(self, desired, desired_velocity, desired_acceleration, measured, measured_force, *,
+                measured_velocity, measured_pressure):
+        v = self.b0 * measured_velocity + self.b1 * self.u1 - self.a1 * self.y1
+        self.u1, self.y1 = measured_velocity, v
+        self.velocities.append(measured_velocity)
+        self.pressures.append(measured_pressure)
+        return desired + self.A * v / self.Kf
+
+
+class PaperVelocityFeedbackSubclass(rths.TrackingController):
+    """The same through the TrackingController subclass (the trampoline), taking **kwargs."""
+
+    def __init__(self, rig, dt):
+        super().__init__()
+        self.impl = PaperVelocityFeedback(rig, dt)
+
+    def reset(self):
+        self.impl.reset()
+
+    def command(self, desired, desired_velocity, desired_acceleration, measured, measured_force, **inputs):
+        return self.impl.command(desired, desired_velocity, desired_acceleration, measured, measured_force, **inputs)
+
+
+@pytest.mark.parametrize("controller", [PaperVelocityFeedback, PaperVelocityFeedbackSubclass])
+def test_a_python_velocity_feedback_from_measured_velocity_is_the_builtin_eft(controller):
+    """Oracle: the built-in VelocityFeedbackTracking (sh.run_eft's default, linear) to the bit; the
+    measured velocity and pressure a controller receives are the rows' sensors to the bit."""
+    rig, ag = sh.zhao2003(), ground_motion()
+    ref = sh.run_eft(rig, ag)
+    c = controller(rig, sh.loops.eft_config().dt)
+    res = sh.run_eft(rig, ag, tracking=c)
+    for ch in ("command", "force", "displacement", "velocity", "pressure"):
+        np.testing.assert_array_equal(res.channels[ch], ref.channels[ch], err_msg=ch)
+    impl = getattr(c, "impl", c)
+    np.testing.assert_array_equal(impl.velocities, ref.channels["velocity"])
+    np.testing.assert_array_equal(impl.pressures, ref.channels["pressure"])
+    assert np.max(np.abs(ref.pressure)) > 1e5 and np.max(np.abs(ref.velocity)) > 1e-4  # inputs that matter
+    # and the compensation is not a pass-through: the oracle can fail
+    none = sh.run_eft(rig, ag, compensation="none")
+    assert np.max(np.abs(none.channels["command"] - ref.channels["command"])) > 1.0
+
+
+class OnlyVelocity:
+    def reset(self):
+        self.seen = []
+
+    def command(self, desired, desired_velocity, desired_acceleration, measured, measured_force,
+                measured_velocity=None):
+        self.seen.append(measured_velocity)
+        return desired
+
+
+class AnyKeywords:
+    def reset(self):
+        self.seen = []
+
+    def command(self, *args, **kwargs):
+        self.seen.append((len(args), sorted(kwargs)))
+        return args[0]
+
+
+@pytest.mark.parametrize("obj, keywords", [(PassThrough(), ()), (OnlyVelocity(), ("measured_velocity",)),
+                                           (AnyKeywords(), ("measured_velocity", "measured_pressure")),
+                                           (Failing(), ())])
+def test_the_optional_inputs_follow_the_signature(obj, keywords):
+    """Decided once from command()'s signature: the five positional inputs always, each optional
+    input as a keyword only if command() names it or takes **kwargs (a five-argument or *args
+    class gets five, as before)."""
+    wrapped = sh._core.rths.PythonController(obj)
+    assert wrapped.keywords == keywords
+    if isinstance(obj, Failing):
+        return
+    res = sh.run_eft(sh.zhao2003(), ground_motion(200), compensation="none", tracking=obj)
+    assert res.success
+    if isinstance(obj, OnlyVelocity):
+        np.testing.assert_array_equal(obj.seen, res.channels["velocity"])
+    if isinstance(obj, AnyKeywords):
+        assert obj.seen == [(5, ["measured_pressure", "measured_velocity"])] * 200

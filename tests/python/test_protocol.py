@@ -33,9 +33,13 @@ def configs():
     r.k_m = 6e5
     r.scheme = _core.IntegrationScheme.ExplicitNewmark
     r.model = _core.ModelSDOF(140.0, 100.0)
-    r.plant_options.method = _core.SolverOptions.Method.Rk4
+    o = _core.RpsdLoopOptions()
+    o.plant_options.method = _core.SolverOptions.Method.Rk4
+    o.physical_mass_fraction = 0.02
+    eo = _core.EftLoopOptions()
+    eo.plant_options.rtol = 1e-9
     return [changed_rig(), changed_rig().effects, changed_rig().flow_curve, e, r, _core.ModelSDOF(1.0, 2.0),
-            r.plant_options]
+            o.plant_options, o, eo]
 
 
 @pytest.mark.parametrize("obj", configs(), ids=lambda o: type(o).__name__)

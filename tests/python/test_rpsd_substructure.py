@@ -158,8 +158,8 @@ def test_the_papers_amplitude_lead_runs_in_the_rths_loop():
         exp = R.BenchmarkPlant(plant, rths.DT)
         num = R.LinearSubstructure(rths.partition(case, exp.specimen()), rths.DT, R.SubstructureScheme.RungeKutta4)
         loop = R.RthsLoop(exp, num, _core.AmplitudeLead(T, 0.1, rths.DT), R.RthsLoopConfig())
-        out = loop.run(num, R.GroundMotion(rec.time, rec.acceleration, 1.0), rec.samples(), False)
-        assert out["ok"]
+        out, summary = loop.run(num, R.GroundMotion(rec.time, rec.acceleration, 1.0), rec.samples(), False)
+        assert summary.ok()
         d, x = np.asarray(out["numerical"])[:, 0], np.asarray(out["measured"])
         lags = np.arange(0, 400)
         delays[T] = lags[int(np.argmax([np.dot(d[: d.size - m], x[m:]) for m in lags]))] * rths.DT

@@ -54,8 +54,9 @@ def test_the_response_is_the_loops_output_to_the_bit(short):
     num = R.LinearSubstructure(rths.partition(case, exp.specimen()), rths.DT, R.SubstructureScheme.RungeKutta4)
     cfg = R.RthsLoopConfig()
     cfg.seed, cfg.generator = 3, R.NoiseGenerator.SimulinkRandomNumber
-    out = R.RthsLoop(exp, num, rths.make_controller("sample"), cfg).run(
+    out, summary = R.RthsLoop(exp, num, rths.make_controller("sample"), cfg).run(
         num, R.GroundMotion(rec.time, rec.acceleration, rths.EQ_INTENSITY), rec.samples(), False)
+    assert isinstance(summary, _core.RunSummary) and summary.ok() and summary.rows == rec.samples()
     res = t.response
     for name, _ in R.RTHS_CHANNELS:
         np.testing.assert_array_equal(res.channels[name], out[name], err_msg=name)
@@ -103,3 +104,6 @@ def test_without_keep_signals_there_is_no_response_and_a_failure_is_said():
     assert not bad.ok and not res.success and res.status == "non_finite" and len(res) == 6
     assert res.message.startswith(f"RTHS failed at t = {5 * rths.DT:.6g} s")
     assert res.to_pandas().shape[0] == 6 and res.work.failure_time == 5 * rths.DT
+    # the core's RunSummary, as every loop's (test_run_summary.py): the failure at the loop's sample time
+    assert not res.work.ok and res.work.status.t == res.work.failure_time and res.work.rows == 6
+    assert bad.failure_time == res.work.failure_time and bad.max_force_N == res.work.peak_force

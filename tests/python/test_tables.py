@@ -95,10 +95,15 @@ def test_cli_accepts_and_lists_every_method(capsys):
 
 
 # ----------------------------------------------------------------- the loop configs' field tables
-#: (config class, its field table, the FMU's prefix, the Python builder)
+#: (config class, its field table, the Python builder): the controllers' configs (controllers.hpp)
 CONFIGS = {
     "eft": (_core.EftConfig, _core.EFT_CONFIG_FIELDS, loops.eft_config),
     "rpsd": (_core.RpsdConfig, _core.RPSD_CONFIG_FIELDS, loops.rpsd_config),
+}
+#: the simulated loops' own settings (loops.hpp), by the same kinds
+LOOP_OPTIONS = {
+    "eft": (_core.EftLoopOptions, _core.EFT_LOOP_OPTION_FIELDS, loops.eft_loop_options),
+    "rpsd": (_core.RpsdLoopOptions, _core.RPSD_LOOP_OPTION_FIELDS, loops.rpsd_loop_options),
 }
 #: the Python keywords of a field whose keyword is not its name (the signatures predate the tables)
 KEYWORDS = {"plant_options": ["solver_options"], "model": [n for n, _, _ in _core.MODEL_SDOF_FIELDS]}
@@ -109,13 +114,29 @@ def _writable(cls) -> list[str]:
     return sorted(n for n in dir(cls) if isinstance(getattr(cls, n), property) and getattr(cls, n).fset is not None)
 
 
+def _keywords(table) -> list[str]:
+    return [k for n, _, _ in table for k in KEYWORDS.get(n, [n])]
+
+
 @pytest.mark.parametrize("kind", CONFIGS)
 def test_config_table_is_the_bindings_attributes(kind):
-    """Every field of kEftConfigFields / kRpsdConfigFields is a read-write attribute of the
-    binding's config, and the config has no other (the same for ModelSDOF's table)."""
-    cls, table, _ = CONFIGS[kind]
-    assert _writable(cls) == sorted(n for n, _, _ in table)
+    """Every field of kEftConfigFields / kRpsdConfigFields (and of the loops' kEftLoopOptionFields /
+    kRpsdLoopOptionFields) is a read-write attribute of the binding's class, and the class has no
+    other (the same for ModelSDOF's table)."""
+    for cls, table, _ in (CONFIGS[kind], LOOP_OPTIONS[kind]):
+        assert _writable(cls) == sorted(n for n, _, _ in table)
     assert _writable(_core.ModelSDOF) == sorted(n for n, _, _ in _core.MODEL_SDOF_FIELDS)
+
+
+def test_a_controller_config_holds_no_simulation_field():
+    """The controllers' configs and the simulated loops' options share no field: a plant's
+    integrator or mass is not a real-time controller's setting."""
+    for kind in CONFIGS:
+        config = {n for n, _, _ in CONFIGS[kind][1]}
+        options = {n for n, _, _ in LOOP_OPTIONS[kind][1]}
+        assert not config & options, kind
+        assert "plant_options" in options and "plant_options" not in config
+    assert "physical_mass_fraction" in {n for n, _, _ in _core.RPSD_LOOP_OPTION_FIELDS}
 
 
 def _fmu_parameters(kind: str) -> list[dict]:
@@ -127,15 +148,13 @@ def _fmu_parameters(kind: str) -> list[dict]:
 @pytest.mark.parametrize("kind", CONFIGS)
 def test_config_table_is_the_fmus_parameters(kind):
     """The controller FMU's "<kind>.*" parameters are the table's fields in table order (a nested
-    struct's fields flattened: rpsd.m_m), with the table's unit and meaning, less exactly the
-    fields _core.FMU_CONFIG_FIELDS_SKIPPED names with a reason (cpp/fmu/model.hpp)."""
+    struct's fields flattened: rpsd.m_m), with the table's unit and meaning, every field but dt,
+    which is the FMU's own parameter "dt" (cpp/fmu/model.cpp add_field): no field is skipped."""
     _, table, _ = CONFIGS[kind]
-    skipped = _core.FMU_CONFIG_FIELDS_SKIPPED
-    all_fields = {n for t in (_core.EFT_CONFIG_FIELDS, _core.RPSD_CONFIG_FIELDS) for n, _, _ in t}
-    assert set(skipped) <= all_fields and all(skipped.values())  # no stale rule, each says why
+    assert not hasattr(_core, "FMU_CONFIG_FIELDS_SKIPPED")  # no skip list
     expected = []
     for name, unit, meaning in table:
-        if name in skipped:
+        if name == "dt":
             continue
         rows = _core.MODEL_SDOF_FIELDS if name == "model" else [(name, unit, meaning)]
         expected += [(f"{kind}.{n}", u, m) for n, u, m in rows]
@@ -148,7 +167,7 @@ def test_config_table_is_the_fmus_parameters(kind):
     from servohydraulics import fmu
 
     assert sorted(n.split(".", 1)[1] for n, _, _ in expected) == sorted(fmu.settings(kind))
-    # the skipped fields: dt is the FMU's own parameter; the plant's are not a controller's
+    # dt: the FMU's own parameter, copied into the config
     assert "dt" in {x["name"] for x in _core.fmu_variables(kind, "displacement", sh.zhao2003(), 5e-4, 0.0,
                                                            _core.SolverOptions(), _core.EftConfig(),
                                                            _core.RpsdConfig())}
@@ -156,20 +175,14 @@ def test_config_table_is_the_fmus_parameters(kind):
 
 @pytest.mark.parametrize("kind", CONFIGS)
 def test_config_table_is_the_python_keywords(kind):
-    """eft_config / rpsd_config (and run_eft / run_rpsd, the controllers less the plant's fields)
-    take one keyword per field of the table; a keyword set to a non-default value changes exactly
-    its field; a field added to the table and not to the builder fails every call."""
-    cls, table, build = CONFIGS[kind]
-    keywords = [k for n, _, _ in table for k in KEYWORDS.get(n, [n])]
-    assert sorted(inspect.signature(build).parameters) == sorted(keywords)
+    """eft_config / rpsd_config (and the controllers) take one keyword per field of the config's
+    table, eft_loop_options / rpsd_loop_options one per field of the loop's; run_eft / run_rpsd
+    take both; a keyword set to a non-default value changes exactly its field; a field added to a
+    table and not to the builder fails every call."""
     run = {"eft": sh.run_eft, "rpsd": sh.run_rpsd}[kind]
-    assert set(keywords) <= set(inspect.signature(run).parameters)
     ctrl = {"eft": sh.EftController, "rpsd": sh.RpsdController}[kind]
-    plant_only = {"solver_options", "physical_mass_fraction"}
-    assert set(keywords) - plant_only <= set(inspect.signature(ctrl).parameters)
-    for name, unit, _ in table:
-        assert f"{name} [{unit}]" in build.__doc__ if unit else f"    {name}: " in build.__doc__
-        assert f"    {name}" in ctrl.__doc__
+    config_keywords = _keywords(CONFIGS[kind][1])
+    assert sorted(set(inspect.signature(ctrl).parameters) - {"rig"}) == sorted(config_keywords)
     opts = _core.SolverOptions()
     opts.rtol = 1e-9
     changed = {"dt": 1e-3, "mass": 100.0, "compensation": "nonlinear", "lead_T": 0.01, "alpha": 0.2,
@@ -177,11 +190,19 @@ def test_config_table_is_the_python_keywords(kind):
                "scheme": "explicit_newmark", "restoring_force": "measured_force",
                "force_measurement": "actuator_pressure", "amplitude_T": 0.05, "delay_T": 0.01,
                "physical_mass_fraction": 0.5, "subtract_mass": 10.0, "subtract_damping": 5.0}
-    default = build()
-    for name, _, _ in table:
-        cfg = build(**{k: changed[k] for k in KEYWORDS.get(name, [name])})
-        differs = [n for n, _, _ in table if getattr(cfg, n) != getattr(default, n)]
-        assert differs == [name], (name, differs)
+    for _, table, build in (CONFIGS[kind], LOOP_OPTIONS[kind]):
+        keywords = _keywords(table)
+        assert sorted(inspect.signature(build).parameters) == sorted(keywords)
+        assert set(keywords) <= set(inspect.signature(run).parameters)
+        for name, unit, _ in table:
+            assert f"{name} [{unit}]" in build.__doc__ if unit else f"    {name}: " in build.__doc__
+        default = build()
+        for name, _, _ in table:
+            cfg = build(**{k: changed[k] for k in KEYWORDS.get(name, [name])})
+            differs = [n for n, _, _ in table if getattr(cfg, n) != getattr(default, n)]
+            assert differs == [name], (name, differs)
+    for name, _, _ in CONFIGS[kind][1]:
+        assert f"    {name}" in ctrl.__doc__
 
 
 def test_a_field_added_to_the_table_fails_the_python_builders(monkeypatch):
@@ -192,3 +213,8 @@ def test_a_field_added_to_the_table_fails_the_python_builders(monkeypatch):
     monkeypatch.setattr(_core, "RPSD_CONFIG_FIELDS", [*_core.RPSD_CONFIG_FIELDS, extra])
     with pytest.raises(TypeError, match="new_field"):
         loops.rpsd_config()
+    for table, build in (("EFT_LOOP_OPTION_FIELDS", loops.eft_loop_options),
+                         ("RPSD_LOOP_OPTION_FIELDS", loops.rpsd_loop_options)):
+        monkeypatch.setattr(_core, table, [*getattr(_core, table), extra])
+        with pytest.raises(TypeError, match="new_field"):
+            build()

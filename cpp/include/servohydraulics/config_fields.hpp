@@ -1,10 +1,11 @@
 // A config's field table: name, unit, meaning and member of every field of a
-// loop configuration (EftConfig, RpsdConfig; controllers.hpp).  The fields have
+// loop configuration (EftConfig, RpsdConfig; controllers.hpp; the simulated loops'
+// EftLoopOptions, RpsdLoopOptions; loops.hpp).  The fields have
 // different types, so a table is a std::tuple of ConfigField<Config, T>; the
 // binding reads it for def_readwrite, the protocol's field list and the
 // <NAME>_CONFIG_FIELDS table Python sees (loops.eft_config / rpsd_config set
 // every field through it), and the controller FMUs' parameters are generated
-// from it (cpp/fmu/model.cpp add_config; fmu::kConfigFieldsNotInFmu the exceptions).
+// from the controllers' (cpp/fmu/model.cpp add_config; dt is the FMU's own parameter).
 #pragma once
 
 #include <tuple>

@@ -9,7 +9,9 @@
 //
 // Construct once (validates, throws Error, allocates the compute-delay buffer);
 // reset() and command() are noexcept and allocation-free.  The simulated loops
-// of loops.hpp are a controller composed with a Plant.
+// of loops.hpp are a controller composed with a Plant.  A config holds only what
+// its controller uses: how the loops simulate the plant (its ODE integrator, the
+// RPsD plant's mass) is their own EftLoopOptions / RpsdLoopOptions (loops.hpp).
 //
 // Symbols of the phase-lead time constants: Table I and the text of the paper
 // swap T_d and T_ld.  We follow the text: T_d = 68 ms is the amplitude
@@ -42,7 +44,6 @@ struct EftConfig {
   double lead_T = Zhao2003TestMethods{}.eft_lead_T;  //!< phase lead on the compensation [s]; 0 = none
   double alpha = Zhao2003TestMethods{}.alpha;        //!< phase-lead constant (Table I)
   int compute_delay = 0;  //!< samples of compute delay on the command (0 or 1 usually)
-  SolverOptions plant_options;  //!< the simulated plant's ODE integrator (loops.hpp only)
   void validate() const;
 };
 
@@ -53,8 +54,7 @@ inline constexpr auto kEftConfigFields = std::make_tuple(
     config_field("compensation", "", "velocity feedback compensation: none, linear, nonlinear", &EftConfig::compensation),
     config_field("lead_T", "s", "phase lead on the compensation (0: none)", &EftConfig::lead_T),
     config_field("alpha", "-", "phase-lead constant", &EftConfig::alpha),
-    config_field("compute_delay", "samples", "compute delay on the command", &EftConfig::compute_delay),
-    config_field("plant_options", "", "the simulated plant's ODE integrator (loops only)", &EftConfig::plant_options));
+    config_field("compute_delay", "samples", "compute delay on the command", &EftConfig::compute_delay));
 
 //! Every channel of one EFT sample.
 struct EftOutput {
@@ -83,7 +83,7 @@ class EftController {
  public:
   //! model: the controller's model of the rig, used by the compensator (A, K_v,
   //! K_s, C_F_force, G_p, flow curve and pressure factor) and, when
-  //! config.mass is none, for m in P_eff = -m a_g.  config.plant_options is unused.
+  //! config.mass is none, for m in P_eff = -m a_g.
   //! tracking: a compensator in place of the paper's (not owned; must outlive the
   //! controller); nullptr = VelocityFeedbackTracking of config.compensation.
   EftController(const EftConfig& config, const Rig& model, TrackingController* tracking = nullptr);
@@ -146,11 +146,9 @@ struct RpsdConfig {
   double amplitude_T = Zhao2003TestMethods{}.amplitude_T;  //!< amplitude compensation T_d on the command [s]; 0 = none
   double delay_T = Zhao2003TestMethods{}.delay_T;  //!< delay compensation T_ld on the restoring force [s]; 0 = none
   double alpha = Zhao2003TestMethods{}.alpha;      //!< phase-lead constant of both networks
-  double physical_mass_fraction = 1.0;  //!< simulation (loops.hpp): the plant's structural mass = fraction * m_m
   std::optional<double> subtract_mass;  //!< (d): mass times measured acceleration removed [kg]; none = the physical mass behind the force measurement
   std::optional<double> subtract_damping;  //!< (d): damping times measured velocity removed [N s/m]; none = the physical rig's c
   int compute_delay = 0;                //!< samples of compute delay on the command
-  SolverOptions plant_options;          //!< the simulated plant's ODE integrator (loops.hpp only)
   void validate() const;
 };
 
@@ -165,13 +163,10 @@ inline constexpr auto kRpsdConfigFields = std::make_tuple(
     config_field("amplitude_T", "s", "amplitude compensation T_d on the command (0: none)", &RpsdConfig::amplitude_T),
     config_field("delay_T", "s", "delay compensation T_ld on the restoring force (0: none)", &RpsdConfig::delay_T),
     config_field("alpha", "-", "phase-lead constant of both networks", &RpsdConfig::alpha),
-    config_field("physical_mass_fraction", "-", "simulation: the plant's structural mass / m_m",
-                 &RpsdConfig::physical_mass_fraction),
     config_field("subtract_mass", "kg", "(d): mass times measured acceleration removed", &RpsdConfig::subtract_mass),
     config_field("subtract_damping", "N s/m", "(d): damping times measured velocity removed",
                  &RpsdConfig::subtract_damping),
-    config_field("compute_delay", "samples", "compute delay on the command", &RpsdConfig::compute_delay),
-    config_field("plant_options", "", "the simulated plant's ODE integrator (loops only)", &RpsdConfig::plant_options));
+    config_field("compute_delay", "samples", "compute delay on the command", &RpsdConfig::compute_delay));
 
 //! Every channel of one RPsD sample.
 struct RpsdOutput {
@@ -213,7 +208,6 @@ class RpsdController {
   //! the load cell).  The controller reads from it only what its defaults need:
   //! k (k_m), m, m_p and effects.piston_mass (subtract_mass), c
   //! (subtract_damping) and A (force from the actuator pressure, p A).
-  //! config.physical_mass_fraction and plant_options are unused here.
   //! tracking: a compensator in place of the paper's amplitude lead (not owned; must
   //! outlive the controller); nullptr = AmplitudeLead(amplitude_T, alpha, dt).
   //! substructure: the numerical substructure in place of Eq (15)'s 1-DOF model (not owned;

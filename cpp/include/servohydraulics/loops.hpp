@@ -19,6 +19,7 @@
 #include <optional>
 #include <utility>
 
+#include "servohydraulics/config_fields.hpp"
 #include "servohydraulics/controllers.hpp"
 #include "servohydraulics/loop_converters.hpp"
 #include "servohydraulics/plant.hpp"
@@ -69,6 +70,30 @@ class ClosedLoop {
 };
 
 // ---------------------------------------------------------------------------
+// The simulated loops' own settings: how the plant is simulated.  Not the
+// controller's (a laboratory's controller config, controllers.hpp, has none of
+// them); each has its field table like the configs (the binding's attributes,
+// _core.EFT_LOOP_OPTION_FIELDS / RPSD_LOOP_OPTION_FIELDS, sh.run_eft / run_rpsd's keywords).
+// ---------------------------------------------------------------------------
+
+struct EftLoopOptions {
+  SolverOptions plant_options;  //!< the simulated plant's ODE integrator
+  void validate() const { plant_options.validate(); }
+};
+inline constexpr auto kEftLoopOptionFields = std::make_tuple(
+    config_field("plant_options", "", "the simulated plant's ODE integrator", &EftLoopOptions::plant_options));
+
+struct RpsdLoopOptions {
+  SolverOptions plant_options;          //!< the simulated plant's ODE integrator
+  double physical_mass_fraction = 1.0;  //!< the plant's structural mass = fraction * m_m (substructuring)
+  void validate() const;
+};
+inline constexpr auto kRpsdLoopOptionFields = std::make_tuple(
+    config_field("plant_options", "", "the simulated plant's ODE integrator", &RpsdLoopOptions::plant_options),
+    config_field("physical_mass_fraction", "-", "the plant's structural mass / m_m",
+                 &RpsdLoopOptions::physical_mass_fraction));
+
+// ---------------------------------------------------------------------------
 // Effective force testing (force control, Fig 1a)
 // ---------------------------------------------------------------------------
 
@@ -79,8 +104,10 @@ class EffectiveForceTest : public ClosedLoop<EftController> {
   //! (the plant's, whatever the model).
   //! converters: the optional sensor and converter blocks (loop_converters.hpp; off by default).
   //! tracking: as EftController's (not owned; nullptr = the paper's velocity feedback compensation).
+  //! options: how the plant is simulated (its ODE integrator).
   EffectiveForceTest(const Rig& rig, const EftConfig& config, const std::optional<Rig>& model = std::nullopt,
-                     const LoopConverters& converters = {}, TrackingController* tracking = nullptr);
+                     const LoopConverters& converters = {}, TrackingController* tracking = nullptr,
+                     const EftLoopOptions& options = {});
 
   Status step(double ground_acceleration, EftOutput& out) noexcept {
     return ClosedLoop::step(out, ground_acceleration);
@@ -96,11 +123,13 @@ class EffectiveForceTest : public ClosedLoop<EftController> {
 
 class RealTimePseudoDynamicTest : public ClosedLoop<RpsdController> {
  public:
-  //! rig: the physical test (its m is replaced by physical_mass_fraction * m_m).
+  //! rig: the physical test (its m is replaced by options.physical_mass_fraction * m_m).
   //! converters: the optional sensor and converter blocks (loop_converters.hpp; off by default).
   //! tracking, substructure: as RpsdController's (not owned; nullptr = the paper's).
+  //! options: how the plant is simulated (its ODE integrator, its mass).
   RealTimePseudoDynamicTest(const Rig& rig, const RpsdConfig& config, const LoopConverters& converters = {},
-                            TrackingController* tracking = nullptr, NumericalSubstructure* substructure = nullptr);
+                            TrackingController* tracking = nullptr, NumericalSubstructure* substructure = nullptr,
+                            const RpsdLoopOptions& options = {});
 
   //! ground_acceleration [m/s^2], external_force into the solver [N], restoring_force_error added to f [N].
   Status step(double ground_acceleration, double external_force, double restoring_force_error,
@@ -108,8 +137,8 @@ class RealTimePseudoDynamicTest : public ClosedLoop<RpsdController> {
     return ClosedLoop::step(out, ground_acceleration, external_force, restoring_force_error);
   }
 
-  //! The rig the plant simulates: rig with m = physical_mass_fraction * m_m (validated).
-  static Rig physical_rig(const Rig& rig, const RpsdConfig& config);
+  //! The rig the plant simulates: rig with m = options.physical_mass_fraction * config.model.m_m (validated).
+  static Rig physical_rig(const Rig& rig, const RpsdConfig& config, const RpsdLoopOptions& options = {});
 
   const RpsdConfig& config() const noexcept { return controller_.config(); }
   const IntegratorState& integrator_state() const noexcept { return controller_.integrator_state(); }

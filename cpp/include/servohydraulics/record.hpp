@@ -28,11 +28,15 @@ struct Channels {
   double* operator[](Channel c) const noexcept { return channel[static_cast<std::size_t>(c)]; }
 };
 
-//! What a run did.
+//! What a run did: the summary of every whole-record run (run_record, run_eft, run_rpsd and
+//! rths::RthsLoop::run), filled alike where a field means something for the loop.
 struct RunSummary {
   //! Counts one sample's status: the largest work, the stiff and the inaccurate samples, and a
-  //! failure (kept in status).  Returns st.ok().
-  bool count(const Status& st) noexcept;
+  //! failure (kept in status, its row's time t in failure_time).  Returns st.ok().
+  bool count(const Status& st, double t) noexcept;
+  //! Takes one row's peaks: |force|, |displacement|, |velocity|.
+  void peaks(double force, double displacement, double velocity) noexcept;
+  bool ok() const noexcept { return status.ok(); }  //!< ran every sample without a failure
 
   Status status;                  //!< the first failure, or Ok
   std::size_t rows = 0;           //!< rows written (n on success)
@@ -43,8 +47,12 @@ struct RunSummary {
   long stiff_samples = 0;         //!< samples the default pair found stiff and CVODE integrated (Status::stiff)
   long inaccurate_samples = 0;    //!< Rk4 samples whose error estimate exceeded the tolerance (Status::inaccurate)
   std::uint32_t flags_any = 0;    //!< OR of every row's OutputFlag bits
-  double peak_force = 0.0;        //!< max |load-cell force| [N]
-  double first_capacity_time = -1.0;  //!< first time |force| > F_cap [s], -1 if never
+  //! max |force| [N]: the load cell (run_record, EFT, RPsD), the actuator force Force_act (RTHS)
+  double peak_force = 0.0;
+  double peak_displacement = 0.0;  //!< max |displacement| [m]: the plant's x (RTHS: the specimen's X_int)
+  double peak_velocity = 0.0;      //!< max |velocity| [m/s]: the plant's v (RTHS: the specimen's x')
+  double failure_time = -1.0;      //!< time of the row whose sample failed [s], -1 if none
+  double first_capacity_time = -1.0;  //!< first time |force| > F_cap [s], -1 if never (the plant's loops)
 };
 
 //! Runs n samples from the plant's current state.  No allocation, no throw:

@@ -36,10 +36,10 @@ void RthsLoop::reset() noexcept {
   delay_.reset();
 }
 
-RthsSummary RthsLoop::run(const GroundMotion& ag, std::size_t n, RthsOutput* rows, double* numerical,
-                          double* step_seconds) noexcept {
+RunSummary RthsLoop::run(const GroundMotion& ag, std::size_t n, RthsOutput* rows, double* numerical,
+                         double* step_seconds) noexcept {
   using clock = std::chrono::steady_clock;
-  RthsSummary sum;
+  RunSummary sum;
   const double h = cfg_.dt;
   const SpecimenModel sp = exp_.specimen();
   const Eigen::Index nd = num_.dof_count(), dof = num_.interface_dof();
@@ -62,17 +62,20 @@ RthsSummary RthsLoop::run(const GroundMotion& ag, std::size_t n, RthsOutput* row
     if (numerical)
       for (Eigen::Index i = 0; i < nd; ++i) numerical[k * nd + i] = num_.dof_displacement(i);
     sum.rows = k + 1;
-    sum.peak_actuator_force = std::fmax(sum.peak_actuator_force, std::fabs(f));
-    sum.peak_displacement = std::fmax(sum.peak_displacement, std::fabs(x));
-    sum.peak_velocity = std::fmax(sum.peak_velocity, std::fabs(exp_.velocity()));
+    sum.peaks(f, x, exp_.velocity());
     const Status st = exp_.step(u);
     num_.step(ag0, ag(t + 0.5 * h), ag(t + h), fin);
     if (step_seconds) step_seconds[k] = std::chrono::duration<double>(clock::now() - t0).count();
-    if (!st.ok() || !std::isfinite(xm) || !std::isfinite(u) || !num_.healthy()) {
-      sum.ok = false;
-      sum.failure_time = t;
-      sum.status = st;
-      if (st.ok()) sum.status.code = Status::NonFinite;  // the loop's own signals or the numerical part
+    sum.internal_steps += st.internal_steps;
+    sum.rhs_evals += st.rhs_evals;
+    sum.restarts += st.restarted ? 1 : 0;
+    if (!sum.count(st, t) || !std::isfinite(xm) || !std::isfinite(u) || !num_.healthy()) {
+      if (st.ok()) {  // the loop's own signals or the numerical part
+        sum.status = st;
+        sum.status.code = Status::NonFinite;
+        sum.failure_time = t;
+      }
+      sum.status.t = t;  // the loop's sample time, not the substructure's clock
       break;
     }
   }

@@ -39,7 +39,8 @@ def register(sub) -> None:
                    help="tracking controller: a built-in (" + ", ".join(CONTROLLERS) + "; default: the benchmark's "
                         "sample controller) or your own as module:Class, the module imported from PYTHONPATH and the "
                         "class built with no arguments, with reset() and command(desired, desired_velocity, "
-                        "desired_acceleration, measured, measured_force) -> command [m] "
+                        "desired_acceleration, measured, measured_force[, measured_velocity=, "
+                        "measured_pressure=]) -> command [m] "
                         "(docs/rths-benchmark.md, 'Bring your own controller')")
     p.add_argument("--perturbed", type=int, default=0, help="perturbed plants per case (default: 0)")
     p.add_argument("--seed", type=int, default=0, help="seed of the noise and of the perturbations (default: 0; with "

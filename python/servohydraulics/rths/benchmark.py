@@ -118,8 +118,10 @@ def make_controller(name: str, dt: float = DT, plant=None):
     perturbed plant), or a user's class as ``"module:Class"``, imported from PYTHONPATH and
     built with no arguments (:func:`load_controller`).  The built-ins are
     ``rths.core.TrackingController`` objects with ``reset()`` and
-    ``command(desired, desired_velocity, desired_acceleration, measured, measured_force)``, the
-    interface a user's controller implements (docs/rths-benchmark.md, "Bring your own controller")."""
+    ``command(desired, desired_velocity, desired_acceleration, measured, measured_force,
+    measured_velocity=0, measured_pressure=0)``, the interface a user's controller implements
+    (the last two optional: passed as keywords when its command() names them; docs/rths-benchmark.md,
+    "Bring your own controller")."""
     if isinstance(name, str) and ":" in name:
         return load_controller(name)
     if name not in CONTROLLERS:
@@ -324,36 +326,30 @@ def run_trial(case: BenchmarkCase, record: Record, controller: Any = "sample", p
     gm = _ground_motion(record, scale)
     n = record.samples()
     t0 = time.perf_counter()
-    out = loop.run(num, gm, n, timing)
+    out, summary = loop.run(num, gm, n, timing)
     wall = time.perf_counter() - t0
     if reference is None:
         reference = case_reference(case, record, scale)
-    if out["ok"]:
+    work = Work.from_core(summary)  # the core's RunSummary, as every loop's (peak_force: the actuator's)
+    if work.ok:
         J = evaluate(out["measured"], out["numerical"], reference, DT)
     else:
         J = [math.nan] * 9
-    trial = Trial(J, float(out["peak_actuator_force"]), float(out["peak_displacement"]),
-                  float(out["peak_velocity"]), bool(out["ok"]), float(out["failure_time"]), wall)
+    trial = Trial(J, work.peak_force, work.peak_displacement, work.peak_velocity, work.ok, work.failure_time, wall)
     if keep_signals:
-        trial.response = _response(out, reference)
+        trial.response = _response(out, work, reference)
     return trial
 
 
-def _response(out: dict[str, Any], reference: np.ndarray) -> Response:
-    """The loop's output (RthsLoop.run) and the reference (up to the rows run) as a Response."""
-    rows = int(out["rows"])
+def _response(out: dict[str, Any], work: Work, reference: np.ndarray) -> Response:
+    """The loop's output (RthsLoop.run: channels and summary) and the reference (up to the rows
+    run) as a Response."""
     names = [n for n, _ in R.RTHS_CHANNELS] + (["step_seconds"] if "step_seconds" in out else [])
     channels = {n: out[n] for n in names}
-    for prefix, data in (("numerical", np.asarray(out["numerical"])), ("reference", np.asarray(reference)[:rows])):
+    for prefix, data in (("numerical", np.asarray(out["numerical"])),
+                         ("reference", np.asarray(reference)[:work.rows])):
         channels.update((f"{prefix}_{i}", data[:, i]) for i in range(data.shape[1]))
     units = {n: "m" for n in channels if n.startswith(("numerical_", "reference_"))}
-    status = Work.from_core(out["status"])  # the experimental substructure's, or non_finite (the loop's own)
-    if not out["ok"]:
-        status.t = float(out["failure_time"])  # the loop's sample time, not the substructure's clock
-    work = Work(rows=rows, ok=bool(out["ok"]), failure_time=float(out["failure_time"]),
-                peak_force=float(out["peak_actuator_force"]), peak_actuator_force=float(out["peak_actuator_force"]),
-                peak_displacement=float(out["peak_displacement"]), peak_velocity=float(out["peak_velocity"]),
-                status=status)
     return Response(channels, kind="rths", dt=DT, work=work, units=units)
 
 

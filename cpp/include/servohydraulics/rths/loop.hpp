@@ -12,13 +12,15 @@
 //   7. experimental substructure: one sample with u_k held; numerical substructure:
 //      one sample with a_g at t_k, t_k + h/2, t_k + h and f_in held.
 // Construction validates (throws Error); run() is noexcept and allocation-free
-// (the caller provides the row buffers: RthsOutput rows described by kRthsChannels).
+// (the caller provides the row buffers: RthsOutput rows described by kRthsChannels) and
+// returns the RunSummary of every loop (record.hpp).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 
 #include "servohydraulics/channels.hpp"
+#include "servohydraulics/record.hpp"
 #include "servohydraulics/rths/benchmark_plant.hpp"
 #include "servohydraulics/rths/converters.hpp"
 #include "servohydraulics/rths/substructure.hpp"
@@ -61,16 +63,6 @@ inline constexpr ChannelInfoOf<RthsOutput> kRthsChannels[] = {
 static_assert(sizeof(RthsOutput) == sizeof(kRthsChannels) / sizeof(kRthsChannels[0]) * sizeof(double),
               "every RthsOutput member is a channel of kRthsChannels");
 
-struct RthsSummary {
-  std::size_t rows = 0;      //!< rows written
-  bool ok = true;            //!< false: the experimental substructure failed or the state is not finite
-  double failure_time = -1.0;
-  double peak_actuator_force = 0.0;  //!< max |f| [N]
-  double peak_displacement = 0.0;    //!< max |X_int| [m]
-  double peak_velocity = 0.0;        //!< max |x'| [m/s]
-  Status status;                     //!< at the failure: the experimental substructure's (NonFinite otherwise)
-};
-
 class RthsLoop {
  public:
   //! References are kept: the three parts must outlive the loop.
@@ -80,7 +72,11 @@ class RthsLoop {
   //! n samples t_k = k dt, k = 0..n-1, ground acceleration from ag (already scaled).  Each
   //! buffer may be nullptr: rows (n), numerical (n x dofs, row-major: the numerical
   //! substructure's displacements [m]), step_seconds (n: each sample's wall time [s]).
-  RthsSummary run(const GroundMotion& ag, std::size_t n, RthsOutput* rows, double* numerical = nullptr,
+  //! The summary (record.hpp, as every loop's): rows, the peaks (peak_force: the actuator force
+  //! Force_act; peak_displacement, peak_velocity: the specimen's), the experimental substructure's
+  //! work counts; at a failure, status (the experimental substructure's, NonFinite when the loop's
+  //! own signals or the numerical substructure failed) with status.t = failure_time = t_k.
+  RunSummary run(const GroundMotion& ag, std::size_t n, RthsOutput* rows, double* numerical = nullptr,
                   double* step_seconds = nullptr) noexcept;
 
   const RthsLoopConfig& config() const noexcept { return cfg_; }
