@@ -2,9 +2,11 @@
 // (python/servohydraulics/realtime.py wraps them).
 #include <pybind11/pybind11.h>
 
+#include "busy.hpp"
 #include "servohydraulics/realtime.hpp"
 
 namespace py = pybind11;
+using namespace servohydraulics;
 using namespace servohydraulics::realtime;
 
 void expose_realtime(py::module_& m) {
@@ -56,11 +58,20 @@ void expose_realtime(py::module_& m) {
              return new Pacer(period_s, o);
            }),
            py::arg("period_s"), py::arg("fifo_priority") = 0, py::arg("cpu") = -1, py::arg("lock_memory") = false)
-      .def("start", &Pacer::start)
-      .def("wait", &Pacer::wait, py::call_guard<py::gil_scoped_release>(),
-           "Sleeps to the next deadline; returns the wake-up latency [s]. Releases the GIL.")
-      .def("stop", &Pacer::stop)
-      .def("stats", &Pacer::stats)
+      .def("start", bindings::guarded(&Pacer::start, "Pacer.start"))
+      .def(
+          "wait",
+          [](Pacer& p) {
+            bindings::BusyGuard busy({&p}, "Pacer.wait");
+            py::gil_scoped_release release;
+            return p.wait();
+          },
+          "Sleeps to the next deadline; returns the wake-up latency [s]. Releases the GIL (one thread per Pacer).")
+      .def("stop", bindings::guarded(&Pacer::stop, "Pacer.stop"))
+      .def("stats", [](const Pacer& p) {
+        bindings::require_idle(&p, "Pacer.stats");
+        return p.stats();
+      })
       .def("deadline_ns", &Pacer::deadline_ns, py::arg("k"))
       .def_property_readonly("started", &Pacer::started)
       .def_property_readonly("period_s", &Pacer::period_s)

@@ -82,17 +82,18 @@ def _plant_step(dt: float):
 
 
 def table(rows: list[dict]) -> str:
-    """A Markdown table of measure() results, one row each."""
+    """A Markdown table of measure() results, one row each (misses and compute may be None: "-")."""
     head = ("| rate [Hz] | step | samples | misses | latency min / p50 / p99 / p99.9 / max [us] "
             "| compute p50 / p99 / max [us] | SCHED_FIFO | mlockall | CPU pinned |")
     lines = [head, "|---:|---|---:|---:|---|---|---|---|---|"]
     for r in rows:
         lat, comp = r["latency_us"], r["compute_us"]
+        misses = "-" if r["misses"] is None else r["misses"]
+        compute = "-" if comp is None else f"{comp['p50']:.1f} / {comp['p99']:.1f} / {comp['max']:.1f}"
         lines.append(
-            f"| {r['rate_hz']:g} | {r['step']} | {r['samples']} | {r['misses']} "
+            f"| {r['rate_hz']:g} | {r['step']} | {r['samples']} | {misses} "
             f"| {lat['min']:.1f} / {lat['p50']:.1f} / {lat['p99']:.1f} / {lat['p99.9']:.1f} / {lat['max']:.1f} "
-            f"| {comp['p50']:.1f} / {comp['p99']:.1f} / {comp['max']:.1f} "
-            f"| {_yes(r, 'fifo')} | {_yes(r, 'mlockall')} | {_yes(r, 'cpu_affinity')} |")
+            f"| {compute} | {_yes(r, 'fifo')} | {_yes(r, 'mlockall')} | {_yes(r, 'cpu_affinity')} |")
     return "\n".join(lines)
 
 
