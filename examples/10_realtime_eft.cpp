@@ -109,8 +109,8 @@ int main(int argc, char** argv) {
     const rt::PacerStats s = pacer.stats();
     std::printf("servohydraulics EFT loop paced to CLOCK_MONOTONIC: %zu samples at %g Hz (period %.3f us)\n", n, rate,
                 1e6 * cfg.dt);
-    std::printf("T: 0 C: %8lld Min: %8.1f Avg: %8.1f P99: %8.1f P99.9: %8.1f Max: %8.1f [us]  Misses: %lld\n",
-                static_cast<long long>(s.samples), s.latency_us.min, s.latency_us.mean, s.latency_us.p99,
+    std::printf("T: 0 C: %8lld Min: %8.1f Avg: %8.1f P50: %8.1f P99: %8.1f P99.9: %8.1f Max: %8.1f [us]  Misses: %lld\n",
+                static_cast<long long>(s.samples), s.latency_us.min, s.latency_us.mean, s.latency_us.p50, s.latency_us.p99,
                 s.latency_us.p999, s.latency_us.max, static_cast<long long>(s.misses));
     std::printf("rate_hz=%g\nsamples=%lld\ndeadline_misses=%lld\nsolver_failures=%ld\n", rate,
                 static_cast<long long>(s.samples), static_cast<long long>(s.misses), failures);

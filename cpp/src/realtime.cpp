@@ -1,6 +1,7 @@
 #include "servohydraulics/realtime.hpp"
 
 #include <sys/mman.h>
+#include <sys/prctl.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -224,6 +225,15 @@ void Pacer::start() {
                             "the CPU must be online and in the process's cpuset (taskset/cgroup)");
       }
     }
+    {
+      // A SCHED_OTHER thread's timers may fire up to its timer slack late (50 us by
+      // default); 1 ns needs no privilege (SCHED_FIFO threads have none anyway).
+      const int old = prctl(PR_GET_TIMERSLACK, 0UL, 0UL, 0UL, 0UL);
+      if (old >= 0 && prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL) == 0) {
+        old_slack_ns_ = old;
+        slack_changed_ = true;
+      }
+    }
     if (options_.fifo_priority > 0) {
       const int got_old = pthread_getschedparam(self, &old_policy_, &old_param_);
       sched_param want{};
@@ -279,7 +289,8 @@ void Pacer::stop() {
   if (policy_changed_) pthread_setschedparam(self, old_policy_, &old_param_);
   if (affinity_changed_) pthread_setaffinity_np(self, sizeof old_affinity_, &old_affinity_);
   if (memory_locked_) munlockall();
-  policy_changed_ = affinity_changed_ = memory_locked_ = false;
+  if (slack_changed_) prctl(PR_SET_TIMERSLACK, static_cast<unsigned long>(old_slack_ns_), 0UL, 0UL, 0UL);
+  policy_changed_ = affinity_changed_ = memory_locked_ = slack_changed_ = false;
   started_ = false;
 }
 

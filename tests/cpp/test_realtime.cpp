@@ -7,6 +7,7 @@
 // is an Error naming the field; SCHED_FIFO refused (in a child without
 // CAP_SYS_NICE and RLIMIT_RTPRIO 0) is reported with its errno, and the loop runs.
 #include <linux/capability.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
@@ -186,16 +187,21 @@ void permissions_reported_and_restored() {
   o.cpu = 0;
   Pacer pacer(1e-3, o);
   const int policy_before = sched_getscheduler(0);
+  const int slack_before = prctl(PR_GET_TIMERSLACK, 0, 0, 0, 0);
   pacer.start();
+  const int slack_during = prctl(PR_GET_TIMERSLACK, 0, 0, 0, 0);
+  CHECK(slack_during >= 0 && slack_during <= slack_before);  // 1 ns asked (a kernel may keep its own; RT: 0)
   for (int k = 0; k < 20; ++k) pacer.wait();
   const auto s = pacer.stats();
   CHECK(s.fifo.requested && s.cpu_affinity.requested);
   CHECK(s.fifo.granted == (sched_getscheduler(0) == SCHED_FIFO));
   CHECK(s.fifo.granted ? s.fifo.error == 0 : (s.fifo.error != 0 && s.fifo.reason.find("failed") != std::string::npos));
   if (s.cpu_affinity.granted) CHECK(sched_getcpu() == 0);
-  std::printf("here: fifo %s; cpu_affinity %s\n", s.fifo.reason.c_str(), s.cpu_affinity.reason.c_str());
+  std::printf("here: fifo %s; cpu_affinity %s; timer slack %d ns -> %d ns\n", s.fifo.reason.c_str(),
+              s.cpu_affinity.reason.c_str(), slack_before, slack_during);
   pacer.stop();
   CHECK(sched_getscheduler(0) == policy_before);
+  CHECK(prctl(PR_GET_TIMERSLACK, 0, 0, 0, 0) == slack_before);
   CHECK(pacer.stats().samples == 20);  // the statistics survive stop()
 }
 

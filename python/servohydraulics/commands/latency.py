@@ -109,7 +109,7 @@ def _run(args) -> int:
     lat, comp = r["latency_us"], r["compute_us"]
     print(f"# servohydraulics latency: {r['samples']} samples at {r['rate_hz']:g} Hz "
           f"(period {1e6 * r['period_s']:.3f} us), step: {r['step']}")
-    print(f"T: 0 C: {r['samples']:8d} Min: {lat['min']:8.1f} Avg: {lat['mean']:8.1f} "
+    print(f"T: 0 C: {r['samples']:8d} Min: {lat['min']:8.1f} Avg: {lat['mean']:8.1f} P50: {lat['p50']:8.1f} "
           f"P99: {lat['p99']:8.1f} P99.9: {lat['p99.9']:8.1f} Max: {lat['max']:8.1f} [us]  Misses: {r['misses']}")
     print(f"compute per step [us]: p50 {comp['p50']:.1f}  p99 {comp['p99']:.1f}  max {comp['max']:.1f}"
           + (f"  plant failures {r['plant_failures']}" if args.plant else ""))
