@@ -73,8 +73,12 @@ class Pacer:
         return self
 
     def wait(self) -> float:
-        """Sleeps to the next deadline; returns the wake-up latency [s] (>= 0)."""
-        return self._pacer.wait()
+        """Sleeps to the next deadline; returns the wake-up latency [s] (>= 0).
+        Raises ``RuntimeError`` before ``start()``."""
+        late = self._pacer.wait()
+        if late < 0.0:
+            raise RuntimeError("Pacer.wait() before start(): start the schedule first (or use 'with Pacer(...)')")
+        return late
 
     def stop(self) -> None:
         """Restores the calling thread's policy and affinity (and unlocks memory).

@@ -47,6 +47,17 @@ def test_wait_never_early_and_the_schedule_is_absolute():
         assert s["latency_us"]["max"] == pytest.approx(1e6 * max(lat), abs=1e-3)
 
 
+def test_wait_before_start_and_after_stop_is_refused():
+    pacer = Pacer(1e-3)
+    with pytest.raises(RuntimeError, match="before start"):
+        pacer.wait()
+    with pacer:
+        pacer.wait()
+    with pytest.raises(RuntimeError, match="before start"):
+        pacer.wait()
+    assert pacer.stats()["samples"] == 1  # the statistics survive stop()
+
+
 def test_overrun_is_counted_and_the_loop_catches_up():
     period = 0.02
     pacer = Pacer(period).start()

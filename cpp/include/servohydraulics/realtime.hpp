@@ -125,7 +125,7 @@ class Pacer {
   //! Sleeps until the next deadline (returns at once when it has passed: a
   //! miss), records the latency and the step's compute time, advances the
   //! deadline by one period.  Returns the wake-up latency [s] (>= 0).
-  //! Before start(): returns -1 and does nothing.  noexcept, allocation-free.
+  //! Before start() or after stop(): returns -1 and does nothing.  noexcept, allocation-free.
   double wait() noexcept;
   //! Restores the scheduling policy, CPU affinity and timer slack the calling
   //! thread had before start(), and munlockall() if start() locked memory.  Must run on the
