@@ -24,6 +24,8 @@
 // in fixed-size histograms: wait() never allocates, never throws, and makes no
 // system call but clock_gettime and clock_nanosleep.
 //
+// start() also sets the loop thread's timer slack to 1 ns (a SCHED_OTHER
+// thread's default 50 us delays every wake-up; no privilege needed).
 // SCHED_FIFO, mlockall and the CPU affinity are requests: when the system
 // refuses one (no CAP_SYS_NICE or RLIMIT_RTPRIO, RLIMIT_MEMLOCK, a CPU outside
 // the cpuset) the loop runs without it, and the Permission says why (errno).
