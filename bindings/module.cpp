@@ -14,6 +14,7 @@ void expose_compensators(py::module_& m);
 void expose_loops(py::module_& m);
 void expose_rths(py::module_& m);
 void expose_fmu(py::module_& m);
+void expose_realtime(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "C++ core of servohydraulics (SUNDIALS CVODE, Eigen)";
@@ -29,4 +30,5 @@ PYBIND11_MODULE(_core, m) {
   expose_loops(m);
   expose_rths(m);
   expose_fmu(m);
+  expose_realtime(m);
 }

@@ -13,25 +13,20 @@
 // Prints the loop's timing and the physics against its oracles: the held
 // displacement P/k, the free-vibration frequency of the modelled system.
 // Nothing is allocated inside the loop.
-#include <time.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <vector>
 
-#include "realtime_clock.hpp"
 #include "servohydraulics/controllers.hpp"
 #include "servohydraulics/plant.hpp"
+#include "servohydraulics/realtime.hpp"
 #include "servohydraulics/zhao2003.hpp"
 
 namespace sh = servohydraulics;
 
 namespace {
-using examples::add_ns;
-using examples::kNsPerS;
-using examples::seconds;
 constexpr double kPi = 3.14159265358979323846;
 
 // ---------------------------------------------------------------------------
@@ -89,18 +84,15 @@ int main(int argc, char** argv) {
   const double P = 0.016 * rig.k;  // [N] Fig 9: 16 mm of static displacement
   const std::size_t n_ramp = std::llround(ramp / cfg.dt), n_hold = std::llround(hold / cfg.dt);
   const std::size_t n = n_ramp + n_hold + static_cast<std::size_t>(std::llround(free / cfg.dt));
-  std::vector<double> calc(n), step_us(n);
-  const long period_ns = std::llround(cfg.dt * kNsPerS);
+  std::vector<double> calc(n);
+  sh::realtime::Pacer pacer(cfg.dt);  // absolute CLOCK_MONOTONIC deadlines, one per sample
 
-  long misses = 0, failures = 0;
+  long failures = 0;
   double peak_command = 0.0, held = 0.0;
   sh::Output sensors;
-  timespec next{}, now{}, done{};
-  clock_gettime(CLOCK_MONOTONIC, &next);
+  pacer.start();
   for (std::size_t k = 0; k < n; ++k) {
-    add_ns(next, period_ns);
-    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
-    clock_gettime(CLOCK_MONOTONIC, &now);
+    pacer.wait();  // sleep to deadline k + 1 (records the wake-up latency and the previous step's time)
     // The external force of the test (Fig 9): half-cosine ramp, hold, release.
     const double s = std::min(1.0, static_cast<double>(k) / static_cast<double>(n_ramp));
     const double p_ext = k < n_ramp + n_hold ? 0.5 * P * (1.0 - std::cos(kPi * s)) : 0.0;
@@ -109,22 +101,21 @@ int main(int argc, char** argv) {
     const double u = controller.command(sensors, 0.0, p_ext);                 // 2. compute the command
     if (!io.write(u)) ++failures;                                             // 3. write it; it holds until t_k+1
 
-    clock_gettime(CLOCK_MONOTONIC, &done);
-    step_us[k] = 1e6 * (seconds(done) - seconds(now));
-    if (seconds(done) > seconds(next) + cfg.dt) ++misses;
     calc[k] = controller.integrator_state().displacement;
     peak_command = std::max(peak_command, std::fabs(u));
     if (k >= n_ramp && k < n_ramp + n_hold) held += calc[k] / static_cast<double>(n_hold);
   }
 
   const double wn = std::sqrt(rig.k / cfg.model.m_m), zeta = cfg.model.c_m / (2.0 * cfg.model.m_m * wn);
-  std::vector<double> sorted = step_us;
-  std::sort(sorted.begin(), sorted.end());
+  pacer.wait();  // closes the last step's time
+  pacer.stop();
+  const sh::realtime::PacerStats rs = pacer.stats();
   std::printf("servohydraulics RPsD controller example: %zu samples at 2 kHz on CLOCK_MONOTONIC\n", n);
   std::printf("steps=%zu\n", n);
-  std::printf("deadline_misses=%ld\n", misses);
+  std::printf("deadline_misses=%lld\n", static_cast<long long>(rs.misses));
   std::printf("solver_failures=%ld\n", failures);
-  std::printf("step_us_median=%.3f\nstep_us_max=%.3f\n", sorted[n / 2], sorted.back());
+  std::printf("step_us_median=%.3f\nstep_us_max=%.3f\n", rs.compute_us.p50, rs.compute_us.max);
+  std::printf("wakeup_latency_us_median=%.3f\nwakeup_latency_us_max=%.3f\n", rs.latency_us.p50, rs.latency_us.max);
   std::printf("held_displacement_mm=%.6f\n", 1e3 * held);
   std::printf("held_displacement_oracle_mm=%.6f\n", 1e3 * P / rig.k);
   std::printf("peak_command_mm=%.6f\n", 1e3 * peak_command);

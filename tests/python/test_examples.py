@@ -1,4 +1,4 @@
-"""The examples run: the C++ examples (01_plant_step, 02_rpsd_controller) build
+"""The examples run: the C++ examples (01_plant_step, 02_rpsd_controller, ...) build
 against an INSTALLED package (cmake --install into a temporary prefix, then
 find_package(servohydraulics)) and keep a 2 kHz loop on the host clock; the
 Python examples run, the pairs with the same numbers as their C++ twins.
@@ -209,6 +209,24 @@ def test_cpp_user_controller_equals_the_builtin_and_tracks_the_building(cpp_exam
     assert 0 < s["pilead_step_us_median"] <= s["pilead_step_us_p99"]
     res = subprocess.run([str(cpp_examples / "07_user_controller"), "-1"], capture_output=True, text=True, timeout=30)
     assert res.returncode == 2 and "invalid seconds" in res.stderr
+
+
+@pytest.mark.parametrize("rate", [2000, 4096])
+def test_cpp_realtime_eft_is_paced_and_computes_what_the_unpaced_loop_computes(cpp_examples, rate):
+    """examples/10_realtime_eft.cpp: the EFT loop on the wall-clock Pacer at 2 kHz and
+    4096 Hz.  Pacing changes when a sample runs, not what it computes: the paced
+    displacements equal the unpaced run_eft's exactly.  The timing figures are reported,
+    not asserted (a shared machine misses deadlines), only their consistency."""
+    s = parse(_run([str(cpp_examples / "10_realtime_eft"), str(rate), "0.5"], timeout=60).stdout)
+    assert s["samples"] == round(0.5 * rate) and s["solver_failures"] == 0
+    assert s["paced_vs_unpaced_max_diff_m"] == 0.0
+    assert 0 <= s["deadline_misses"] <= s["samples"]
+    for name in ("wakeup_latency", "compute"):
+        q = [s[f"{name}_us_{p}"] for p in ("min", "p50", "p99", "p999", "max")]
+        assert 0.0 <= q[0] and q == sorted(q)
+    for bad in (["50"], ["2000", "-1"], ["2000", "1", "--fifo"], ["2000", "1", "--bogus"]):
+        res = subprocess.run([str(cpp_examples / "10_realtime_eft"), *bad], capture_output=True, text=True, timeout=30)
+        assert res.returncode == 2 and "usage" in res.stderr
 
 
 def test_python_user_controller_equals_the_builtin():
