@@ -101,6 +101,71 @@ class PythonSubstructure final : public NumericalSubstructure {
   mutable std::string error_;
 };
 
+// A Python object as the loop's experimental substructure (e.g. distributed.RemoteSite: a
+// site across the network).  Its protocol: attribute dt; methods reset(), step(command),
+// specimen() -> (m, c, k); attributes displacement, velocity, actuator_force (read after
+// every reset and step).  Each call takes the GIL.  A Python exception marks it failed:
+// step() returns NonFinite (the loop stops) and run() raises the exception's message.
+class PythonExperimentalSubstructure final : public ExperimentalSubstructure {
+ public:
+  explicit PythonExperimentalSubstructure(py::object obj) : obj_(std::move(obj)) {
+    dt_ = obj_.attr("dt").cast<double>();
+    if (!(std::isfinite(dt_) && dt_ > 0.0))
+      throw Error("invalid experimental.dt = " + std::to_string(dt_) + ": finite and > 0");
+    const auto s = obj_.attr("specimen")().cast<std::vector<double>>();
+    if (s.size() != 3 || !(std::isfinite(s[0]) && std::isfinite(s[1]) && std::isfinite(s[2])))
+      throw Error("invalid experimental.specimen(): expected three finite values (m, c, k)");
+    specimen_ = {s[0], s[1], s[2]};
+  }
+  void reset() noexcept override {
+    failed_ = false;
+    error_.clear();
+    call([&] {
+      obj_.attr("reset")();
+      pull();
+    });
+  }
+  Status step(double command) noexcept override {
+    call([&] {
+      obj_.attr("step")(command);
+      pull();
+    });
+    Status s;
+    if (failed_ || !(std::isfinite(x_) && std::isfinite(v_) && std::isfinite(f_))) s.code = Status::NonFinite;
+    return s;
+  }
+  double displacement() const noexcept override { return x_; }
+  double velocity() const noexcept override { return v_; }
+  double actuator_force() const noexcept override { return f_; }
+  SpecimenModel specimen() const noexcept override { return specimen_; }
+  double dt() const noexcept override { return dt_; }
+  const std::string& error() const noexcept { return error_; }
+  const py::object& object() const noexcept { return obj_; }
+
+ private:
+  void pull() {
+    x_ = obj_.attr("displacement").cast<double>();
+    v_ = obj_.attr("velocity").cast<double>();
+    f_ = obj_.attr("actuator_force").cast<double>();
+  }
+  template <class F>
+  void call(F&& f) noexcept {
+    if (failed_) return;
+    py::gil_scoped_acquire gil;
+    try {
+      f();
+    } catch (const std::exception& e) {
+      failed_ = true;
+      error_ = e.what();
+    }
+  }
+  py::object obj_;
+  double dt_ = 0.0, x_ = 0.0, v_ = 0.0, f_ = 0.0;
+  SpecimenModel specimen_;
+  bool failed_ = false;
+  std::string error_;
+};
+
 py::dict run_loop(RthsLoop& loop, const NumericalSubstructure& num, const GroundMotion& ag, std::size_t n,
                   bool timing) {
   if (&num != &loop.numerical())
@@ -118,6 +183,10 @@ py::dict run_loop(RthsLoop& loop, const NumericalSubstructure& num, const Ground
     s = loop.run(ag, n, rows.data(), numerical.mutable_data(), timing ? steps.mutable_data() : nullptr);
   }
   bindings::raise_controller_error(loop.controller(), loop.config().dt);
+  if (const auto* e = dynamic_cast<const PythonExperimentalSubstructure*>(&loop.experimental());
+      e && !e->error().empty())
+    throw std::runtime_error("experimental substructure failed at t = " + std::to_string(s.failure_time) +
+                             " s: " + e->error());
   if (const auto* p = dynamic_cast<const PythonSubstructure*>(&num); p && !p->error().empty())
     throw std::runtime_error("numerical substructure failed at t = " + std::to_string(s.failure_time) +
                              " s: " + p->error());
@@ -222,6 +291,11 @@ void expose_rths(py::module_& m) {
       .def(py::init<const BenchmarkPlantParameters&, double>(), py::arg("parameters"), py::arg("dt"))
       .def_property_readonly("parameters", &BenchmarkPlant::parameters)
       .def_property_readonly("state", &BenchmarkPlant::state);
+  py::class_<PythonExperimentalSubstructure, ExperimentalSubstructure>(
+      r, "PythonExperimentalSubstructure", "a Python object (e.g. distributed.RemoteSite) as the loop's experimental substructure")
+      .def(py::init<py::object>(), py::arg("substructure"))
+      .def_property_readonly("error", &PythonExperimentalSubstructure::error)
+      .def_property_readonly("substructure", &PythonExperimentalSubstructure::object);
   py::class_<ServoHydraulicSubstructure, ExperimentalSubstructure>(r, "ServoHydraulicSubstructure")
       .def(py::init<const Rig&, double, const SolverOptions&>(), py::arg("rig"), py::arg("dt"),
            py::arg("options") = SolverOptions{});
