@@ -15,7 +15,6 @@ This module only encodes, decodes and checks sizes; it holds no socket.
 
 from __future__ import annotations
 
-import math
 import struct
 from dataclasses import dataclass
 from enum import IntEnum
@@ -122,6 +121,7 @@ def generic_client_sizes(n: int, data_size: int = 256) -> Sizes:
 
 
 _CODES = frozenset(int(a) for a in Action)
+_ACTION_OF = {float(a): a for a in Action}
 
 
 class Codec:
@@ -130,7 +130,9 @@ class Codec:
 
     def __init__(self, sizes: Sizes):
         self.sizes = sizes
-        self._trial = [(name, s) for name, s in sizes.offsets(sizes.control, 1).items() if s.stop > s.start]
+        self._trial = [(name, slice(s.start - 1, s.stop - 1))
+                       for name, s in sizes.offsets(sizes.control, 1).items() if s.stop > s.start]
+        self._payload_end = 1 + sum(sizes.control)
         self._daq = [(name, n) for name, n in zip(QUANTITIES, sizes.daq) if n]
         self._out = np.zeros(sizes.data_size)
 
@@ -141,18 +143,19 @@ class Codec:
             raise ProtocolError(f"message of {len(message)} bytes, expected data_size x 8 = "
                                 f"{self.sizes.message_bytes}")
         v = np.frombuffer(message, dtype=np.float64)
-        code = float(v[0])
-        if not (math.isfinite(code) and code == int(code) and int(code) in _CODES):
-            raise ProtocolError(f"unknown action code {code!r}: expected one of {sorted(_CODES)}")
-        action = Action(int(code))
+        action = _ACTION_OF.get(float(v[0]))  # NaN is no key
+        if action is None:
+            raise ProtocolError(f"unknown action code {float(v[0])!r}: expected one of {sorted(_CODES)}")
         payload: dict[str, np.ndarray] = {}
         if action == Action.SET_TRIAL_RESPONSE:
+            values = v[1:self._payload_end].copy()  # one copy, one check; the quantities are views of it
+            if not np.isfinite(values).all():
+                for name, s in self._trial:
+                    bad = np.flatnonzero(~np.isfinite(values[s]))
+                    if bad.size:
+                        raise ProtocolError(f"trial {name}[{bad[0]}] = {values[s][bad[0]]}: not finite")
             for name, s in self._trial:
-                x = v[s].copy()
-                if not np.isfinite(x).all():
-                    i = int(np.flatnonzero(~np.isfinite(x))[0])
-                    raise ProtocolError(f"trial {name}[{i}] = {x[i]}: not finite")
-                payload[name] = x
+                payload[name] = values[s]
         return action, payload
 
     def reply(self, values: np.ndarray) -> bytes:

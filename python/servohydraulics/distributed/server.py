@@ -22,6 +22,7 @@ import sys
 import tempfile
 import time
 from collections import Counter
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
@@ -244,14 +245,15 @@ class Server:
         return bytes(buf)
 
 
-def start_server_process(*args: str, env: dict[str, str] | None = None,
-                         timeout: float = 60.0) -> tuple[subprocess.Popen, int]:
+def start_server_process(*args: str, env: dict[str, str] | None = None, timeout: float = 60.0,
+                         prefix: Sequence[str] = ()) -> tuple[subprocess.Popen, int]:
     """Starts ``python -m servohydraulics serve --port 0 ARGS...`` in its own process (OpenSeesPy
     clients hold the GIL while they wait: a server in the client's process would never run) and
     returns it with the port it listens on.  Its log goes to a temporary file (``server_log(proc)``
     reads it; a pipe nobody drains would stall a chatty server); stop it with ``proc.terminate()``
-    (SIGTERM: a clean stop), ``proc.send_signal(SIGINT)`` (Ctrl-C), or let ``--max-clients`` end it."""
-    cmd = [sys.executable, "-m", "servohydraulics", "serve", "--port", "0", *args]
+    (SIGTERM: a clean stop), ``proc.send_signal(SIGINT)`` (Ctrl-C), or let ``--max-clients`` end it.
+    ``prefix``: a command to run it under (``["ip", "netns", "exec", NAME]``)."""
+    cmd = [*prefix, sys.executable, "-m", "servohydraulics", "serve", "--port", "0", *args]
     package_parent = str(Path(__file__).resolve().parents[2])  # the same servohydraulics as ours
     env = {**os.environ, **(env or {})}
     env["PYTHONPATH"] = os.pathsep.join(p for p in (package_parent, env.get("PYTHONPATH")) if p)

@@ -50,10 +50,11 @@ class Site:
         self.x, self.v, self.a, self.f = z.copy(), z.copy(), z.copy(), z.copy()
         self.t = 0.0
         self.trials = 0
+        self._tangent_at, self._tangent, self._zeros = None, None, np.zeros((self.n, self.n))
 
     def check_trial(self, x: np.ndarray) -> None:
-        over = np.flatnonzero(np.abs(x) > self.stroke)
-        if over.size:
+        if np.abs(x).max() > self.stroke:
+            over = np.flatnonzero(np.abs(x) > self.stroke)
             i = int(over[0])
             raise ProtocolError(f"trial displacement[{i}] = {x[i]:.6g} m beyond the stroke +-{self.stroke:.6g} m")
 
@@ -78,8 +79,11 @@ class Site:
         if action == Action.GET_INITIAL_STIFFNESS:
             return self.stiffness(np.zeros(self.n))
         if action == Action.GET_TANGENT_STIFFNESS:
-            return self.stiffness(self.x)
-        return np.zeros((self.n, self.n))
+            key = self.x.tobytes()
+            if key != self._tangent_at:  # asked several times a step at one displacement
+                self._tangent_at, self._tangent = key, self.stiffness(self.x)
+            return self._tangent
+        return self._zeros
 
     def commit(self) -> None:
         pass
@@ -101,6 +105,7 @@ class IdealSite(Site):
             raise ValueError(f"--actuator ideal: the rig's specimen has a state of its own ({', '.join(on)}): "
                              "switch it off or use --actuator model")
         super().__init__(rig, n)
+        self._m = float(rig.m)
 
     def reset(self) -> None:
         super().reset()
@@ -118,7 +123,7 @@ class IdealSite(Site):
         if a is None:
             a = (v - self._vc) / h if h > 0 else np.zeros(self.n)
         self.x, self.v, self.a, self.t = x, v, a, t
-        self.f = self.rig.m * a + self._dyn.structure_forces(x, v)
+        self.f = self._m * a + self._dyn.structure_forces(x, v)
         self.trials += 1
 
     def commit(self) -> None:
