@@ -255,3 +255,41 @@ def test_distributed_frame_example_compensation_brings_the_frame_back():
     assert v["lead_delay_ms"] < 0.5 * v["none_delay_ms"]
     assert v["lead_vs_ideal_pct"] < 0.5 * v["none_vs_ideal_pct"]
     assert v["lead_tracking_error_pct"] < v["none_tracking_error_pct"]
+
+
+def test_model_site_paces_every_controller_sample_and_moves_on_request():
+    """--realtime's pacing contract (servohydraulics.realtime.Pacer: start() per connection,
+    wait() before every controller sample, stats() logged), and when the model moves: on a
+    request for the response, over the client's time step; a trial at an unchanged time waits."""
+    from servohydraulics.distributed import ModelSite
+
+    class Pacer:
+        def __init__(self):
+            self.starts = self.waits = 0
+
+        def start(self):
+            self.starts += 1
+
+        def wait(self):
+            self.waits += 1
+            return 0.0
+
+        def stats(self):
+            return {"waits": self.waits}
+
+    pacer = Pacer()
+    site = ModelSite(sh.zhao2003(), pacer=pacer)  # dt 0.5 ms
+    assert pacer.starts == 1
+    site.set_trial({"displacement": np.array([1e-3])}, 0.01)
+    assert pacer.waits == 0  # nothing moves before the client asks
+    r = site.response()
+    assert pacer.waits == 20 and r["time"][0] == pytest.approx(0.01) and 0 < r["displacement"][0] < 1e-3
+    site.set_trial({"displacement": np.array([2e-3])}, 0.01)  # the corrector, at the same time
+    site.response()
+    assert pacer.waits == 20 and site.deferred == 1
+    site.set_trial({"displacement": np.array([2e-3])}, 0.015)
+    site.response()
+    assert pacer.waits == 30 and site.close() == {"controller samples": 30, "trials deferred to the next step": 1,
+                                                   "pacing": {"waits": 30}}
+    site.reset()
+    assert pacer.starts == 2

@@ -41,7 +41,12 @@ def _run(args) -> int:
 def _pacer(args):
     """The wall-clock pacing of --realtime (servohydraulics.realtime), one period per controller sample."""
     from .. import _core
-    from ..realtime import Pacer  # imported only here: the realtime path's own module
+
+    try:
+        from ..realtime import Pacer  # imported only here: the realtime path's own module
+    except ImportError as e:
+        raise ValueError(f"--realtime needs servohydraulics.realtime (the pacing module), not importable here: {e}") \
+            from None
 
     dt = args.dt if args.dt is not None else _core.RpsdConfig().dt
     return Pacer(dt, fifo_priority=args.fifo_priority, cpu=args.cpu, lock_memory=args.lock_memory)

@@ -99,6 +99,9 @@ class Server:
         Ctrl-C, which closes everything and re-raises KeyboardInterrupt)."""
         log.info("serving %s actuator(s) on %s:%d (one client at a time, timeout %g s)",
                  self.site.n, *self.address, self.timeout)
+        if not self._loopback():
+            log.warning("listening beyond this machine (%s): whoever reaches this port drives the actuator",
+                        self.address[0])
         if on_ready:
             on_ready()
         try:
@@ -114,6 +117,14 @@ class Server:
             self.close()
         log.info("done: %s", self._summary())
         return self.stats
+
+    def _loopback(self) -> bool:
+        import ipaddress
+
+        try:
+            return ipaddress.ip_address(self.address[0]).is_loopback
+        except ValueError:
+            return False
 
     def close(self) -> None:
         for s in (self._client, self._listener):

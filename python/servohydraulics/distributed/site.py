@@ -161,7 +161,6 @@ class ModelSite(Site):
                         for _ in range(n)]
         self._leads = ([_core.PhaseLead(cfg.amplitude_T, cfg.alpha, self.dt) for _ in range(n)]
                        if controller == "lead" else None)
-        self.latencies: list[float] = []
         self._rows: list[np.ndarray] = []  # per controller sample: t, command[n], displacement[n], force[n]
         super().__init__(rig, n)
 
@@ -214,7 +213,7 @@ class ModelSite(Site):
         for j in range(1, steps + 1):
             u = u0 + (x - u0) * (j / steps)
             if self.pacer is not None:
-                self.latencies.append(self.pacer.wait())
+                self.pacer.wait()  # its stats() hold the wake-up latencies and misses
             outs = []
             for i, p in enumerate(self._plants):
                 cmd = self._leads[i].step(float(u[i])) if self._leads else float(u[i])
