@@ -21,16 +21,9 @@ import numpy as np
 import servohydraulics as sh
 from servohydraulics.distributed.frame import run_frame
 from servohydraulics.distributed.server import finish_server_process, start_server_process
+from servohydraulics.distributed.site import tracking_delay
 
 DT = 0.005  # the frame's step [s]: 10 controller samples of 0.5 ms
-
-
-def delay_of(t: np.ndarray, command: np.ndarray, measured: np.ndarray) -> float:
-    """The lag [s] (0 .. 150 ms) that best maps the command onto the measured displacement."""
-    lags = np.arange(300) * 5e-4
-    i0 = len(t) // 5
-    err = [np.mean((measured[i0:] - np.interp(t[i0:] - L, t, command)) ** 2) for L in lags]
-    return float(lags[int(np.argmin(err))])
 
 
 def remote(rig_file: Path, duration: float, controller: str, folder: Path):
@@ -61,7 +54,7 @@ def main(duration: float = 4.0, plot: str | None = None) -> None:
         track = np.sqrt(np.mean((rec.displacement - rec.command) ** 2) / np.mean(rec.command ** 2))
         print(f"{name}_peak_mm={1e3 * np.abs(x).max():.3f} {name}_vs_ideal_pct={100 * nrms:.1f} "
               f"{name}_tracking_error_pct={100 * track:.1f} "
-              f"{name}_delay_ms={1e3 * delay_of(rec.time, rec.command, rec.displacement):.1f}")
+              f"{name}_delay_ms={1e3 * tracking_delay(rec.time, rec.command, rec.displacement):.1f}")
     if plot:
         from matplotlib.figure import Figure
 

@@ -19,6 +19,7 @@ from servohydraulics import rths
 from servohydraulics.distributed import Action, ProtocolError, RemoteSite, Sizes, generic_client_sizes
 from servohydraulics.distributed.protocol import Codec, request
 from servohydraulics.distributed.server import finish_server_process, start_server_process
+from servohydraulics.distributed.site import tracking_delay
 
 K = 700800.0  # the specimen's stiffness [N/m] (the rig's k)
 LINEAR = """[structure]
@@ -134,9 +135,7 @@ def test_opensees_frame_with_the_papers_actuator_shows_tracking_error_and_delay(
     t, u, x = rec.time, rec.command, rec.displacement
     assert np.allclose(np.diff(t), 5e-4) and len(t) == 400 * 10  # 10 controller samples per 5 ms step
     assert "trials deferred to the next step: 400" in log  # Newmark's corrector, at the predictor's time
-    lags = np.arange(0, 300) * 5e-4
-    err = [np.sqrt(np.mean((x[400:] - np.interp(t[400:] - L, t, u)) ** 2)) for L in lags]
-    delay = lags[int(np.argmin(err))]
+    delay = tracking_delay(t, u, x)
     # oracle: the phase delay of the linearised displacement loop at the excitation's 2 Hz
     import control as ct
     w = 2 * math.pi * frame.FREQUENCY
@@ -293,3 +292,27 @@ def test_model_site_paces_every_controller_sample_and_moves_on_request():
                                                    "pacing": {"waits": 30}}
     site.reset()
     assert pacer.starts == 2
+
+
+def test_tracking_delay_finds_a_known_lag():
+    t = np.arange(4000) * 5e-4
+    u = np.sin(2 * math.pi * 2.0 * t) + 0.3 * np.sin(2 * math.pi * 5.3 * t)
+    assert tracking_delay(t, u, np.interp(t - 0.0375, t, u)) == pytest.approx(0.0375)
+
+
+def test_ideal_site_of_two_actuators_answers_each_spring(linear_rig):
+    """--actuators 2: each element DOF its own specimen against the ground: force k x per DOF, a
+    diagonal stiffness, column-major on the wire; a client of the wrong size is refused."""
+    from servohydraulics.distributed import IdealSite
+
+    site = IdealSite(sh.load_rig(linear_rig), 2)
+    sizes = generic_client_sizes(2)
+    c = Codec(sizes)
+    _, p = c.decode(request(Action.SET_TRIAL_RESPONSE, sizes, displacement=[1e-3, -2e-3], time=[0.01]))
+    site.set_trial(p, 0.01)
+    f = np.frombuffer(c.reply(site.response()["force"]), dtype=float)
+    assert f[:2].tolist() == [K * 1e-3, -K * 2e-3] and not f[2:].any()
+    k = np.frombuffer(c.reply(site.matrix(Action.GET_TANGENT_STIFFNESS)), dtype=float)
+    assert k[:4].tolist() == [K, 0.0, 0.0, K]
+    with pytest.raises(ProtocolError, match="control size of displacement = 1"):
+        generic_client_sizes(1).check(2)

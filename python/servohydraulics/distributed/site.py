@@ -247,6 +247,18 @@ class ModelSite(Site):
         return out
 
 
+def tracking_delay(time: np.ndarray, command: np.ndarray, measured: np.ndarray, longest: float = 0.15) -> float:
+    """The lag [s] (0 .. ``longest``, on the record's sample grid) that maps the command best onto
+    the measured displacement (least squares, the first fifth of the record left out as the
+    start-up): the tracking delay of a ``ModelSite.record()``."""
+    t = np.asarray(time, dtype=float)
+    dt = float(t[1] - t[0])
+    i0 = len(t) // 5
+    lags = np.arange(int(longest / dt) + 1) * dt
+    err = [np.mean((measured[i0:] - np.interp(t[i0:] - lag, t, command)) ** 2) for lag in lags]
+    return float(lags[int(np.argmin(err))])
+
+
 def make_site(rig: Rig, actuator: str = "model", n: int = 1, **model_options) -> Site:
     """The site of ``servohydraulics serve --actuator``."""
     if actuator == "ideal":
