@@ -154,6 +154,13 @@ class PythonExperimentalSubstructure final : public ExperimentalSubstructure {
     py::gil_scoped_acquire gil;
     try {
       f();
+    } catch (py::error_already_set& e) {  // "Type: message", without the traceback pybind11 appends
+      failed_ = true;
+      try {
+        error_ = py::str(e.type().attr("__name__")).cast<std::string>() + ": " + py::str(e.value()).cast<std::string>();
+      } catch (...) {
+        error_ = e.what();
+      }
     } catch (const std::exception& e) {
       failed_ = true;
       error_ = e.what();

@@ -316,3 +316,28 @@ def test_ideal_site_of_two_actuators_answers_each_spring(linear_rig):
     assert k[:4].tolist() == [K, 0.0, 0.0, K]
     with pytest.raises(ProtocolError, match="control size of displacement = 1"):
         generic_client_sizes(1).check(2)
+
+
+def test_python_experimental_substructure_failure_names_the_time():
+    """rths.run_trial(experimental=<a Python object>): what it raises stops the loop and comes
+    back as an error naming the sample's time (the binding's PythonExperimentalSubstructure)."""
+
+    class Failing:
+        dt = rths.DT
+        displacement = velocity = actuator_force = 0.0
+
+        def specimen(self):
+            return (29.13, 0.0, 1.19e6)
+
+        def reset(self):
+            self.k = 0
+
+        def step(self, command):
+            self.k += 1
+            if self.k == 100:
+                raise ConnectionError("the site went away")
+
+    rec = rths.synthetic_record(duration=0.5)
+    with pytest.raises(RuntimeError, match=r"experimental substructure failed at t = 0.024[0-9]* s: "
+                                           r"ConnectionError: the site went away$"):
+        rths.run_trial(rths.embedded_case(1), rec, "sample", experimental=Failing())

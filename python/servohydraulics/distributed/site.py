@@ -134,7 +134,7 @@ class ModelSite(Site):
     """The rig's actuator and servo controller track each trial displacement.
 
     The site moves when the client asks for the response (get DAQ response, get
-    displacement ... get time): if the client's time channel has advanced since the last
+    displacement ... get time) or commits: if the client's time channel has advanced since the last
     move, the displacement command ramps linearly from the last target to the latest trial over
     round(t / dt) - round(t_last / dt) controller samples, and the reply is what the transducers
     read at the end.  Trials at an unchanged time (OpenSees' Newmark sends its predictor at the
@@ -199,6 +199,9 @@ class ModelSite(Site):
     def response(self) -> dict[str, np.ndarray]:
         self._move()
         return super().response()
+
+    def commit(self) -> None:
+        self._move()  # a client that commits without asking still moves the specimen
 
     def _move(self) -> None:
         """Executes the pending trial over the time it gives (see the class)."""
