@@ -4,12 +4,13 @@ remote ideal linear spring, median and p99 of each analysis step's wall time, wi
 delayed-ACK countermeasure (TCP_QUICKACK after every read) on and off, and the same frame with
 the local spring for scale.
 
-    PYTHONPATH=python python benchmarks/serve_latency.py [--steps 400] [--slow-steps 60]
+    PYTHONPATH=python python benchmarks/serve_latency.py [--steps 400] [--slow-steps 60] [--pin]
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import tempfile
 from pathlib import Path
 
@@ -30,9 +31,9 @@ piston_mass = false
 """
 
 
-def measure(rig: Path, steps: int, quickack: bool, dt: float = 0.01) -> np.ndarray:
+def measure(rig: Path, steps: int, quickack: bool, dt: float = 0.01, server_cpu: int | None = None) -> np.ndarray:
     args = ["--rig", str(rig), "--actuator", "ideal", "--max-clients", "1"] + ([] if quickack else ["--no-quickack"])
-    proc, port = start_server_process(*args)
+    proc, port = start_server_process(*args, prefix=[] if server_cpu is None else ["taskset", "-c", str(server_cpu)])
     try:
         res = run_frame(port=port, dt=dt, duration=steps * dt)
     finally:
@@ -49,18 +50,31 @@ def main() -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--steps", type=int, default=400, help="analysis steps with the countermeasure (default 400)")
     p.add_argument("--slow-steps", type=int, default=60, help="steps without it (each may stall ~40 ms; default 60)")
+    p.add_argument("--pin", action="store_true",
+                   help="also run with the client on CPU 0 and the server on CPU 1, and both on CPU 0 (taskset)")
     a = p.parse_args()
+    pinned = {}
     with tempfile.TemporaryDirectory() as tmp:
         rig = Path(tmp) / "linear.toml"
         rig.write_text(LINEAR_RIG)
         local = run_frame(local_k=700800.0, duration=a.steps * 0.01)["step_seconds"][1:]
         fast = measure(rig, a.steps, quickack=True)
         slow = measure(rig, a.slow_steps, quickack=False)
+        if a.pin:
+            mask = os.sched_getaffinity(0)
+            try:
+                os.sched_setaffinity(0, {0})
+                pinned["remote, default, client on CPU 0, server on CPU 1"] = measure(rig, a.steps, True, server_cpu=1)
+                pinned["remote, default, client and server on CPU 0"] = measure(rig, a.steps, True, server_cpu=0)
+            finally:
+                os.sched_setaffinity(0, mask)
     print("| client step (OpenSeesPy analyze(1, dt)) | steps | median [us] | p99 [us] | max [us] |")
     print("|---|---|---|---|---|")
     print(row("local spring (no network)", local))
     print(row("remote, server TCP_NODELAY + TCP_QUICKACK (default)", fast))
     print(row("remote, server TCP_NODELAY only (--no-quickack)", slow))
+    for name, s in pinned.items():
+        print(row(name, s))
     return 0
 
 
