@@ -16,19 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from servohydraulics.distributed.frame import run_frame
+import servohydraulics as sh
+from servohydraulics.distributed.frame import linear_specimen_rig, run_frame
 from servohydraulics.distributed.server import start_server_process
-
-#: A linear spring specimen: the rig's k, no friction, no softening, no damping, a negligible mass.
-LINEAR_RIG = """[structure]
-m = 1e-300
-c = 0.0
-k = 700800.0
-[effects]
-coulomb_friction = false
-spring_softening = false
-piston_mass = false
-"""
 
 
 def measure(rig: Path, steps: int, quickack: bool, dt: float = 0.01, server_cpu: int | None = None) -> np.ndarray:
@@ -55,8 +45,7 @@ def main() -> int:
     a = p.parse_args()
     pinned = {}
     with tempfile.TemporaryDirectory() as tmp:
-        rig = Path(tmp) / "linear.toml"
-        rig.write_text(LINEAR_RIG)
+        rig = sh.save_rig(linear_specimen_rig(700800.0), Path(tmp) / "linear.toml")
         local = run_frame(local_k=700800.0, duration=a.steps * 0.01)["step_seconds"][1:]
         fast = measure(rig, a.steps, quickack=True)
         slow = measure(rig, a.slow_steps, quickack=False)

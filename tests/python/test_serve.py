@@ -17,28 +17,16 @@ import pytest
 import servohydraulics as sh
 from servohydraulics import rths
 from servohydraulics.distributed import Action, ProtocolError, RemoteSite, Sizes, generic_client_sizes
+from servohydraulics.distributed.frame import linear_specimen_rig
 from servohydraulics.distributed.protocol import Codec, request
 from servohydraulics.distributed.server import finish_server_process, start_server_process
 from servohydraulics.distributed.site import tracking_delay
 
 K = 700800.0  # the specimen's stiffness [N/m] (the rig's k)
-LINEAR = """[structure]
-m = 1e-300
-c = 0.0
-k = 700800.0
-[effects]
-coulomb_friction = false
-spring_softening = false
-piston_mass = false
-"""
-
-
 @pytest.fixture
 def linear_rig(tmp_path):
     """A rig whose specimen is a linear spring: friction and softening off, damping 0, a negligible mass."""
-    p = tmp_path / "linear.toml"
-    p.write_text(LINEAR)
-    return p
+    return sh.save_rig(linear_specimen_rig(K), tmp_path / "linear.toml")
 
 
 _RUNNING: list = []

@@ -14,13 +14,13 @@ from collections import Counter
 import numpy as np
 import pytest
 
+import servohydraulics as sh
 from servohydraulics.distributed import Action, RemoteSite, generic_client_sizes
+from servohydraulics.distributed.frame import linear_specimen_rig
 from servohydraulics.distributed.protocol import request
 from servohydraulics.distributed.server import finish_server_process, server_log, start_server_process
 
 K = 700800.0
-LINEAR = "[structure]\nm = 1e-300\nc = 0.0\nk = 700800.0\n[effects]\ncoulomb_friction = false\n" \
-         "spring_softening = false\npiston_mass = false\n"
 GOOD = generic_client_sizes(1)
 CONNECTIONS = 1200
 SILENT = 4  # clients that send nothing: each costs the server's --timeout
@@ -100,8 +100,7 @@ def _run_client(port: int, data: bytes, end: str) -> str:
 
 
 def test_a_thousand_malformed_clients_then_a_good_one(tmp_path):
-    rig = tmp_path / "linear.toml"
-    rig.write_text(LINEAR)
+    rig = sh.save_rig(linear_specimen_rig(K), tmp_path / "linear.toml")
     proc, port = start_server_process("--rig", str(rig), "--actuator", "ideal", "--timeout", "0.3")
     try:
         rng = np.random.default_rng(24)

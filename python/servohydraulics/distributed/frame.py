@@ -26,6 +26,18 @@ PGA, FREQUENCY, DURATION = 1.0, 2.0, 4.0
 SPECIMEN_NODE, SPECIMEN_TAG = 3, 100
 
 
+def linear_specimen_rig(k: float = 700800.0):
+    """The preset with a linear spring of stiffness k [N/m] as its specimen: friction, softening
+    and the piston mass off, damping 0 and a negligible mass (1e-300 kg), so that ``serve
+    --actuator ideal`` answers exactly k x and the frame's local twin is a zeroLength spring of k."""
+    from ..rig import zhao2003
+
+    rig = zhao2003()
+    rig.m, rig.c, rig.k = 1e-300, 0.0, float(k)
+    rig.effects.coulomb_friction = rig.effects.spring_softening = rig.effects.piston_mass = False
+    return rig
+
+
 def ground_acceleration(dt: float, duration: float = DURATION, pga: float = PGA, frequency: float = FREQUENCY):
     t = np.arange(int(round(duration / dt)) + 1) * dt
     return t, pga * np.sin(2 * math.pi * frequency * t) * np.sin(math.pi * t / duration) ** 2
