@@ -113,11 +113,11 @@ class Sizes:
                                 f"(the largest message of these sizes holds {need} float64)")
 
 
-def generic_client_sizes(n: int, data_size: int = 256) -> Sizes:
+def generic_client_sizes(n: int) -> Sizes:
     """The handshake OpenSees' ``element genericClient`` sends for n element DOFs, as recorded on
-    the wire from OpenSeesPy 3.x (n = 1 and 2: control (n, n, n, 0, 1), acquisition (0, 0, 0, n, 0),
-    data_size 256)."""
-    return Sizes((n, n, n, 0, 1), (0, 0, 0, n, 0), data_size)
+    the wire from OpenSeesPy 3.x (n = 1, 2, 3, 17): control (n, n, n, 0, 1), acquisition
+    (0, 0, 0, n, 0), data_size max(256, n^2)."""
+    return Sizes((n, n, n, 0, 1), (0, 0, 0, n, 0), max(256, 3 * n + 2, n * n))
 
 
 _CODES = frozenset(int(a) for a in Action)

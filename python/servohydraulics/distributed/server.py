@@ -187,6 +187,8 @@ class Server:
             outcome, reason = "site failure", str(e)
         except OSError as e:  # reset by peer, broken pipe
             outcome, reason = "connection error", f"{type(e).__name__}: {e.strerror or e}"
+        except Exception as e:  # noqa: BLE001 - a bug of ours ends this client, not the server
+            outcome, reason = "internal error", f"{type(e).__name__}: {e} (please report it)"
         finally:
             self._sel.unregister(sock)
             sock.close()
@@ -196,7 +198,11 @@ class Server:
         if self.record is not None and hasattr(self.site, "record"):
             from ..records import write_record
 
-            extra["record"] = write_record(self.record / f"client_{self.stats.clients:03d}.csv", self.site.record())
+            try:
+                extra["record"] = write_record(self.record / f"client_{self.stats.clients:03d}.csv",
+                                               self.site.record())
+            except (OSError, ValueError) as e:
+                extra["record not written"] = str(e)
         level = logging.INFO if outcome == "stopped" else logging.WARNING
         actions = " ".join(f"{int(a)}x{c}" for a, c in sorted(self.actions.items()))
         log.log(level, "client %s ended (%s): %s; %d messages (action x count: %s) in %.3f s%s", who, outcome, reason,
