@@ -143,6 +143,7 @@ def test_remote_site_in_the_rths_loop_equals_the_local_plant(tmp_path):
     rig.m, rig.k, rig.c = 100.0, 1.0e6, 200.0  # test_rths's small specimen
     path = sh.save_rig(rig, tmp_path / "rig.toml")
     rec = rths.synthetic_record(duration=1.5)
+    rec.time, rec.acceleration = rec.time[450:700] - 4.5, rec.acceleration[450:700]  # 0.5 s of zeros, the motion
     case = rths.embedded_case(1)
     local = rths.run_trial(case, rec, "sample", experimental=rths.core.ServoHydraulicSubstructure(rig, rths.DT),
                            seed=1, keep_signals=True)
@@ -152,7 +153,7 @@ def test_remote_site_in_the_rths_loop_equals_the_local_plant(tmp_path):
     log = _finish(proc)
     assert local.ok and remote.ok and "ended (stopped)" in log
     n = len(local.response.time)
-    assert n == len(remote.response.time) == rec.samples()
+    assert n == len(remote.response.time) == rec.samples() and np.abs(local.response.actuator_force).max() > 100.0
     for ch in ("displacement", "actuator_force", "command", "measured", "feedback_force"):
         np.testing.assert_array_equal(getattr(remote.response, ch), getattr(local.response, ch), err_msg=ch)
     assert remote.J == local.J
