@@ -22,21 +22,14 @@ from pathlib import Path
 import numpy as np
 
 import servohydraulics as sh
-from servohydraulics.distributed.frame import run_frame
-from servohydraulics.distributed.server import finish_server_process, start_server_process
+from servohydraulics.distributed.frame import run_frame, run_frame_served
 
 DT, DURATION = 0.005, 4.0
 
 
 def run(rig: sh.Rig, controller: str, folder: Path) -> np.ndarray:
     path = sh.save_rig(rig, folder / "rig.toml")
-    proc, port = start_server_process("--rig", str(path), "--controller", controller, "--max-clients", "1")
-    try:
-        res = run_frame(port=port, dt=DT, duration=DURATION)
-    finally:
-        log = finish_server_process(proc)
-    if "ended (stopped)" not in log:
-        raise RuntimeError(f"the server did not end cleanly:\n{log}")
+    res = run_frame_served("--rig", str(path), "--controller", controller, dt=DT, duration=DURATION)
     return res["displacement"][:, 0]
 
 

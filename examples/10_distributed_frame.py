@@ -19,22 +19,15 @@ from pathlib import Path
 import numpy as np
 
 import servohydraulics as sh
-from servohydraulics.distributed.frame import run_frame
-from servohydraulics.distributed.server import finish_server_process, start_server_process
+from servohydraulics.distributed.frame import run_frame, run_frame_served
 from servohydraulics.distributed.site import tracking_delay
 
 DT = 0.005  # the frame's step [s]: 10 controller samples of 0.5 ms
 
 
 def remote(rig_file: Path, duration: float, controller: str, folder: Path):
-    proc, port = start_server_process("--rig", str(rig_file), "--controller", controller, "--max-clients", "1",
-                                      "--record", str(folder / controller))
-    try:
-        res = run_frame(port=port, dt=DT, duration=duration)
-    finally:
-        log = finish_server_process(proc)
-    if "ended (stopped)" not in log:
-        raise RuntimeError(f"the server did not end cleanly:\n{log}")
+    res = run_frame_served("--rig", str(rig_file), "--controller", controller, "--record", str(folder / controller),
+                           dt=DT, duration=duration)
     return res, sh.read_record(folder / controller / "client_001.csv")
 
 

@@ -103,6 +103,23 @@ def run_frame(port: int | None = None, host: str = "127.0.0.1", local_k: float |
     return {"time": t, "displacement": disp, "force": force, "step_seconds": wall}
 
 
+def run_frame_served(*server_args: str, dt: float = 0.01, duration: float = DURATION, pga: float = PGA,
+                     algorithm: str = "Linear") -> dict[str, np.ndarray]:
+    """``servohydraulics serve SERVER_ARGS... --max-clients 1`` in its own process, the frame
+    against it (run_frame), the server's log under ``"log"``; RuntimeError unless the server
+    ended the client cleanly."""
+    from .server import finish_server_process, start_server_process
+
+    proc, port = start_server_process(*server_args, "--max-clients", "1")
+    try:
+        res = run_frame(port=port, dt=dt, duration=duration, pga=pga, algorithm=algorithm)
+    finally:
+        log = finish_server_process(proc)
+    if "ended (stopped)" not in log:
+        raise RuntimeError(f"the server did not end the client cleanly:\n{log}")
+    return {**res, "log": log}
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--port", type=int, default=None, help="the site server's port (the specimen is remote)")
