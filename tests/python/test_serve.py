@@ -330,3 +330,36 @@ def test_python_experimental_substructure_failure_names_the_time():
     with pytest.raises(RuntimeError, match=r"experimental substructure failed at t = 0.024[0-9]* s: "
                                            r"ConnectionError: the site went away$"):
         rths.run_trial(rths.embedded_case(1), rec, "sample", experimental=Failing())
+
+
+@pytest.mark.parametrize("restoring_force", ["measured_displacement", "measured_force_corrected"])
+def test_rpsd_by_hand_against_a_remote_site_equals_run_rpsd(tmp_path, restoring_force):
+    """The RPsD controller stepped by hand against the paper's rig served by another process
+    (RemoteSite.sensors() as its sensors) is sh.run_rpsd with the rig in-process, sample for
+    sample: the controller/plant seam across the network."""
+    rig = sh.zhao2003()
+    path = sh.save_rig(rig, tmp_path / "rig.toml")
+    n, dt = 1000, 5e-4
+    t = np.arange(n) * dt
+    ag = 1.0 * np.sin(2 * math.pi * 1.1 * t) * np.minimum(1.0, t / 0.2)
+    res = sh.run_rpsd(rig, ground_acceleration=ag, restoring_force=restoring_force)
+    ctrl = sh.RpsdController(rig, restoring_force=restoring_force)
+    proc, port = _start("--rig", str(path), "--max-clients", "1")
+    commands, measured = np.empty(n), np.empty(n)
+    with RemoteSite("127.0.0.1", port, dt=dt, specimen=(rig.m, rig.c, rig.k)) as site:
+        sensors = site.sensors()
+        for k in range(n):
+            commands[k], measured[k] = ctrl.command(sensors, ground_acceleration=ag[k]), sensors.displacement
+            site.step(commands[k])
+            sensors = site.sensors()
+    assert "ended (stopped)" in _finish(proc)
+    assert np.abs(res.displacement).max() > 1e-3
+    np.testing.assert_array_equal(commands, res.command)
+    np.testing.assert_array_equal(measured, res.displacement)
+
+
+def test_output_from_channels_names_a_wrong_channel():
+    o = sh._core.Output.from_channels(displacement=0.25, force=-3.0)
+    assert (o.displacement, o.force, o.velocity) == (0.25, -3.0, 0.0)
+    with pytest.raises(ValueError, match="unknown plant channel pressur: expected one of time, displacement"):
+        sh._core.Output.from_channels(pressur=1.0)

@@ -2,7 +2,12 @@
 SimAppSiteServer or a lab's own) as the physical substructure of our loops.
 
     site = RemoteSite("lab.example.org", 8090, dt=rths.DT, specimen=(m, c, k))
-    trial = rths.run_trial(case, record, "sample", experimental=site)
+    trial = rths.run_trial(case, record, "sample", experimental=site)     # the RTHS loop
+
+    ctrl = sh.RpsdController(rig)                                         # RPsD, stepped by hand
+    site = RemoteSite("lab.example.org", 8090, dt=5e-4)
+    for ag in ground_acceleration:
+        site.step(ctrl.command(site.sensors(), ground_acceleration=ag))
 
 Each sample the loop's command goes out as a trial displacement stamped with the sample's
 end time ((k + 1) dt), and the site's acquired displacement, velocity and force come back
@@ -18,10 +23,13 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .. import _core
 from .protocol import Action, Sizes, request, unpack_daq
 
-#: What RemoteSite asks for: control (displacement, time), acquisition (displacement, velocity, force).
-SIZES = Sizes((1, 0, 0, 0, 1), (1, 1, 0, 1, 0), 256)
+#: What RemoteSite asks for: control (displacement, time), acquisition (displacement, velocity,
+#: acceleration, force, time).
+SIZES = Sizes((1, 0, 0, 0, 1), (1, 1, 1, 1, 1), 256)
+_ACQUIRED = ("displacement", "velocity", "acceleration", "force", "time")
 
 
 class RemoteSite:
@@ -54,6 +62,7 @@ class RemoteSite:
             self._connect()
         self.k = 0
         self.displacement = self.velocity = self.actuator_force = 0.0
+        self._acquired = dict.fromkeys(_ACQUIRED, 0.0)
 
     def step(self, command: float) -> None:
         self._used = True
@@ -61,12 +70,26 @@ class RemoteSite:
         self._send(request(Action.SET_TRIAL_RESPONSE, SIZES, displacement=[command], time=[t]))
         self._send(request(Action.GET_DAQ_RESPONSE, SIZES))
         r = unpack_daq(self._recv(), SIZES)
-        self.displacement, self.velocity, self.actuator_force = (float(r[q][0]) for q in
+        self._acquired = {q: float(r[q][0]) for q in _ACQUIRED}
+        self.displacement, self.velocity, self.actuator_force = (self._acquired[q] for q in
                                                                  ("displacement", "velocity", "force"))
         self.k += 1
 
     def specimen(self) -> tuple[float, float, float]:
         return self._specimen
+
+    # --- the controller/plant seam: the site's sensors for sh.RpsdController / sh.EftController ---
+    def sensors(self) -> _core.Output:
+        """The last acquired sample as the ``_core.Output`` a controller's ``command()`` reads
+        (time, displacement, velocity, acceleration, force; the channels the site does not send,
+        such as the pressure, are 0).  An RPsD test across the network, stepped by hand:
+
+            sensors = site.sensors()
+            for ag in ground_acceleration:
+                site.step(ctrl.command(sensors, ground_acceleration=ag))
+                sensors = site.sensors()
+        """
+        return _core.Output.from_channels(**self._acquired)
 
     # --- the rest --------------------------------------------------------------------------------
     def matrix(self, action: Action) -> np.ndarray:
