@@ -83,6 +83,26 @@ void expose_plant(py::module_& m) {
   py::class_<Output> output(m, "Output");
   output.def(py::init<>()).def_readonly("flags", &Output::flags);
   for (const ChannelInfo& c : kPlantChannels) output.def_readonly(c.name, c.member, c.doc);
+  output.def_static(
+      "from_channels",
+      [](const py::kwargs& channels) {
+        Output o;
+        for (const auto& item : channels) {
+          const auto name = item.first.cast<std::string>();
+          const ChannelInfo* c = nullptr;
+          for (const ChannelInfo& ch : kPlantChannels)
+            if (name == ch.name) c = &ch;
+          if (c == nullptr) {
+            std::string names;
+            for (const ChannelInfo& ch : kPlantChannels) names += std::string(names.empty() ? "" : ", ") + ch.name;
+            throw py::value_error("unknown plant channel " + name + ": expected one of " + names);
+          }
+          o.*(c->member) = item.second.cast<double>();
+        }
+        return o;
+      },
+      "An Output holding the given channels by name (the others 0): sensors read from a real or remote rig, for a "
+      "controller's command()");
   m.attr("PLANT_CHANNELS") = sh_py::channel_units(kPlantChannels);
 
   m.attr("FLAG_CAPACITY_EXCEEDED") = static_cast<unsigned>(kCapacityExceeded);

@@ -27,6 +27,51 @@ std::vector<double> to_vector(const Arr& a, const char* name) {
   return std::vector<double>(a.data(), a.data() + a.shape(0));
 }
 
+// Calls from a loop that runs without the GIL into a Python object: each call takes the GIL;
+// the first exception marks the object failed (later calls are skipped) and keeps its
+// "Type: message" (without the traceback pybind11 appends) for run() to raise.
+class PythonCalls {
+ public:
+  explicit PythonCalls(py::object obj) : obj_(std::move(obj)) {}
+  py::object attr(const char* name) const { return obj_.attr(name); }
+  //! The loop's reset: clears a failure, calls the object's reset(), then then().
+  template <class F>
+  void reset(F&& then) noexcept {
+    failed_ = false;
+    error_.clear();
+    (*this)([&] {
+      obj_.attr("reset")();
+      then();
+    });
+  }
+  template <class F>
+  void operator()(F&& f) const noexcept {
+    if (failed_) return;
+    py::gil_scoped_acquire gil;
+    try {
+      f();
+    } catch (py::error_already_set& e) {
+      failed_ = true;
+      try {
+        error_ = py::str(e.type().attr("__name__")).cast<std::string>() + ": " + py::str(e.value()).cast<std::string>();
+      } catch (...) {
+        error_ = e.what();
+      }
+    } catch (const std::exception& e) {
+      failed_ = true;
+      error_ = e.what();
+    }
+  }
+  bool failed() const noexcept { return failed_; }
+  const std::string& error() const noexcept { return error_; }
+  const py::object& object() const noexcept { return obj_; }
+
+ private:
+  py::object obj_;
+  mutable bool failed_ = false;
+  mutable std::string error_;
+};
+
 // A Python object as the loop's numerical substructure (e.g. rths.OpenSeesSubstructure).
 // Its protocol: attributes h, size, interface_dof; methods reset(), step(ag0, ag_mid,
 // ag1, f_in), displacements() -> size floats, interface_velocity(),
@@ -35,27 +80,20 @@ std::vector<double> to_vector(const Arr& a, const char* name) {
 // the loop stops); run() then raises it with its message.
 class PythonSubstructure final : public NumericalSubstructure {
  public:
-  explicit PythonSubstructure(py::object obj) : obj_(std::move(obj)) {
-    h_ = obj_.attr("h").cast<double>();
-    n_ = obj_.attr("size").cast<Eigen::Index>();
-    dof_ = obj_.attr("interface_dof").cast<Eigen::Index>();
+  explicit PythonSubstructure(py::object obj) : py_(std::move(obj)) {
+    h_ = py_.attr("h").cast<double>();
+    n_ = py_.attr("size").cast<Eigen::Index>();
+    dof_ = py_.attr("interface_dof").cast<Eigen::Index>();
     if (!(std::isfinite(h_) && h_ > 0.0)) throw Error("invalid numerical.h = " + std::to_string(h_) + ": finite and > 0");
     if (n_ < 1) throw Error("invalid numerical.size = " + std::to_string(n_) + ": >= 1");
     if (dof_ < 0 || dof_ >= n_)
       throw Error("invalid numerical.interface_dof = " + std::to_string(dof_) + ": one of its DOFs (0 .. size-1)");
     x_.setZero(n_);
   }
-  void reset() noexcept override {
-    failed_ = false;
-    error_.clear();
-    call([&] {
-      obj_.attr("reset")();
-      pull();
-    });
-  }
+  void reset() noexcept override { py_.reset([&] { pull(); }); }
   void step(double ag0, double ag_mid, double ag1, double f_in) noexcept override {
-    call([&] {
-      obj_.attr("step")(ag0, ag_mid, ag1, f_in);
+    py_([&] {
+      py_.attr("step")(ag0, ag_mid, ag1, f_in);
       pull();
     });
   }
@@ -65,40 +103,72 @@ class PythonSubstructure final : public NumericalSubstructure {
   double interface_velocity() const noexcept override { return v_; }
   double interface_acceleration(double ag, double f_in) const noexcept override {
     double a = std::nan("");
-    call([&] { a = obj_.attr("interface_acceleration")(ag, f_in).cast<double>(); });
+    py_([&] { a = py_.attr("interface_acceleration")(ag, f_in).cast<double>(); });
     return a;
   }
   double sample_time() const noexcept override { return h_; }
-  bool healthy() const noexcept override { return !failed_ && x_.allFinite() && std::isfinite(v_); }
-  const std::string& error() const noexcept { return error_; }
-  const py::object& object() const noexcept { return obj_; }
+  bool healthy() const noexcept override { return !py_.failed() && x_.allFinite() && std::isfinite(v_); }
+  const std::string& error() const noexcept { return py_.error(); }
+  const py::object& object() const noexcept { return py_.object(); }
 
  private:
   void pull() {
-    const auto d = obj_.attr("displacements")().cast<std::vector<double>>();
+    const auto d = py_.attr("displacements")().cast<std::vector<double>>();
     if (static_cast<Eigen::Index>(d.size()) != n_)
       throw Error("invalid numerical.displacements(): " + std::to_string(d.size()) + " values, expected size = " +
                   std::to_string(n_));
     for (Eigen::Index i = 0; i < n_; ++i) x_(i) = d[static_cast<std::size_t>(i)];
-    v_ = obj_.attr("interface_velocity")().cast<double>();
+    v_ = py_.attr("interface_velocity")().cast<double>();
   }
-  template <class F>
-  void call(F&& f) const noexcept {
-    if (failed_) return;
-    py::gil_scoped_acquire gil;
-    try {
-      f();
-    } catch (const std::exception& e) {
-      failed_ = true;
-      error_ = e.what();
-    }
-  }
-  py::object obj_;
+  PythonCalls py_;
   double h_ = 0.0, v_ = 0.0;
   Eigen::Index n_ = 0, dof_ = 0;
   Eigen::VectorXd x_;
-  mutable bool failed_ = false;
-  mutable std::string error_;
+};
+
+// A Python object as the loop's experimental substructure (e.g. distributed.RemoteSite: a
+// site across the network).  Its protocol: attribute dt; methods reset(), step(command),
+// specimen() -> (m, c, k); attributes displacement, velocity, actuator_force (read after
+// every reset and step).  Each call takes the GIL.  A Python exception marks it failed:
+// step() returns NonFinite (the loop stops) and run() raises the exception's message.
+class PythonExperimentalSubstructure final : public ExperimentalSubstructure {
+ public:
+  explicit PythonExperimentalSubstructure(py::object obj) : py_(std::move(obj)) {
+    dt_ = py_.attr("dt").cast<double>();
+    if (!(std::isfinite(dt_) && dt_ > 0.0))
+      throw Error("invalid experimental.dt = " + std::to_string(dt_) + ": finite and > 0");
+    const auto s = py_.attr("specimen")().cast<std::vector<double>>();
+    if (s.size() != 3 || !(std::isfinite(s[0]) && std::isfinite(s[1]) && std::isfinite(s[2])))
+      throw Error("invalid experimental.specimen(): expected three finite values (m, c, k)");
+    specimen_ = {s[0], s[1], s[2]};
+  }
+  void reset() noexcept override { py_.reset([&] { pull(); }); }
+  Status step(double command) noexcept override {
+    py_([&] {
+      py_.attr("step")(command);
+      pull();
+    });
+    Status s;
+    if (py_.failed() || !(std::isfinite(x_) && std::isfinite(v_) && std::isfinite(f_))) s.code = Status::NonFinite;
+    return s;
+  }
+  double displacement() const noexcept override { return x_; }
+  double velocity() const noexcept override { return v_; }
+  double actuator_force() const noexcept override { return f_; }
+  SpecimenModel specimen() const noexcept override { return specimen_; }
+  double dt() const noexcept override { return dt_; }
+  const std::string& error() const noexcept { return py_.error(); }
+  const py::object& object() const noexcept { return py_.object(); }
+
+ private:
+  void pull() {
+    x_ = py_.attr("displacement").cast<double>();
+    v_ = py_.attr("velocity").cast<double>();
+    f_ = py_.attr("actuator_force").cast<double>();
+  }
+  PythonCalls py_;
+  double dt_ = 0.0, x_ = 0.0, v_ = 0.0, f_ = 0.0;
+  SpecimenModel specimen_;
 };
 
 py::tuple run_loop(RthsLoop& loop, const NumericalSubstructure& num, const GroundMotion& ag, std::size_t n,
@@ -118,6 +188,10 @@ py::tuple run_loop(RthsLoop& loop, const NumericalSubstructure& num, const Groun
     s = loop.run(ag, n, rows.data(), numerical.mutable_data(), timing ? steps.mutable_data() : nullptr);
   }
   bindings::raise_controller_error(loop.controller(), loop.config().dt);
+  if (const auto* e = dynamic_cast<const PythonExperimentalSubstructure*>(&loop.experimental());
+      e && !e->error().empty())
+    throw std::runtime_error("experimental substructure failed at t = " + std::to_string(s.failure_time) +
+                             " s: " + e->error());
   if (const auto* p = dynamic_cast<const PythonSubstructure*>(&num); p && !p->error().empty())
     throw std::runtime_error("numerical substructure failed at t = " + std::to_string(s.failure_time) +
                              " s: " + p->error());
@@ -215,6 +289,11 @@ void expose_rths(py::module_& m) {
       .def(py::init<const BenchmarkPlantParameters&, double>(), py::arg("parameters"), py::arg("dt"))
       .def_property_readonly("parameters", &BenchmarkPlant::parameters)
       .def_property_readonly("state", &BenchmarkPlant::state);
+  py::class_<PythonExperimentalSubstructure, ExperimentalSubstructure>(
+      r, "PythonExperimentalSubstructure", "a Python object (e.g. distributed.RemoteSite) as the loop's experimental substructure")
+      .def(py::init<py::object>(), py::arg("substructure"))
+      .def_property_readonly("error", &PythonExperimentalSubstructure::error)
+      .def_property_readonly("substructure", &PythonExperimentalSubstructure::object);
   py::class_<ServoHydraulicSubstructure, ExperimentalSubstructure>(r, "ServoHydraulicSubstructure")
       .def(py::init<const Rig&, double, const SolverOptions&>(), py::arg("rig"), py::arg("dt"),
            py::arg("options") = SolverOptions{});

@@ -309,14 +309,17 @@ def run_trial(case: BenchmarkCase, record: Record, controller: Any = "sample", p
         scheme: the numerical substructure's integrator (``RungeKutta4`` as the
             benchmark, ``CentralDifference``, ``ExplicitNewmark``, ``AverageAcceleration``).
         reference: the reference displacements (N x 3), if already computed.
-        experimental: another ExperimentalSubstructure (e.g. ServoHydraulicSubstructure);
-            None: the benchmark plant.
+        experimental: another ExperimentalSubstructure (e.g. ServoHydraulicSubstructure) or a
+            Python object with its protocol (e.g. ``distributed.RemoteSite``: a site across the
+            network); None: the benchmark plant.
         numerical: another numerical substructure: a core NumericalSubstructure (e.g. a
             LinearSubstructure of other matrices) or a Python object with its protocol (e.g.
             ``rths.OpenSeesSubstructure``); None: the case partitioned at the first floor.
     """
     plant = plant if plant is not None else nominal_plant()
-    exp = experimental if experimental is not None else R.BenchmarkPlant(plant, DT)
+    exp = (R.BenchmarkPlant(plant, DT) if experimental is None
+           else experimental if isinstance(experimental, R.ExperimentalSubstructure)
+           else R.PythonExperimentalSubstructure(experimental))
     num = _numerical(numerical, case, exp, scheme)
     ctrl = as_controller(controller)
     cfg = R.RthsLoopConfig()
