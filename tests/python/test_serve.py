@@ -283,6 +283,29 @@ def test_model_site_paces_every_controller_sample_and_moves_on_request():
     assert pacer.starts == 2
 
 
+def test_serve_realtime_paces_with_the_real_pacer_and_changes_no_digit(tmp_path):
+    """serve --realtime with servohydraulics.realtime.Pacer: the frame's response is the unpaced
+    run's to the bit (pacing only waits), every controller sample was paced (the log's pacing
+    stats count them: 10 per 5 ms step, 100 steps), and the client's wall time covers them
+    (absolute deadlines: n periods cannot pass in less than n * dt)."""
+    import time
+
+    frame = pytest.importorskip("servohydraulics.distributed.frame")
+    pytest.importorskip("openseespy.opensees")
+    rig = sh.zhao2003()
+    rig.m = 140.0
+    path = str(sh.save_rig(rig, tmp_path / "rig.toml"))
+    free = frame.run_frame_served("--rig", path, dt=0.005, duration=0.5)
+    t0 = time.monotonic()
+    paced = frame.run_frame_served("--rig", path, "--realtime", dt=0.005, duration=0.5)
+    wall = time.monotonic() - t0
+    np.testing.assert_array_equal(paced["displacement"], free["displacement"])
+    np.testing.assert_array_equal(paced["force"], free["force"])
+    m = re.search(r"'samples': (\d+), 'misses': (\d+)", paced["log"])
+    assert m, paced["log"]
+    assert int(m.group(1)) == 1000 and wall >= 1000 * 5e-4
+
+
 def test_tracking_delay_finds_a_known_lag():
     t = np.arange(4000) * 5e-4
     u = np.sin(2 * math.pi * 2.0 * t) + 0.3 * np.sin(2 * math.pi * 5.3 * t)
