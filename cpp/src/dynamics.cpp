@@ -105,10 +105,10 @@ double Dynamics::spring_stiffness(double x) const noexcept { return law<Spring>(
 double Dynamics::friction_level(double v) const noexcept { return StribeckLevel::of(rig_).level(v); }
 double Dynamics::friction_level_slope(double v) const noexcept { return StribeckLevel::of(rig_).slope(v); }
 double Dynamics::friction_force(double v) const noexcept {
-  return TanhFriction::acts(rig_) ? TanhFriction::of(rig_).force(v) : 0.0;
+  return TanhFriction::acts(rig_) ? TanhFriction::of(rig_).at(v).F : 0.0;
 }
 double Dynamics::friction_slope(double v) const noexcept {
-  return TanhFriction::acts(rig_) ? TanhFriction::of(rig_).slope(v) : 0.0;
+  return TanhFriction::acts(rig_) ? TanhFriction::of(rig_).at(v).dF_dv : 0.0;
 }
 double Dynamics::flow_gain(double s) const noexcept {
   return rig_.effects.flow_nonlinearity ? rig_.flow_curve.eval(s) : s;

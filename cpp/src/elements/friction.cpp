@@ -26,16 +26,7 @@ std::optional<TanhFriction> TanhFriction::from(const Rig& r, ControlMode) {
   return of(r);
 }
 
-double TanhFriction::force(double v) const noexcept { return g.level(v) * std::tanh(v / v_stick); }
-
-double TanhFriction::slope(double v) const noexcept {
-  const double t = std::tanh(v / v_stick);
-  return g.slope(v) * t + g.level(v) * (1.0 - t * t) / v_stick;
-}
-
-// force() and slope() with one tanh and one level.
-LawForce TanhFriction::eval(const double* y, Algebra&) const noexcept {
-  const double v = y[kV];
+LawForce TanhFriction::at(double v) const noexcept {
   const double t = std::tanh(v / v_stick), gv = g.level(v);
   LawForce f;
   f.F = gv * t;

@@ -29,11 +29,11 @@ struct TanhFriction {
   static TanhFriction of(const Rig& r) noexcept { return {StribeckLevel::of(r), r.v_stick}; }  //!< whichever is on
   //! The Coulomb switch is on with a force (either law acts).
   static bool acts(const Rig& r) noexcept { return r.effects.coulomb_friction && r.F_c != 0.0; }
-  double force(double v) const noexcept;  //!< [N]
-  double slope(double v) const noexcept;  //!< dF/dv [N s/m]
+  //! The force F [N] and its slope dF/dv [N s/m] at v (the other derivatives 0).
+  LawForce at(double v) const noexcept;
   double static_force(double) const noexcept { return kNoStaticForce; }
   double rate_bound(double) const noexcept { return 0.0; }
-  LawForce eval(const double* y, Algebra& g) const noexcept;
+  LawForce eval(const double* y, Algebra&) const noexcept { return at(y[kV]); }
 };
 
 //! LuGre: z' = v - sigma_0 |v| z / g(v), F = sigma_0 z + sigma_1 z' (its sigma_2 v is the
