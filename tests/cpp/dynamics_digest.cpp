@@ -14,11 +14,13 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <iterator>
 #include <string>
 #include <vector>
 
 #include "randomizer.hpp"
 #include "servohydraulics/linearize.hpp"
+#include "servohydraulics/parameters.hpp"
 #include "servohydraulics/plant.hpp"
 #include "servohydraulics/presets.hpp"
 
@@ -59,21 +61,11 @@ struct Hash {
   }
 };
 
+// Bit i of mask is the switch of row i of kEffects (servovalve_dynamics = 1, ..., fluid_damper = 4096).
 void set_effects(Effects& e, unsigned mask) {
-  e.servovalve_dynamics = mask & 1u;
-  e.load_pressure = mask & 2u;
-  e.flow_nonlinearity = mask & 4u;
-  e.coulomb_friction = mask & 8u;
-  e.spring_softening = mask & 16u;
-  e.piston_mass = mask & 32u;
-  e.drive_saturation = mask & 64u;
-  e.spool_saturation = mask & 128u;
-  e.lugre_friction = mask & 256u;
-  e.bouc_wen_hysteresis = mask & 512u;
-  e.mr_damper = mask & 1024u;
-  e.loop_delay = mask & 2048u;
-  e.fluid_damper = mask & 4096u;
+  for (std::size_t i = 0; i < std::size(kEffects); ++i) e.*kEffects[i].member = (mask >> i) & 1u;
 }
+static_assert(std::size(kEffects) == 13, "one mask bit per effect");
 constexpr unsigned kMasks = 1u << 13;
 
 std::vector<Rig> rigs() {
