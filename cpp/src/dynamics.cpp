@@ -102,8 +102,8 @@ const Dynamics::Pade& Dynamics::pade() const noexcept {
 
 double Dynamics::spring_force(double x) const noexcept { return law<Spring>()->force(x); }
 double Dynamics::spring_stiffness(double x) const noexcept { return law<Spring>()->stiffness(x); }
-double Dynamics::friction_level(double v) const noexcept { return StribeckLevel::of(rig_).level(v); }
-double Dynamics::friction_level_slope(double v) const noexcept { return StribeckLevel::of(rig_).slope(v); }
+double Dynamics::friction_level(double v) const noexcept { return StribeckLevel::of(rig_).at(v).level; }
+double Dynamics::friction_level_slope(double v) const noexcept { return StribeckLevel::of(rig_).at(v).slope; }
 double Dynamics::friction_force(double v) const noexcept {
   return TanhFriction::acts(rig_) ? TanhFriction::of(rig_).at(v).F : 0.0;
 }

@@ -9,16 +9,10 @@ namespace servohydraulics {
 
 using detail::sgn;
 
-double StribeckLevel::level(double v) const noexcept {
-  if (ratio == 1.0) return F_c;
-  const double q = v / v_s;
-  return F_c * (1.0 + (ratio - 1.0) * std::exp(-q * q));
-}
-
-double StribeckLevel::slope(double v) const noexcept {
-  if (ratio == 1.0) return 0.0;
-  const double q = v / v_s;
-  return F_c * (ratio - 1.0) * std::exp(-q * q) * (-2.0 * q / v_s);
+StribeckLevel::Value StribeckLevel::at(double v) const noexcept {
+  if (ratio == 1.0) return {F_c, 0.0};
+  const double q = v / v_s, e = std::exp(-q * q);
+  return {F_c * (1.0 + (ratio - 1.0) * e), F_c * (ratio - 1.0) * e * (-2.0 * q / v_s)};
 }
 
 std::optional<TanhFriction> TanhFriction::from(const Rig& r, ControlMode) {
@@ -27,10 +21,11 @@ std::optional<TanhFriction> TanhFriction::from(const Rig& r, ControlMode) {
 }
 
 LawForce TanhFriction::at(double v) const noexcept {
-  const double t = std::tanh(v / v_stick), gv = g.level(v);
+  const double t = std::tanh(v / v_stick);
+  const StribeckLevel::Value gv = g.at(v);
   LawForce f;
-  f.F = gv * t;
-  f.dF_dv = g.slope(v) * t + gv * (1.0 - t * t) / v_stick;
+  f.F = gv.level * t;
+  f.dF_dv = gv.slope * t + gv.level * (1.0 - t * t) / v_stick;
   return f;
 }
 
@@ -41,9 +36,10 @@ std::optional<LuGreFriction> LuGreFriction::from(const Rig& r, ControlMode) {
 
 LawForce LuGreFriction::eval(const double* y, Algebra& a) const noexcept {
   const double v = y[kV], z = y[kZ];
-  const double gv = g.level(v), av = std::fabs(v);
+  const StribeckLevel::Value s = g.at(v);
+  const double gv = s.level, av = std::fabs(v);
   a.zdot = v - sigma_0 * av * z / gv;
-  a.dzdot[kV] = 1.0 - sigma_0 * z * (sgn(v) * gv - av * g.slope(v)) / (gv * gv);
+  a.dzdot[kV] = 1.0 - sigma_0 * z * (sgn(v) * gv - av * s.slope) / (gv * gv);
   a.dzdot[kZ] = -sigma_0 * av / gv;
   LawForce f;
   f.F = sigma_0 * z + sigma_1 * a.zdot;

@@ -15,8 +15,10 @@ namespace servohydraulics {
 struct StribeckLevel {
   double F_c = 0.0, ratio = 1.0, v_s = 1.0;  //!< Rig::F_c, stribeck_ratio, v_s
   static StribeckLevel of(const Rig& r) noexcept { return {r.F_c, r.stribeck_ratio, r.v_s}; }
-  double level(double v) const noexcept;  //!< g(v) [N]
-  double slope(double v) const noexcept;  //!< g'(v) [N s/m]
+  struct Value {
+    double level, slope;  //!< g(v) [N] and g'(v) [N s/m]
+  };
+  Value at(double v) const noexcept;  //!< both, with one exp
 };
 
 //! The static law F = g(v) tanh(v / v_stick) (effects.coulomb_friction without lugre_friction).
