@@ -3,10 +3,12 @@
 //
 //   sh_bench_step_time --command cmd.csv --json out.json [--dt 0.0005]
 //                      [--only NAME] [--steps N] [--repeat R] [--no-reference]
+//                      [--effect NAME[=0|1]]...
 //
 // cmd.csv: a header line, then rows "time,command" (command: displacement [m]);
 // benchmarks/run.py writes it (the displacement response of the rig's SDOF to
-// a synthetic ground-motion record) and runs this program.
+// a synthetic ground-motion record) and runs this program.  --effect switches an
+// effect of the preset by its kEffects name (lugre_friction, loop_delay, ...).
 //
 // For every solver configuration: per-step wall time (median, p99, p99.9, max)
 // and its share of the budget, CVODE internal steps and right-hand-side
@@ -24,10 +26,13 @@
 #include <functional>
 #include <iostream>
 #include <sstream>
+#include <iterator>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "servohydraulics/loops.hpp"
+#include "servohydraulics/parameters.hpp"
 #include "servohydraulics/plant.hpp"
 #include "servohydraulics/zhao2003.hpp"
 #include "servohydraulics/record.hpp"
@@ -47,6 +52,7 @@ struct Args {
   long steps = -1;  // -1: the whole record
   int repeat = 1;   // timed passes per case (the fastest whole-record pass is kept)
   bool no_reference = false;  // with --only: skip the reference (profiling runs)
+  std::vector<std::pair<std::string, bool>> effects;  // --effect NAME[=0|1]: switches of the preset
 };
 
 Args parse(int argc, char** argv) {
@@ -64,6 +70,11 @@ Args parse(int argc, char** argv) {
     else if (k == "--steps") a.steps = std::stol(next());
     else if (k == "--repeat") a.repeat = std::stoi(next());
     else if (k == "--no-reference") a.no_reference = true;
+    else if (k == "--effect") {
+      const std::string e = next();
+      const auto eq = e.find('=');
+      a.effects.emplace_back(e.substr(0, eq), eq == std::string::npos || e.substr(eq + 1) != "0");
+    }
     else throw std::runtime_error("unknown argument " + k);
   }
   if (a.command_path.empty()) throw std::runtime_error("--command FILE is required");
@@ -382,7 +393,13 @@ int main(int argc, char** argv) {
     const Input in = read_input(args.command_path);
     std::size_t n = in.command.size();
     if (args.steps > 0 && static_cast<std::size_t>(args.steps) < n) n = static_cast<std::size_t>(args.steps);
-    const sh::Rig rig = sh::zhao2003();  // calibrated preset, every nonlinear effect on
+    sh::Rig rig = sh::zhao2003();  // calibrated preset, every nonlinear effect on
+    for (const auto& [name, on] : args.effects) {
+      const auto* e = std::find_if(std::begin(sh::kEffects), std::end(sh::kEffects),
+                                   [&](const sh::EffectInfo& i) { return name == i.key; });
+      if (e == std::end(sh::kEffects)) throw std::runtime_error("--effect: no effect named " + name);
+      rig.effects.*(e->member) = on;
+    }
     using R = sh::SolverOptions::Restart;
     const sh::SolverOptions reference_options = cvode(1e-10, R::OnInputChange, 5);
 

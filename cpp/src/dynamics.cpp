@@ -22,7 +22,8 @@ Dynamics::Dynamics(const Rig& rig, ControlMode mode) : rig_(rig), mode_(mode) {
   M_ = rig_.m + mp_;
   CF_ = mode == ControlMode::Force ? rig_.C_F_force : rig_.C_F_disp;
   wv_ = 2.0 * kPi * rig_.f_v;
-  lugre_ = rig_.effects.coulomb_friction && rig_.effects.lugre_friction && rig_.F_c > 0.0;
+  std::apply([&](auto&... law) { ((law = std::decay_t<decltype(law)>::value_type::from(rig_, mode_)), ...); },
+             laws_);
   // The elements' states are appended in the order of Elements, each only when it is on.
   int n = kNumStates;
   std::size_t idx = 0;
@@ -63,8 +64,11 @@ double Dynamics::state_scale(int i) const noexcept {
   return scale;
 }
 
+// The structure's laws (each adds its force at rest; kNoStaticForce adds nothing), then the
+// structure elements.
 double Dynamics::static_force(double x) const noexcept {
-  double f = spring_force(x);
+  double f = kNoStaticForce;
+  each_law([&](const auto& law) { f += law.static_force(x); });
   each([&](const auto& e, int) {
     if constexpr (std::decay_t<decltype(e)>::kPort == Port::Structure) {
       const double fe = e.static_force(x);
@@ -80,6 +84,12 @@ double Dynamics::element_rate_bound(double v_ref) const noexcept {
   return rho;
 }
 
+double Dynamics::rate_bound(double v_ref) const noexcept {
+  double rho = 0.0;
+  each_law([&](const auto& law) { rho = std::max(rho, law.rate_bound(v_ref)); });
+  return std::max(rho, element_rate_bound(v_ref));
+}
+
 double Dynamics::no_load_speed() const noexcept {
   return rig_.K_v * flow_gain(std::min(rig_.x_v_max, 1.0)) / rig_.A;
 }
@@ -90,33 +100,15 @@ const Dynamics::Pade& Dynamics::pade() const noexcept {
   return p ? *p : off;
 }
 
-double Dynamics::spring_force(double x) const noexcept {
-  const double xc = rig_.x_contact;
-  if (!rig_.effects.spring_softening || std::fabs(x) <= xc) return rig_.k * x;
-  return std::copysign(rig_.k * xc + rig_.k_2 * (std::fabs(x) - xc), x);
-}
-double Dynamics::spring_stiffness(double x) const noexcept {
-  if (!rig_.effects.spring_softening || std::fabs(x) <= rig_.x_contact) return rig_.k;
-  return rig_.k_2;
-}
-double Dynamics::friction_level(double v) const noexcept {
-  if (rig_.stribeck_ratio == 1.0) return rig_.F_c;
-  const double q = v / rig_.v_s;
-  return rig_.F_c * (1.0 + (rig_.stribeck_ratio - 1.0) * std::exp(-q * q));
-}
-double Dynamics::friction_level_slope(double v) const noexcept {
-  if (rig_.stribeck_ratio == 1.0) return 0.0;
-  const double q = v / rig_.v_s;
-  return rig_.F_c * (rig_.stribeck_ratio - 1.0) * std::exp(-q * q) * (-2.0 * q / rig_.v_s);
-}
+double Dynamics::spring_force(double x) const noexcept { return law<Spring>()->force(x); }
+double Dynamics::spring_stiffness(double x) const noexcept { return law<Spring>()->stiffness(x); }
+double Dynamics::friction_level(double v) const noexcept { return StribeckLevel::of(rig_).at(v).level; }
+double Dynamics::friction_level_slope(double v) const noexcept { return StribeckLevel::of(rig_).at(v).slope; }
 double Dynamics::friction_force(double v) const noexcept {
-  if (!rig_.effects.coulomb_friction || rig_.F_c == 0.0) return 0.0;
-  return friction_level(v) * std::tanh(v / rig_.v_stick);
+  return TanhFriction::acts(rig_) ? TanhFriction::of(rig_).at(v).F : 0.0;
 }
 double Dynamics::friction_slope(double v) const noexcept {
-  if (!rig_.effects.coulomb_friction || rig_.F_c == 0.0) return 0.0;
-  const double t = std::tanh(v / rig_.v_stick);
-  return friction_level_slope(v) * t + friction_level(v) * (1.0 - t * t) / rig_.v_stick;
+  return TanhFriction::acts(rig_) ? TanhFriction::of(rig_).at(v).dF_dv : 0.0;
 }
 double Dynamics::flow_gain(double s) const noexcept {
   return rig_.effects.flow_nonlinearity ? rig_.flow_curve.eval(s) : s;
@@ -138,31 +130,6 @@ double Dynamics::pressure_factor_dp(double s, double p) const noexcept {
 // element is appended).  Arrays are sized for the capacity; evaluate<W> runs over W = n + 1.
 constexpr int kCap = Algebra::kCap;
 
-struct Dynamics::Friction {
-  double F = 0, dF_dv = 0, dF_dz = 0;           // friction force and its gradient
-  double zdot = 0, dzdot_dv = 0, dzdot_dz = 0;  // LuGre bristle rate and its gradient
-};
-
-// Friction: the static law g(v) tanh(v / v_stick), or LuGre (Canudas de Wit et al. 1995):
-// z' = v - sigma_0 |v| z / g(v),  F_f = sigma_0 z + sigma_1 z'  (its sigma_2 v is c v).
-Dynamics::Friction Dynamics::friction(double v, double z) const noexcept {
-  const Rig& r = rig_;
-  Friction f;
-  if (lugre_) {
-    const double gv = friction_level(v), av = std::fabs(v);
-    f.zdot = v - r.sigma_0 * av * z / gv;
-    f.dzdot_dv = 1.0 - r.sigma_0 * z * (sgn(v) * gv - av * friction_level_slope(v)) / (gv * gv);
-    f.dzdot_dz = -r.sigma_0 * av / gv;
-    f.F = r.sigma_0 * z + r.sigma_1 * f.zdot;
-    f.dF_dv = r.sigma_1 * f.dzdot_dv;
-    f.dF_dz = r.sigma_0 + r.sigma_1 * f.dzdot_dz;
-  } else {
-    f.F = friction_force(v);
-    f.dF_dv = friction_slope(v);
-  }
-  return f;
-}
-
 double Dynamics::specimen_force(const double* y) const noexcept {
   if (!specimen_on_) return 0.0;
   Algebra g;
@@ -171,8 +138,16 @@ double Dynamics::specimen_force(const double* y) const noexcept {
   return g.Fsp;
 }
 
+// The structure's laws' forces, in the order of StructureLaws.
 double Dynamics::structure_force(double x, double v, double z) const noexcept {
-  return friction(v, z).F + rig_.c * v + spring_force(x);
+  double y[kNumStates] = {};
+  y[kX] = x;
+  y[kV] = v;
+  y[kZ] = z;
+  Algebra g;
+  double F = kNoStaticForce;
+  each_law([&](const auto& law) { F += law.eval(y, g).F; });
+  return F;
 }
 
 // The structure elements (specimens in parallel with the structure): their force and state rates.
@@ -196,36 +171,34 @@ bool Dynamics::delay_drive(const double* y, Algebra& g) const noexcept {
   return on;
 }
 
-// Structure, Eq (5), with friction (the static law or LuGre, see friction()) and the structure
-// elements: the acceleration and its gradient.
+// Structure, Eq (5): M a = pA - (the structure's laws: friction, damping, spring, in the order
+// of StructureLaws) - (the structure elements), the piston riding along.  The acceleration and
+// its gradient.
 template <int W>
 void Dynamics::structure(const double* y, const Input& in, Algebra& g) const noexcept {
-  const Rig& r = rig_;
   const bool actuator = mode_ != ControlMode::Free;
-  const double x = y[kX], v = y[kV], p = y[kP];
-  const Friction f = friction(v, y[kZ]);
-  const double Ff = f.F, dFf_dv = f.dF_dv, dFf_dz = f.dF_dz;
-  if (lugre_) {
-    g.zdot = f.zdot;
-    g.dzdot[kV] = f.dzdot_dv;
-    g.dzdot[kZ] = f.dzdot_dz;
-  }
-
-  // M a = pA - F_f - c v - f_s(x) - F_sp, the piston riding along.
-  const double applied = actuator ? p * r.A : in.u;  // Free: the command is an ideal force
+  double net = actuator ? y[kP] * rig_.A : in.u;  // Free: the command is an ideal force
+  LawForce laws;                                   // the laws' gradients, summed
+  each_law([&](const auto& law) {
+    const LawForce f = law.eval(y, g);
+    net -= f.F;
+    laws.dF_dx += f.dF_dx;
+    laws.dF_dv += f.dF_dv;
+    laws.dF_dz += f.dF_dz;
+  });
   if (!specimen_on_) {
-    g.a = (applied - Ff - r.c * v - spring_force(x)) / M_;
-    g.da[kX] = -spring_stiffness(x) / M_;
-    g.da[kV] = -(dFf_dv + r.c) / M_;
+    g.a = net / M_;
+    g.da[kX] = -laws.dF_dx / M_;
+    g.da[kV] = -laws.dF_dv / M_;
   } else {
     specimen<W>(y, g);
-    g.a = (applied - Ff - r.c * v - spring_force(x) - g.Fsp) / M_;
+    g.a = (net - g.Fsp) / M_;
     for (int j = 0; j < W; ++j) g.da[j] = -g.dFsp[j] / M_;
-    g.da[kX] = -(spring_stiffness(x) + g.dFsp[kX]) / M_;
-    g.da[kV] = -(dFf_dv + r.c + g.dFsp[kV]) / M_;
+    g.da[kX] = -(laws.dF_dx + g.dFsp[kX]) / M_;
+    g.da[kV] = -(laws.dF_dv + g.dFsp[kV]) / M_;
   }
-  g.da[kZ] = -dFf_dz / M_;
-  g.da[kP] = actuator ? r.A / M_ : 0.0;
+  g.da[kZ] = -laws.dF_dz / M_;
+  g.da[kP] = actuator ? rig_.A / M_ : 0.0;
   g.da[ku_] = actuator ? 0.0 : 1.0 / M_;
 }
 
@@ -338,7 +311,7 @@ void Dynamics::rhs(const double* y, const Input& in, double* ydot) const noexcep
   const bool valve = actuator && rig_.effects.servovalve_dynamics;
   ydot[kXv] = valve ? y[kXvDot] : 0.0;
   ydot[kXvDot] = valve ? g.xvdd : 0.0;
-  ydot[kZ] = lugre_ ? g.zdot : 0.0;
+  ydot[kZ] = g.zdot;  // the bristle's rate (0 unless a friction law has one)
   for (int i = kNumStates; i < layout_.num_states; ++i) ydot[i] = g.rate[i];
 }
 
@@ -351,8 +324,7 @@ void Dynamics::jacobian(const double* y, const Input& in, Jacobian& J, State* B)
   J[kX][kV] = 1.0;
   for (int j = 0; j < n; ++j) J[kV][j] = g.da[j];
   if (B) (*B)[kV] = g.da[ku_];
-  if (lugre_)
-    for (int j = 0; j < n; ++j) J[kZ][j] = g.dzdot[j];
+  for (int j = 0; j < n; ++j) J[kZ][j] = g.dzdot[j];
   jacobian_appended(g, J, B);
   if (mode_ == ControlMode::Free) return;
   for (int j = 0; j < n; ++j) J[kP][j] = g.dpdot[j];

@@ -10,6 +10,11 @@
 //    the Stribeck peak and LuGre.
 // 3. simulate() (the allocating Trace wrapper) gives the rows run_record's
 //    convention promises: row k is the state before command[k], stepping by hand.
+// 4. The structure's laws (StructureLaws): which are on for each friction switch (at most one
+//    friction law; LuGre only with F_c > 0), the spring's closed form across the contact point,
+//    the RK4 rule's bound (rate_bound: LuGre's sigma_0 v / F_c with the elements') apart from the
+//    kinematic driver's (element_rate_bound and specimen_forces see the specimens only).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -114,6 +119,53 @@ void check_simulate_trace() {
   CHECK(rows);
   CHECK(&tr[Channel::Force] == &tr.channel[static_cast<std::size_t>(Channel::Force)]);
 }
+void check_structure_laws() {
+  for (int mask = 0; mask < 8; ++mask) {
+    Rig rig = zhao2003();
+    rig.effects.coulomb_friction = mask & 1;
+    rig.effects.lugre_friction = mask & 2;
+    rig.F_c = (mask & 4) ? 0.0 : 40.0;
+    const Dynamics dyn(rig, ControlMode::Displacement);
+    const bool coulomb = rig.effects.coulomb_friction && rig.F_c > 0.0;
+    const bool lugre = coulomb && rig.effects.lugre_friction;
+    CHECK((dyn.law<LuGreFriction>() != nullptr) == lugre);
+    CHECK(dyn.lugre() == lugre);
+    CHECK((dyn.law<TanhFriction>() != nullptr) == (coulomb && !lugre));
+    CHECK(dyn.law<Spring>() != nullptr && dyn.law<ViscousDamping>() != nullptr);
+    CHECK(dyn.rate_bound(0.3) == (lugre ? rig.sigma_0 * 0.3 / rig.F_c : 0.0));
+    CHECK(dyn.element_rate_bound(0.3) == 0.0);
+  }
+  // The spring: k x inside the contact point, k x_c + k_2 (|x| - x_c) beyond, odd, continuous.
+  const Rig rig = zhao2003();
+  const Dynamics dyn(rig, ControlMode::Displacement);
+  const double xc = rig.x_contact;
+  CHECK_NEAR(dyn.spring_force(0.5 * xc), rig.k * 0.5 * xc, 1e-9 * rig.k * xc);
+  CHECK_NEAR(dyn.spring_force(2.0 * xc), rig.k * xc + rig.k_2 * xc, 1e-9 * rig.k * xc);
+  CHECK(dyn.spring_force(-2.0 * xc) == -dyn.spring_force(2.0 * xc));
+  CHECK_NEAR(dyn.spring_force(xc * (1.0 + 1e-12)), rig.k * xc, 1e-6 * rig.k * xc);
+  CHECK(dyn.spring_stiffness(2.0 * xc) == rig.k_2 && dyn.spring_stiffness(0.5 * xc) == rig.k);
+  // LuGre with a Bouc-Wen specimen: the RK4 rule takes the larger bound, the driver only the specimen's;
+  // the driver's force is the specimen's whichever friction law acts.
+  Rig both = zhao2003();
+  both.effects.lugre_friction = true;
+  both.effects.bouc_wen_hysteresis = true;
+  const Dynamics with_lugre(both, ControlMode::Displacement);
+  const double specimen = with_lugre.element_rate_bound(0.3);
+  CHECK(specimen > 0.0);
+  CHECK(with_lugre.rate_bound(0.3) == std::max(specimen, both.sigma_0 * 0.3 / both.F_c));
+  Rig none = both;
+  none.effects.coulomb_friction = false;
+  const Dynamics without(none, ControlMode::Displacement);
+  std::vector<double> x(300), v(300), Fa(300), Fb(300);
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    x[k] = 0.01 * std::sin(0.05 * static_cast<double>(k));
+    v[k] = 0.01 * 0.05 / 1e-3 * std::cos(0.05 * static_cast<double>(k));
+  }
+  with_lugre.specimen_forces(x.data(), v.data(), x.size(), 1e-3, 4, Fa.data());
+  without.specimen_forces(x.data(), v.data(), x.size(), 1e-3, 4, Fb.data());
+  CHECK(Fa == Fb);
+  CHECK(std::fabs(Fa.back()) > 0.0);
+}
 }  // namespace
 
 int main() {
@@ -121,5 +173,6 @@ int main() {
   check_operating_point(rnd);
   check_structure_force(rnd);
   check_simulate_trace();
+  check_structure_laws();
   return sh_test::report("test_dynamics");
 }

@@ -76,6 +76,9 @@ class Dynamics {
   //! Upper estimate of |d rate / d state| of the elements' states when sliding at v_ref [m/s]:
   //! their stiffness for an explicit integrator [1/s] (0 when no element bounds it).
   double element_rate_bound(double v_ref) const noexcept;
+  //! The same over the structure's laws' states too (LuGre's bristle) and the elements': the
+  //! bound the automatic RK4 rule takes with the Jacobian's spectral radius [1/s].
+  double rate_bound(double v_ref) const noexcept;
   //! The actuator's no-load speed K_v g(min(x_v_max, 1)) / A [m/s].
   double no_load_speed() const noexcept;
   //! The switched-on element E, or nullptr when it is off.
@@ -83,6 +86,12 @@ class Dynamics {
   const E* element() const noexcept {
     const auto& e = std::get<element_index<E>>(elements_);
     return e ? &*e : nullptr;
+  }
+  //! The structure's law L (StructureLaws), or nullptr when it is off.
+  template <class L>
+  const L* law() const noexcept {
+    const auto& l = std::get<std::optional<L>>(laws_);
+    return l ? &*l : nullptr;
   }
   //! The Pade loop delay's realisation (order 0 when it is off).
   using Pade = PadeDelay;
@@ -92,24 +101,23 @@ class Dynamics {
   ControlMode mode() const noexcept { return mode_; }
   double moving_mass() const noexcept { return M_; }
 
-  // Pieces of the model, exposed for compensators and tests.
+  // Pieces of the model, exposed for compensators and tests (the laws' own, elements/*.hpp).
   //! The structure's force against the applied one in Eq (5), f_s(x) + c v + F_f [N]:
-  //! spring, damping and friction (the static law, or LuGre with bristle deflection z).
+  //! its laws, spring, damping and friction (the static law, or LuGre with bristle deflection z).
   double structure_force(double x, double v, double z = 0.0) const noexcept;
   double spring_force(double x) const noexcept;         //!< f_s(x) [N]
   double spring_stiffness(double x) const noexcept;     //!< df_s/dx [N/m]
-  double friction_force(double v) const noexcept;       //!< static friction law g(v) tanh(v / v_stick) [N]
+  double friction_force(double v) const noexcept;       //!< static friction law g(v) tanh(v / v_stick) [N] (either law on)
   double friction_slope(double v) const noexcept;       //!< its derivative [N s/m]
   double friction_level(double v) const noexcept;       //!< sliding level g(v) with the Stribeck peak [N]
   double friction_level_slope(double v) const noexcept; //!< g'(v) [N s/m]
-  bool lugre() const noexcept { return lugre_; }        //!< friction is the LuGre model (state kZ active)
+  bool lugre() const noexcept { return law<LuGreFriction>() != nullptr; }  //!< friction is LuGre (state kZ active)
   double flow_gain(double s) const noexcept;            //!< g(s) with the effect switches applied
   double flow_gain_slope(double s) const noexcept;      //!< g'(s)
   double pressure_factor(double s, double p) const noexcept;        //!< the square-root term of Eq (3)
   double pressure_factor_dp(double s, double p) const noexcept;     //!< its derivative by p [1/Pa]
 
  private:
-  struct Friction;  // friction force, bristle rate and their gradients
   // W: the gradient width the loops run over, a constant so that they unroll (the paper
   // plant's kNumStates + 1, or the capacity with appended states).
   template <int W>
@@ -126,6 +134,11 @@ class Dynamics {
   template <int W>
   bool delay_drive(const double* y, Algebra& a) const noexcept;
   void jacobian_appended(const Algebra& g, Jacobian& J, State* B) const noexcept;
+  // f(law) for each law of the structure that is on, in the order of StructureLaws.
+  template <class F>
+  void each_law(F&& f) const {
+    std::apply([&](const auto&... l) { ((l ? f(*l) : void()), ...); }, laws_);
+  }
   // f(element, offset) for each switched-on element, in the order of Elements.
   template <class F>
   void each(F&& f) const {
@@ -135,20 +148,19 @@ class Dynamics {
   void each_impl(F& f, std::index_sequence<I...>) const {
     ((std::get<I>(elements_) ? f(*std::get<I>(elements_), layout_.offset[I]) : void()), ...);
   }
-  Friction friction(double v, double z) const noexcept;
   double static_force(double x) const noexcept;  // the structure's force at rest at x
 
   Rig rig_;
   ControlMode mode_;
   double M_;        // moving mass [kg]
   double mp_;       // piston mass seen by the load cell [kg]
-  bool lugre_;      // LuGre friction on (coulomb_friction && lugre_friction && F_c > 0)
   double CF_;       // conversion factor of the mode [V/m or V/N]
   double wv_;       // valve natural frequency [rad/s]
   StateLayout layout_;
   int ku_ = kNumStates;      // gradient column of the command u (= num_states())
   int ng_ = kNumStates + 1;  // gradient width
   bool specimen_on_ = false;  // a structure element is on
+  detail::Optionals<StructureLaws>::type laws_;
   detail::Optionals<Elements>::type elements_;
 };
 

@@ -14,6 +14,19 @@
 //   void jacobian(const Algebra&, int offset, int n, int ku, Jacobian&, State* B)
 //                                 its rows of J and B (copy_rows, or constant rows of its own).
 // Adding an element: docs/architecture.md, "Add an element".
+//
+// The structure's own laws of Eq (5), the spring with its softening, the viscous damping and the
+// friction laws (the static law, LuGre), are a second, smaller collection, StructureLaws, folded
+// the same way, because they differ from the switchable elements in three ways: they are the
+// structure, not a specimen (their force is not the specimen_force channel nor the kinematic
+// driver's); they append no state (LuGre's bristle is the base state kZ, so that the layout, the
+// channels and the FMU's variables stay the paper plant's); and they are functions of x, v and z
+// only, so each returns a LawForce (its force and three partial derivatives) rather than rows of
+// the full gradient width.  A law is a struct with
+//   kName, static std::optional<L> from(const Rig&, ControlMode) (nullopt: off; the spring and
+//   the damping are always on), double static_force(double x) (kNoStaticForce when it holds
+//   nothing at rest), double rate_bound(double v_ref) (its state's stiffness, for the RK4 rule),
+//   LawForce eval(const double* y, Algebra&) (LuGre also writes the bristle's rate zdot, dzdot).
 #pragma once
 
 #include <array>
@@ -24,8 +37,11 @@
 
 #include "servohydraulics/elements/bouc_wen.hpp"
 #include "servohydraulics/elements/fluid_damper.hpp"
+#include "servohydraulics/elements/friction.hpp"
 #include "servohydraulics/elements/mr_damper.hpp"
 #include "servohydraulics/elements/pade_delay.hpp"
+#include "servohydraulics/elements/spring.hpp"
+#include "servohydraulics/elements/viscous_damping.hpp"
 
 namespace servohydraulics {
 
@@ -33,6 +49,10 @@ namespace servohydraulics {
 using Elements = std::tuple<BoucWen, MrDamper, PadeDelay, FluidDamper>;
 
 constexpr std::size_t kNumElements = std::tuple_size_v<Elements>;
+
+//! The structure's laws, in the order Eq (5) subtracts their forces (pA - F_f - c v - f_s(x)):
+//! at most one friction law is on, the damping and the spring always are.
+using StructureLaws = std::tuple<TanhFriction, LuGreFriction, ViscousDamping, Spring>;
 
 namespace detail {
 template <class T, class Tuple>

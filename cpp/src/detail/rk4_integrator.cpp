@@ -46,12 +46,12 @@ int rk4_automatic_substeps(const Dynamics& dyn, double dt, const SolverOptions& 
   require(std::isfinite(dt) && dt > 0.0, "dt", dt, "controller sample time must be finite and > 0 [s]");
   opt.validate();
   double rho = loop_spectral_radius(dyn);
-  // LuGre and the elements' states (hysteretic specimens, dashpots) stiffen with the sliding speed:
+  // The laws' and the elements' states (LuGre's bristle, hysteretic specimens, dashpots) stiffen with the
+  // sliding speed (Dynamics::rate_bound):
   // bound |v| by v_ref, given, or the no-load actuator speed (1 m/s in free mode, no actuator).
   const double v_ref =
       opt.rk4_v_ref > 0.0 ? opt.rk4_v_ref : (dyn.mode() == ControlMode::Free ? 1.0 : dyn.no_load_speed());
-  if (dyn.lugre()) rho = std::max(rho, dyn.rig().sigma_0 * v_ref / dyn.rig().F_c);
-  rho = std::max(rho, dyn.element_rate_bound(v_ref));
+  rho = std::max(rho, dyn.rate_bound(v_ref));
   const double n = std::ceil(dt * rho / opt.rk4_h_rho);
   require(std::isfinite(n) && n <= SolverOptions::kMaxSubsteps, "rk4_substeps (automatic)", n,
           "exceeds the cap of 100000 per sample: the plant is too stiff for a fixed-step integrator at this dt; "

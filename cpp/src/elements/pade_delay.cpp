@@ -42,6 +42,7 @@ std::optional<PadeDelay> PadeDelay::from(const Rig& r, ControlMode mode) {
   for (int k = 0; k < N; ++k) {
     P.a[k] = den[k] / den[N];
     P.c[k] = (num[k] - P.d * den[k]) / den[N];
+    P.a_tau[k] = P.a[k] / P.tau;
   }
   P.K_s = r.K_s;
   P.full_drive = r.x_v_max / r.K_s;
@@ -62,24 +63,29 @@ void PadeDelay::rest(const RestPoint& p, double* z) const noexcept {
   z[0] = p.spool / (K_s * a[0]);
 }
 
+// The sums run in locals and the last row is built in a local array: y, g's rows and this element
+// could alias as far as the compiler knows, which made it store and reload every term and check
+// the row's loop for overlap at run time (+50 instructions a call, +6 % on a step with order 3).
 template <int W>
 void PadeDelay::eval(const double* y, int i0, Algebra& g) const noexcept {
   const int N = order;
-  g.vdrive = d * g.drive;
+  const double* q = y + i0;
+  double vdrive = d * g.drive, last = g.drive;
   for (int j = 0; j < W; ++j) g.dvdrive[j] = d * g.ddrive[j];
-  double last = g.drive;
   for (int k = 0; k < N; ++k) {
-    g.vdrive += c[k] * y[i0 + k];
+    vdrive += c[k] * q[k];
     g.dvdrive[i0 + k] += c[k];
-    last -= a[k] * y[i0 + k];
+    last -= a[k] * q[k];
   }
+  g.vdrive = vdrive;
   // The chain q_k' = q_(k+1) / tau (its constant gradient rows are written by jacobian()), and
-  // the last state's rate.
-  for (int k = 0; k + 1 < N; ++k) g.rate[i0 + k] = y[i0 + k + 1] / tau;
-  double* dq = g.drate[i0 + N - 1];
+  // the last state's rate and row.
+  for (int k = 0; k + 1 < N; ++k) g.rate[i0 + k] = q[k + 1] / tau;
   g.rate[i0 + N - 1] = last / tau;
-  for (int j = 0; j < W; ++j) dq[j] = g.ddrive[j] / tau;
-  for (int k = 0; k < N; ++k) dq[i0 + k] -= a[k] / tau;
+  double row[kGradientCapacity];
+  for (int j = 0; j < W; ++j) row[j] = g.ddrive[j] / tau;
+  for (int k = 0; k < N; ++k) row[i0 + k] -= a_tau[k];
+  std::copy(row, row + W, g.drate[i0 + N - 1]);
 }
 
 void PadeDelay::jacobian(const Algebra& g, int i0, int n, int ku, Jacobian& J, State* B) const noexcept {

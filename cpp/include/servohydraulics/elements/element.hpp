@@ -26,7 +26,7 @@ struct Algebra {
   double Q = 0, dQ[kCap];          // valve flow
   double pdot = 0, dpdot[kCap];
   double xvdd = 0, dxvdd[kCap];
-  double zdot = 0, dzdot[kCap];    // LuGre bristle rate
+  double zdot = 0, dzdot[kCap];    // rate of the bristle state kZ (a friction law's, LuGre; else 0)
   double Fsp = 0, dFsp[kCap];      // specimen force (the structure elements')
   double vdrive = 0, dvdrive[kCap];  // the drive as the valve sees it (after a drive element)
   double rate[kMaxStates];              // rates of the elements' states (by state index)
@@ -48,6 +48,16 @@ enum class Port {
   Structure,  //!< a force in parallel with the structure (Eq 5), reported as specimen_force
   Drive,      //!< on the valve drive between the controller (Eq 1) and the valve (Eq 2)
 };
+
+//! A structure law's force on the structure (Eq 5) and its partial derivatives by the base
+//! states it reads: x, v and the bristle deflection z (StructureLaws, elements.hpp).
+struct LawForce {
+  double F = 0.0, dF_dx = 0.0, dF_dv = 0.0, dF_dz = 0.0;
+};
+
+//! The static force of a law that has none at rest (friction, damping): -0.0, the identity of
+//! floating-point addition, so that the sum of the laws' static forces is the spring's to the bit.
+constexpr double kNoStaticForce = -0.0;
 
 //! The plant at rest, from which an element sets its states (Dynamics::equilibrium).
 struct RestPoint {

@@ -19,6 +19,7 @@ struct PadeDelay {
   double tau = 0.0;
   double a[kMaxPadeOrder] = {};  //!< denominator coefficients over the leading one
   double c[kMaxPadeOrder] = {};  //!< output row C'
+  double a_tau[kMaxPadeOrder] = {};  //!< a[k] / tau: the last state's constant gradient on the chain
   double d = 0.0;                //!< feedthrough (-1)^N
   double K_s = 0.0;              //!< the valve gain (the rest state holds the spool)
   double full_drive = 0.0;       //!< the drive that opens the valve fully, x_v_max / K_s [V]
