@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ..atomic import write_text, write_with
+from ..atomic import FileSet, check_folder, write_text
 from ..response import Response
 from ..rig import Rig
 from .frf import FrequencyResponse, command_band, gain_phase, h1
@@ -76,13 +76,13 @@ class Comparison:
                                   f"{self.name}: frequency response (H1)", unit)}
 
     def write(self, out: str | Path) -> Path:
-        """Writes ``comparison.json``, ``overlay.png`` and ``frf.png`` into ``out``."""
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
+        """Writes ``comparison.json``, ``overlay.png`` and ``frf.png`` into ``out``, as one
+        ``atomic.FileSet``: all of them, or (an OSError naming the file) none."""
+        out = check_folder(out)
         figs = self.figures()
-        write_json(out / "comparison.json", self.to_dict())
-        for name, fig in figs.items():
-            write_with(out / f"{name}.png", lambda p, fig=fig: fig.savefig(p, dpi=110, format="png"))
+        with FileSet() as files:
+            write_json(out / "comparison.json", self.to_dict(), files)
+            save_figures(files, {out / f"{name}.png": fig for name, fig in figs.items()})
         return out / "comparison.json"
 
 
@@ -98,10 +98,17 @@ def finite_or_none(obj):
     return obj
 
 
-def write_json(path: Path, data: dict) -> Path:
-    """Writes JSON atomically (``atomic.write_text``: never a half-written file); non-finite
-    numbers become null."""
-    return write_text(path, json.dumps(finite_or_none(data), indent=2, allow_nan=False) + "\n")
+def write_json(path: Path, data: dict, files: FileSet | None = None) -> Path:
+    """Writes JSON atomically (``atomic.write_text``: never a half-written file; into ``files``
+    when given, renamed with the rest of its set); non-finite numbers become null."""
+    text = json.dumps(finite_or_none(data), indent=2, allow_nan=False) + "\n"
+    return files.write_text(path, text) if files is not None else write_text(path, text)
+
+
+def save_figures(files: FileSet, figures: dict) -> None:
+    """Saves each figure (PNG, 110 dpi) to its path through ``files``."""
+    for path, fig in figures.items():
+        fig.savefig(files.path(path), dpi=110, format="png")
 
 
 def frf_points(measured: FrequencyResponse, simulated: FrequencyResponse, frequencies: np.ndarray) -> dict:

@@ -31,11 +31,11 @@ from typing import Any
 
 import numpy as np
 
-from ..atomic import write_text, write_with
+from ..atomic import FileSet, check_folder
 from ..records import read_record
 from ..response import Response
 from ..rig import Rig, load_rig, save_rig
-from .compare import Comparison, channels_of, compare, write_json
+from .compare import Comparison, channels_of, compare, save_figures, write_json
 from .coordinates import FORCE_KEYS, LOOP_KEYS, Coordinates, check_keys, specimen_keys, use_specimen
 from .fit import (
     StageResult,
@@ -106,18 +106,15 @@ class Identification:
         return identification_markdown(self)
 
     def write(self, out: str | Path) -> Path:
-        """Writes the rig, the JSON and markdown report and the plots into ``out``."""
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        figs = {}
-        for a in self.after:
-            for name, fig in a.figures().items():
-                figs[f"{name}_{a.name}.png"] = fig
-        for name, fig in figs.items():
-            write_with(out / name, lambda p, fig=fig: fig.savefig(p, dpi=110, format="png"))
-        save_rig(self.rig, out / "rig_identified.toml")
-        write_json(out / "identification.json", self.to_dict())
-        write_text(out / "report.md", self.markdown())
+        """Writes the rig, the JSON and markdown report and the plots into ``out``, as one
+        ``atomic.FileSet``: all of them, or (an OSError naming the file) none."""
+        out = check_folder(out)
+        figs = {out / f"{name}_{a.name}.png": fig for a in self.after for name, fig in a.figures().items()}
+        with FileSet() as files:
+            save_figures(files, figs)
+            save_rig(self.rig, files.path(out / "rig_identified.toml"))
+            write_json(out / "identification.json", self.to_dict(), files)
+            files.write_text(out / "report.md", self.markdown())
         return out / "report.md"
 
 
