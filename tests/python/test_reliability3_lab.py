@@ -152,3 +152,68 @@ def test_cli_on_a_full_disk_is_one_line_and_no_file(lab, tmp_path, full_disk, ca
     assert err.count("\n") == 1 and f"servohydraulics {command}: error: cannot write {out}/" in err, err
     assert err.strip().endswith("[Errno 28] No space left on device")
     assert _files(out) == {}
+
+
+# ----------------------------------------------------------------------------- 10: user mistakes, named
+
+def _record(path: Path, n: int = 1000, change=None) -> Path:
+    """The lab record cut to ``n`` samples, with ``change(columns)`` applied."""
+    res = sh.simulate(sh.zhao2003(), mode="displacement", command=noise_command(), dt=DT)
+    cols = {k: np.asarray(res.channels[k], dtype=float)[:n].copy() for k in ("time", "command", "displacement",
+                                                                             "force")}
+    if change is not None:
+        change(cols)
+    sh.write_record(path, cols)
+    return path
+
+
+def _set(name, value, row=None):
+    def change(cols):
+        if row is None:
+            cols[name][:] = value
+        else:
+            cols[name][row] = value
+
+    return change
+
+
+MISTAKES = [  # (command, samples, change, flags, the message's text)
+    ("identify", 1000, None, ["--dt", "0"], "error: invalid dt = 0.0: must be finite and > 0"),
+    ("identify", 1000, None, ["--dt", "nan"], "error: invalid dt = nan: must be finite and > 0"),
+    ("identify", 1000, None, ["--dt", "1e-9"], "error: invalid dt = 1e-09: 1,998,000,001 controller samples for "
+                                                "the record's 1,000 at 0.002 s, more than the 50,000,000 allowed"),
+    ("identify", 1000, None, ["--dt", "3e-4"], "error: invalid dt = 0.0003: the controller sample must divide"),
+    ("identify", 1000, None, ["--dt", "1e300"], "error: invalid dt = 1e+300: longer than the record"),
+    ("compare", 1000, None, ["--dt", "1e300"], "error: invalid dt = 1e+300: longer than the record"),
+    ("identify", 1000, None, ["--max-nfev", "0"], "error: invalid max_nfev = 0: must be an integer >= 1"),
+    ("identify", 11, None, [], "rec.csv: invalid record length = 11 samples: compare and identify need at least 384"),
+    ("identify", 11, None, ["--rig", None], "invalid record length = 11 samples"),
+    ("compare", 300, None, [], "rec.csv: invalid record length = 300 samples"),
+    ("compare", 1000, _set("command", 1.0), [], "rec.csv: invalid command = constant 1.0: no energy"),
+    ("identify", 1000, _set("command", 1.0), [], "rec.csv: invalid command = constant 1.0: no energy"),
+    ("compare", 1000, _set("force", 1e300, 7), [], "rec.csv: invalid force[7] = 1e+300: must be finite and within"),
+    ("identify", 1000, _set("force", -1e300, 7), [], "rec.csv: invalid force[7] = -1e+300"),
+    ("identify", 1000, _set("displacement", 0.0), ["--specimen", "mr_damper", "--mode", "force"],
+     "rec.csv: invalid displacement = constant 0.0: the generic start scales the rig from the motion"),
+    ("identify", 400, _set("force", 0.0), ["--rig", None, "--mode", "force", "--fit", "K_v"],
+     "rec.csv: invalid frequency response = none usable"),
+]
+
+
+@pytest.mark.parametrize("command, samples, change, flags, text", MISTAKES,
+                         ids=[f"{m[0]}-{i}" for i, m in enumerate(MISTAKES)])
+def test_identify_and_compare_mistakes_are_named(lab, tmp_path, capsys, command, samples, change, flags, text):
+    """Each once ended in an opaque message ('padlen, which is 15', 'no frequency with coherence'
+    after a --dt 0 the fit never used, '`max_nfev` must be None or positive integer', 'invalid
+    command: constant' naming no record) or an internal error (RuntimeWarning: overflow)."""
+    rec = _record(tmp_path / "rec.csv", samples, change)
+    rig = lab[1]
+    flags = [str(rig) if f is None else f for f in flags]
+    argv = [command, rec, "--out", tmp_path / "out"]
+    argv += [] if "--mode" in flags else ["--mode", "displacement"]
+    argv += [] if command == "identify" or "--rig" in flags else ["--rig", rig]
+    argv += ["--quiet", "--fit=K_v", "--max-nfev=2"] if command == "identify" and "--max-nfev" not in flags else []
+    code, _, err = _cli(capsys, *argv, *flags)
+    assert code == 2, err
+    assert err.count("\n") == 1 and text in err, err
+    assert not (tmp_path / "out").exists() or not list((tmp_path / "out").iterdir())

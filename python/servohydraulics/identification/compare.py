@@ -23,21 +23,26 @@ from ..atomic import FileSet, check_folder, write_text
 from ..response import Response
 from ..rig import Rig
 from .frf import FrequencyResponse, command_band, gain_phase, h1
-from .run import CHANNELS, nrmse_demeaned_pct, nrmse_pct, simulate_record
+from .run import (
+    CHANNELS,
+    check_record,
+    controller_ratio,
+    nrmse_demeaned_pct,
+    nrmse_pct,
+    record_name,
+    simulate_record,
+)
 
 #: default frequencies of the reported FRF points [Hz] (those above the command's band are dropped)
 FREQUENCIES = (0.5, 1.0, 2.0, 5.0, 8.0, 10.0, 12.0, 15.0, 18.0, 20.0, 30.0, 50.0, 100.0)
-
-
-def record_name(record: Response) -> str:
-    return record.path.stem if record.path is not None else "record"
 
 
 def channels_of(record: Response, mode: str) -> tuple[str, ...]:
     """The channels of ``CHANNELS`` the record carries with some variation."""
     out = tuple(c for c in CHANNELS if c in record.channels and np.std(record.channels[c]) > 0)
     if not out:
-        raise ValueError(f"{record_name(record)}: no measured channel among {list(CHANNELS)} varies")
+        raise ValueError(f"{record.path or record_name(record)}: no measured channel among {list(CHANNELS)} "
+                         "varies")
     return out
 
 
@@ -137,6 +142,8 @@ def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, opti
     """
     if mode not in ("displacement", "force"):
         raise ValueError(f"invalid mode = {mode!r}: a record compares in 'displacement' or 'force' control")
+    check_record(record)
+    controller_ratio(record.dt, record.time.size, dt)
     chans = channels_of(record, mode)
     sim = simulated if simulated is not None else simulate_record(rig, record, mode, dt=dt, options=options)
     u = np.asarray(record.command, dtype=float)

@@ -49,7 +49,7 @@ from .fit import (
     time_costs,
 )
 from .generic import generic_rig, specimen_start
-from .run import simulate_record
+from .run import check_record, controller_ratio, simulate_record
 from .stats import LEVEL, ar1_coefficient, ar1_effective_n, covariance, quantile
 
 MAX_CORRELATION = 0.95  #: |corr| above which two keys are reported as not separable
@@ -245,12 +245,19 @@ def _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar
     return z, nfev
 
 
-def _setup(records, rig, fit, mode: str, specimen: str, channels) -> tuple[list, Rig, bool, tuple, tuple]:
-    """(records, start rig, generic start?, keys, channels), validated."""
+def _setup(records, rig, fit, mode: str, specimen: str, channels, dt: float | None = None
+           ) -> tuple[list, Rig, bool, tuple, tuple]:
+    """(records, start rig, generic start?, keys, channels), validated (with the controller ``dt``)."""
     if mode not in LOOP_KEYS:
         raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(LOOP_KEYS)}")
-    recs = as_records(records)
+    recs = [check_record(r) for r in as_records(records)]
+    for r in recs:
+        controller_ratio(r.dt, r.time.size, dt)
     spec = specimen_keys(specimen)
+    x = np.asarray(recs[0].displacement, dtype=float)
+    if rig is None and np.ptp(x) == 0:  # the generic start scales from the motion
+        raise ValueError(f"{recs[0].path or 'record'}: invalid displacement = constant {float(x[0])!r}: the generic "
+                         "start scales the rig from the motion; give a start rig")
     start, generic = _start_rig(rig, recs)
     if generic:
         specimen_start(start, recs[0], specimen)
@@ -299,8 +306,10 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         progress: a tqdm bar over the simulations.
         workers: threads for the Jacobian's columns (default: up to 2).
     """
+    if isinstance(max_nfev, bool) or not isinstance(max_nfev, (int, np.integer)) or max_nfev < 1:
+        raise ValueError(f"invalid max_nfev = {max_nfev!r}: must be an integer >= 1")
     t_start = time.perf_counter()
-    recs, start, generic, keys, chans = _setup(records, rig, fit, mode, specimen, channels)
+    recs, start, generic, keys, chans = _setup(records, rig, fit, mode, specimen, channels, dt)
     coords = Coordinates.about(start, keys)
     runtime: dict[str, float] = {}
     z1, stage1_keys, nfev = np.zeros(len(keys)), [], {}
