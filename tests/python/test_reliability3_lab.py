@@ -217,3 +217,64 @@ def test_identify_and_compare_mistakes_are_named(lab, tmp_path, capsys, command,
     assert code == 2, err
     assert err.count("\n") == 1 and text in err, err
     assert not (tmp_path / "out").exists() or not list((tmp_path / "out").iterdir())
+
+
+# ----------------------------------------------------------------------------- 11: warnings, run_record
+
+def test_compare_surfaces_the_runs_warnings(lab, tmp_path, capsys):
+    """A rig whose stroke is shorter than the record's motion: the run hits the end stop; compare
+    used to print only the NRMSE and write no warning."""
+    rec, _ = lab
+    rig = sh.zhao2003()
+    peak = float(np.max(np.abs(sh.read_record(rec).displacement)))
+    rig.stroke = 0.5 * peak
+    sh.save_rig(rig, tmp_path / "short_stroke.toml")
+    code, _, err = _cli(capsys, "compare", rec, "--rig", tmp_path / "short_stroke.toml", "--mode", "displacement",
+                        "--out", tmp_path / "out")
+    assert code == 0, err
+    assert "warning: displacement beyond the actuator stroke" in err
+    import json
+
+    data = json.loads((tmp_path / "out" / "comparison.json").read_text())
+    assert any("beyond the actuator stroke" in w for w in data["warnings"])
+    same = sh.identification.compare(sh.read_record(rec), sh.zhao2003(), "displacement")
+    assert same.warnings == [] and same.to_dict()["warnings"] == []
+
+
+@pytest.mark.parametrize("dt", [None, DT / 4, DT * 4])
+def test_resampled_runs_keep_every_flag(lab, dt):
+    """The flags of a run on a faster or slower controller grid reach the record's rows (the
+    slower grid's rows used to carry no flags at all): the stroke warning is the same."""
+    from servohydraulics.identification.run import simulate_record
+
+    record = sh.read_record(lab[0])
+    rig = sh.zhao2003()
+    rig.stroke = 0.5 * float(np.max(np.abs(record.displacement)))
+    sim = simulate_record(rig, record, "displacement", dt=dt)
+    assert sim.flags.size == record.time.size
+    assert any("beyond the actuator stroke" in w for w in sim.warnings())
+
+
+def test_chunked_run_record_overlaps_by_one_command_as_documented():
+    """run_record returns one row per command, row k the state before command[k]; the last command
+    is not applied.  Chunks overlapping by one command (the docstring's recipe) equal one run; chunks
+    that do not overlap repeat a row and skip a command at every boundary."""
+    from servohydraulics import _core
+    from servohydraulics.simulate import make_plant
+
+    u = noise_command(600)
+    whole, s = _core.run_record(make_plant(sh.zhao2003(), "displacement", DT), u)
+    assert s.rows == u.size
+    plant = make_plant(sh.zhao2003(), "displacement", DT)
+    rows = []
+    for k, start in enumerate(range(0, u.size, 200)):
+        ch, _ = _core.run_record(plant, u[start:start + 201])
+        part = np.asarray(ch["displacement"])[: min(201, u.size - start)]
+        rows.append(part if k == 0 else part[1:])
+    chunked = np.concatenate(rows)[: u.size]
+    assert np.array_equal(chunked, np.asarray(whole["displacement"]))
+    plant = make_plant(sh.zhao2003(), "displacement", DT)
+    a, _ = _core.run_record(plant, u[:300])
+    b, _ = _core.run_record(plant, u[300:])
+    assert a["displacement"][-1] == b["displacement"][0]  # the repeated row of naive chunks
+    assert not np.array_equal(np.r_[a["displacement"], b["displacement"]], whole["displacement"])

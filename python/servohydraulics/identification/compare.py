@@ -5,8 +5,9 @@ Per channel: ``nrmse_pct`` = 100 rms(sim - measured) / std(measured) (the
 issue's definition), ``nrmse_demeaned_pct`` (the same with the error's mean
 removed, the UTFSM README's figure), and the gain and phase of the measured
 and simulated frequency responses channel/command (H1, with coherence) at a
-set of frequencies.  ``Comparison.write(out)`` writes ``comparison.json``,
-``overlay.png`` and ``frf.png``.
+set of frequencies.  ``warnings`` are the simulated run's (``Response.warnings``: the limits it
+hit, the solver's notes), in the JSON and on the command line's stderr.
+``Comparison.write(out)`` writes ``comparison.json``, ``overlay.png`` and ``frf.png``.
 """
 
 from __future__ import annotations
@@ -60,6 +61,7 @@ class Comparison:
     frequencies: np.ndarray = field(repr=False)
     f_max: float = 0.0
     channels: dict = field(default_factory=dict)  #: channel -> metrics (the JSON's "channels")
+    warnings: list = field(default_factory=list)  #: the simulated run's limits and solver notes (``Response.warnings``)
 
     def nrmse(self, channel: str) -> float:
         return self.channels[channel]["nrmse_pct"]
@@ -69,7 +71,7 @@ class Comparison:
                 "dt_s": float(self.time[1] - self.time[0]), "command_band_hz": self.f_max,
                 "definition": "nrmse_pct = 100 rms(sim - measured) / std(measured); nrmse_demeaned_pct: the "
                               "error's mean removed; frf: H1 = S_uy/S_uu (Welch, Hann, nperseg) of channel/command",
-                "channels": self.channels}
+                "warnings": self.warnings, "channels": self.channels}
 
     def figures(self) -> dict:
         from .figures import frf_figure, overlay_figure
@@ -151,7 +153,7 @@ def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, opti
     freq = np.asarray(frequencies if frequencies is not None else [f for f in FREQUENCIES if f <= 1.05 * f_max],
                       dtype=float)
     out = Comparison(name=record_name(record), mode=mode, time=np.asarray(record.time), measured={}, simulated={},
-                     frf_measured={}, frf_simulated={}, frequencies=freq, f_max=f_max)
+                     frf_measured={}, frf_simulated={}, frequencies=freq, f_max=f_max, warnings=sim.warnings(rig))
     for ch in chans:
         m, s = np.asarray(record.channels[ch], dtype=float), np.asarray(sim.channels[ch], dtype=float)
         out.measured[ch], out.simulated[ch] = m, s

@@ -96,7 +96,7 @@ class Identification:
             "integrator": self.integrator, "n_eff": self.n_eff, "rho1": self.rho1, "nfev": self.nfev,
             "runtime_s": self.runtime_s, "costs": self.costs, "kept": self.kept,
             "records": [{"record": b.name, "before": {c: b.channels[c]["nrmse_pct"] for c in b.channels},
-                         "after": {c: a.channels[c]["nrmse_pct"] for c in a.channels}}
+                         "after": {c: a.channels[c]["nrmse_pct"] for c in a.channels}, "warnings": a.warnings}
                         for b, a in zip(self.before, self.after)],
         }
 

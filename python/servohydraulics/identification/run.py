@@ -118,12 +118,16 @@ def simulate_command(rig: Rig, mode: str, command: np.ndarray, record_dt: float,
         uc = u if n == 1 else np.interp(np.arange((u.size - 1) * n + 1) * (record_dt / n), tr, u)
         res = simulate(rig, mode=mode, command=uc, dt=record_dt / n, x0=x0, options=options)
         data = {k: np.asarray(v)[::n] for k, v in res.channels.items() if k != "time"}
+        if n > 1:  # a row's flags: every controller sample since the previous row (none is lost)
+            starts = np.r_[0, np.arange(u.size - 1) * n + 1]  # row k >= 1: controller rows (k-1) n + 1 .. k n
+            data["flags"] = np.bitwise_or.reduceat(np.asarray(res.flags), starts)
     else:
         uc = u[::n]
         res = simulate(rig, mode=mode, command=uc, dt=record_dt * n, x0=x0, options=options)
         ts = np.arange(uc.size) * record_dt * n
         data = {k: np.interp(tr, ts, np.asarray(v, dtype=float)) for k, v in res.channels.items()
                 if k not in ("time", "flags", "internal_steps", "rhs_evals")}
+        data["flags"] = np.asarray(res.flags)[np.minimum(np.arange(u.size) // n, uc.size - 1)]
     data["time"] = tr
     data["command"] = u
     return Response(data, kind="plant", mode=mode, dt=record_dt, rig=rig, work=res.work)
