@@ -278,3 +278,27 @@ def test_chunked_run_record_overlaps_by_one_command_as_documented():
     b, _ = _core.run_record(plant, u[300:])
     assert a["displacement"][-1] == b["displacement"][0]  # the repeated row of naive chunks
     assert not np.array_equal(np.r_[a["displacement"], b["displacement"]], whole["displacement"])
+
+
+# ----------------------------------------------------------------------------- 5: the evaluation scripts' pools
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.parametrize("script, args", [("evaluate.py", ["--data", "DIR"]), ("generate.py", ["--out", "DIR/set"])])
+@pytest.mark.parametrize("jobs", ["100000", "0"])
+def test_evaluation_pools_are_bounded(tmp_path, script, args, jobs):
+    """The diagnosis evaluation made ProcessPoolExecutor(max_workers=--jobs) itself: --jobs 100000
+    forked until the machine stopped. Now workers.process_pool: a named error before any work."""
+    import os
+    import subprocess
+    import sys
+
+    argv = [sys.executable, str(ROOT / "evaluation" / "diagnose_eval" / script), "--jobs", jobs]
+    argv += [a.replace("DIR", str(tmp_path)) for a in args]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
+    p = subprocess.run(argv, capture_output=True, text=True, timeout=120, env=env)
+    assert p.returncode == 2, p.stderr
+    assert f"error: invalid --jobs = {jobs}: must be an integer from 1 to" in p.stderr
+    assert "Traceback" not in p.stderr
+    assert list(tmp_path.iterdir()) == []
