@@ -48,5 +48,9 @@ void expose_record(py::module_& m) {
         return py::make_tuple(out, sum);
       },
       py::arg("plant"), py::arg("command"),
-      "Run one sample per command element; returns (channels dict, RunSummary). Releases the GIL.");
+      "Runs the plant over the command: returns (channels dict, RunSummary) with one row per command\n"
+      "element, row k the state before command[k] is applied (row 0: the plant's current state). The\n"
+      "last command is not applied (its effect is past the record): n commands make n - 1 steps.\n"
+      "Chunks of one record therefore overlap by one element: pass each chunk with the next chunk's\n"
+      "first command appended and drop the first row of every chunk after the first. Releases the GIL.");
 }

@@ -17,7 +17,6 @@ import json
 import os
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -324,6 +323,12 @@ def main() -> None:
     p.add_argument("--doc", default="docs/diagnose_eval.md")
     p.add_argument("--from-json", action="store_true", help="re-render the doc from the saved JSON (no diagnoses)")
     a = p.parse_args()
+    from servohydraulics.workers import check_workers, process_pool
+
+    try:  # 1 .. cpu_count, before any work (a large count forks without bound)
+        check_workers(a.jobs, "--jobs")
+    except ValueError as e:
+        p.error(str(e))
     data = Path(a.data)
     doc = Path(a.doc)
     if a.from_json:
@@ -338,7 +343,7 @@ def main() -> None:
     results = []
     from tqdm import tqdm
 
-    with ProcessPoolExecutor(max_workers=a.jobs) as ex:
+    with process_pool(a.jobs, "--jobs") as ex:  # workers that die with this process
         for r in tqdm(ex.map(run_one, jobs), total=len(jobs), file=sys.stderr, desc="diagnose"):
             results.append(r)
     wall = time.time() - t0

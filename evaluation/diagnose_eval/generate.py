@@ -52,7 +52,6 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, replace
 from pathlib import Path
 
@@ -334,7 +333,9 @@ SUBSTEPS = 4  #: RK4 substeps a 0.5 ms sample in the generator (125 us: h times 
 def generate(out: Path, size: str = "default", seed: int = 2003, duration: float = 4.0, jobs: int = 2,
              cases: str = "all") -> None:
     import servohydraulics as sh
+    from servohydraulics.workers import check_workers, process_pool
 
+    check_workers(jobs, "--jobs")  # 1 .. cpu_count, before any file is written (a large count forks without bound)
     out.mkdir(parents=True, exist_ok=True)
     (out / "records").mkdir(exist_ok=True)
     for rig in RIGS:
@@ -345,7 +346,7 @@ def generate(out: Path, size: str = "default", seed: int = 2003, duration: float
     items.append({"kind": "single", "effects": [("coulomb", 300.0)], "mode": "displacement", "cmd": "std",
                   "snr": 30, "duration": 10.0, "runtime_check": True})
     manifest, key = [], []
-    with ProcessPoolExecutor(max_workers=jobs) as ex:
+    with process_pool(jobs, "--jobs") as ex:  # workers that die with this process
         for rec, man, k in ex.map(make_record, [(i, it, seed, duration) for i, it in enumerate(items)]):
             path = out / "records" / f"{man['id']}.csv"
             sh.write_record(path, rec)
@@ -370,7 +371,10 @@ def main() -> None:
     p.add_argument("--cases", choices=["all", "new", "old"], default="all",
                    help="all cases, only those added for issue 13, or only the earlier ones")
     a = p.parse_args()
-    generate(Path(a.out), a.size, a.seed, a.duration, a.jobs, a.cases)
+    try:
+        generate(Path(a.out), a.size, a.seed, a.duration, a.jobs, a.cases)
+    except ValueError as e:  # a bad --jobs: one line, exit 2
+        p.error(str(e))
 
 
 if __name__ == "__main__":

@@ -4,6 +4,7 @@ command simulated through a rig, NRMSE and FRF per channel (docs/lab-records.md)
 from __future__ import annotations
 
 import argparse
+import sys
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -16,6 +17,8 @@ def _run(args: argparse.Namespace) -> int:
     options = None if args.method is None else solver_options(method=args.method)
     c = compare(rec, load_rig(args.rig), args.mode, dt=args.dt, options=options)
     path = c.write(args.out)
+    for w in c.warnings:
+        print("warning:", w, file=sys.stderr)
     for ch, m in c.channels.items():
         print(f"{c.name} {ch}: NRMSE {m['nrmse_pct']:.2f} % (error mean removed: {m['nrmse_demeaned_pct']:.2f} %)")
     print(f"wrote {path}, overlay.png, frf.png")

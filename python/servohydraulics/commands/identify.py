@@ -4,6 +4,7 @@ identified from lab records (docs/lab-records.md)."""
 from __future__ import annotations
 
 import argparse
+import sys
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -18,6 +19,9 @@ def _run(args: argparse.Namespace) -> int:
         print(f"  {k} = {ident.values[k]:.5g} [{lo:.5g}, {hi:.5g}] (95 %)")
     for f in ident.flags:
         print(f"  note: {f}")
+    for a in ident.after:
+        for w in a.warnings:
+            print(f"warning: {a.name} (identified rig): {w}", file=sys.stderr)
     for b, a in zip(ident.before, ident.after):
         print(f"  {a.name}: " + ", ".join(f"{c} NRMSE {b.nrmse(c):.2f} % -> {a.nrmse(c):.2f} %" for c in a.channels))
     print(f"wrote {args.out}/rig_identified.toml, identification.json, {report.name} "

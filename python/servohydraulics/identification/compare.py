@@ -5,8 +5,9 @@ Per channel: ``nrmse_pct`` = 100 rms(sim - measured) / std(measured) (the
 issue's definition), ``nrmse_demeaned_pct`` (the same with the error's mean
 removed, the UTFSM README's figure), and the gain and phase of the measured
 and simulated frequency responses channel/command (H1, with coherence) at a
-set of frequencies.  ``Comparison.write(out)`` writes ``comparison.json``,
-``overlay.png`` and ``frf.png``.
+set of frequencies.  ``warnings`` are the simulated run's (``Response.warnings``: the limits it
+hit, the solver's notes), in the JSON and on the command line's stderr.
+``Comparison.write(out)`` writes ``comparison.json``, ``overlay.png`` and ``frf.png``.
 """
 
 from __future__ import annotations
@@ -19,25 +20,30 @@ from typing import Any
 
 import numpy as np
 
-from ..atomic import write_text, write_with
+from ..atomic import FileSet, check_folder, write_text
 from ..response import Response
 from ..rig import Rig
 from .frf import FrequencyResponse, command_band, gain_phase, h1
-from .run import CHANNELS, nrmse_demeaned_pct, nrmse_pct, simulate_record
+from .run import (
+    CHANNELS,
+    check_record,
+    controller_ratio,
+    nrmse_demeaned_pct,
+    nrmse_pct,
+    record_name,
+    simulate_record,
+)
 
 #: default frequencies of the reported FRF points [Hz] (those above the command's band are dropped)
 FREQUENCIES = (0.5, 1.0, 2.0, 5.0, 8.0, 10.0, 12.0, 15.0, 18.0, 20.0, 30.0, 50.0, 100.0)
-
-
-def record_name(record: Response) -> str:
-    return record.path.stem if record.path is not None else "record"
 
 
 def channels_of(record: Response, mode: str) -> tuple[str, ...]:
     """The channels of ``CHANNELS`` the record carries with some variation."""
     out = tuple(c for c in CHANNELS if c in record.channels and np.std(record.channels[c]) > 0)
     if not out:
-        raise ValueError(f"{record_name(record)}: no measured channel among {list(CHANNELS)} varies")
+        raise ValueError(f"{record.path or record_name(record)}: no measured channel among {list(CHANNELS)} "
+                         "varies")
     return out
 
 
@@ -55,6 +61,7 @@ class Comparison:
     frequencies: np.ndarray = field(repr=False)
     f_max: float = 0.0
     channels: dict = field(default_factory=dict)  #: channel -> metrics (the JSON's "channels")
+    warnings: list = field(default_factory=list)  #: the simulated run's limits and solver notes (``Response.warnings``)
 
     def nrmse(self, channel: str) -> float:
         return self.channels[channel]["nrmse_pct"]
@@ -64,7 +71,7 @@ class Comparison:
                 "dt_s": float(self.time[1] - self.time[0]), "command_band_hz": self.f_max,
                 "definition": "nrmse_pct = 100 rms(sim - measured) / std(measured); nrmse_demeaned_pct: the "
                               "error's mean removed; frf: H1 = S_uy/S_uu (Welch, Hann, nperseg) of channel/command",
-                "channels": self.channels}
+                "warnings": self.warnings, "channels": self.channels}
 
     def figures(self) -> dict:
         from .figures import frf_figure, overlay_figure
@@ -76,13 +83,13 @@ class Comparison:
                                   f"{self.name}: frequency response (H1)", unit)}
 
     def write(self, out: str | Path) -> Path:
-        """Writes ``comparison.json``, ``overlay.png`` and ``frf.png`` into ``out``."""
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
+        """Writes ``comparison.json``, ``overlay.png`` and ``frf.png`` into ``out``, as one
+        ``atomic.FileSet``: all of them, or (an OSError naming the file) none."""
+        out = check_folder(out)
         figs = self.figures()
-        write_json(out / "comparison.json", self.to_dict())
-        for name, fig in figs.items():
-            write_with(out / f"{name}.png", lambda p, fig=fig: fig.savefig(p, dpi=110, format="png"))
+        with FileSet() as files:
+            write_json(out / "comparison.json", self.to_dict(), files)
+            save_figures(files, {out / f"{name}.png": fig for name, fig in figs.items()})
         return out / "comparison.json"
 
 
@@ -98,10 +105,17 @@ def finite_or_none(obj):
     return obj
 
 
-def write_json(path: Path, data: dict) -> Path:
-    """Writes JSON atomically (``atomic.write_text``: never a half-written file); non-finite
-    numbers become null."""
-    return write_text(path, json.dumps(finite_or_none(data), indent=2, allow_nan=False) + "\n")
+def write_json(path: Path, data: dict, files: FileSet | None = None) -> Path:
+    """Writes JSON atomically (``atomic.write_text``: never a half-written file; into ``files``
+    when given, renamed with the rest of its set); non-finite numbers become null."""
+    text = json.dumps(finite_or_none(data), indent=2, allow_nan=False) + "\n"
+    return files.write_text(path, text) if files is not None else write_text(path, text)
+
+
+def save_figures(files: FileSet, figures: dict) -> None:
+    """Saves each figure (PNG, 110 dpi) to its path through ``files``."""
+    for path, fig in figures.items():
+        fig.savefig(files.path(path), dpi=110, format="png")
 
 
 def frf_points(measured: FrequencyResponse, simulated: FrequencyResponse, frequencies: np.ndarray) -> dict:
@@ -130,6 +144,8 @@ def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, opti
     """
     if mode not in ("displacement", "force"):
         raise ValueError(f"invalid mode = {mode!r}: a record compares in 'displacement' or 'force' control")
+    check_record(record)
+    controller_ratio(record.dt, record.time.size, dt)
     chans = channels_of(record, mode)
     sim = simulated if simulated is not None else simulate_record(rig, record, mode, dt=dt, options=options)
     u = np.asarray(record.command, dtype=float)
@@ -137,7 +153,7 @@ def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, opti
     freq = np.asarray(frequencies if frequencies is not None else [f for f in FREQUENCIES if f <= 1.05 * f_max],
                       dtype=float)
     out = Comparison(name=record_name(record), mode=mode, time=np.asarray(record.time), measured={}, simulated={},
-                     frf_measured={}, frf_simulated={}, frequencies=freq, f_max=f_max)
+                     frf_measured={}, frf_simulated={}, frequencies=freq, f_max=f_max, warnings=sim.warnings(rig))
     for ch in chans:
         m, s = np.asarray(record.channels[ch], dtype=float), np.asarray(sim.channels[ch], dtype=float)
         out.measured[ch], out.simulated[ch] = m, s

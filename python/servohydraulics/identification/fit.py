@@ -73,8 +73,9 @@ def frequency_targets(records: list[Response], channels: tuple[str, ...]) -> lis
             if idx.size >= 3:
                 out.append((rec, ch, est.frequency[idx], est.response[idx], est.coherence[idx]))
     if not out:
-        raise ValueError("no frequency with coherence >= 0.9 inside the commands' band: the records carry no "
-                         "usable frequency response")
+        names = ", ".join(str(r.path or "record") for r in records)
+        raise ValueError(f"{names}: invalid frequency response = none usable: no 3 frequencies with coherence "
+                         f">= {MIN_COHERENCE} inside the command's band (a longer or broader-band record)")
     return out
 
 

@@ -56,10 +56,14 @@ class FrequencyResponse:
         return (f > 0) & (f >= f_min) & (f <= f_max) & (self._quality() >= min_coherence)
 
 
+#: samples an H1 estimate needs (six segments of the shortest, 64)
+MIN_SAMPLES = 384
+
+
 def default_nperseg(n: int) -> int:
     """Largest power of two not above n/6 (at least 64): about ten averaged Hann segments."""
-    if n < 384:
-        raise ValueError(f"invalid record length = {n} samples: an H1 estimate needs at least 384")
+    if n < MIN_SAMPLES:
+        raise ValueError(f"invalid record length = {n} samples: an H1 estimate needs at least {MIN_SAMPLES}")
     return 2 ** int(math.floor(math.log2(n / 6)))
 
 
@@ -128,4 +132,4 @@ def command_band(command: ArrayLike, dt: float, share: float = 0.99) -> float:
     return float(f[min(np.searchsorted(c, share * c[-1]), f.size - 1)])
 
 
-__all__ = ["FrequencyResponse", "command_band", "default_nperseg", "dft_ratio", "gain_phase", "h1"]
+__all__ = ["MIN_SAMPLES", "FrequencyResponse", "command_band", "default_nperseg", "dft_ratio", "gain_phase", "h1"]

@@ -31,11 +31,11 @@ from typing import Any
 
 import numpy as np
 
-from ..atomic import write_text, write_with
+from ..atomic import FileSet, check_folder
 from ..records import read_record
 from ..response import Response
 from ..rig import Rig, load_rig, save_rig
-from .compare import Comparison, channels_of, compare, write_json
+from .compare import Comparison, channels_of, compare, save_figures, write_json
 from .coordinates import FORCE_KEYS, LOOP_KEYS, Coordinates, check_keys, specimen_keys, use_specimen
 from .fit import (
     StageResult,
@@ -49,7 +49,7 @@ from .fit import (
     time_costs,
 )
 from .generic import generic_rig, specimen_start
-from .run import simulate_record
+from .run import check_record, controller_ratio, simulate_record
 from .stats import LEVEL, ar1_coefficient, ar1_effective_n, covariance, quantile
 
 MAX_CORRELATION = 0.95  #: |corr| above which two keys are reported as not separable
@@ -96,7 +96,7 @@ class Identification:
             "integrator": self.integrator, "n_eff": self.n_eff, "rho1": self.rho1, "nfev": self.nfev,
             "runtime_s": self.runtime_s, "costs": self.costs, "kept": self.kept,
             "records": [{"record": b.name, "before": {c: b.channels[c]["nrmse_pct"] for c in b.channels},
-                         "after": {c: a.channels[c]["nrmse_pct"] for c in a.channels}}
+                         "after": {c: a.channels[c]["nrmse_pct"] for c in a.channels}, "warnings": a.warnings}
                         for b, a in zip(self.before, self.after)],
         }
 
@@ -106,18 +106,15 @@ class Identification:
         return identification_markdown(self)
 
     def write(self, out: str | Path) -> Path:
-        """Writes the rig, the JSON and markdown report and the plots into ``out``."""
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        figs = {}
-        for a in self.after:
-            for name, fig in a.figures().items():
-                figs[f"{name}_{a.name}.png"] = fig
-        for name, fig in figs.items():
-            write_with(out / name, lambda p, fig=fig: fig.savefig(p, dpi=110, format="png"))
-        save_rig(self.rig, out / "rig_identified.toml")
-        write_json(out / "identification.json", self.to_dict())
-        write_text(out / "report.md", self.markdown())
+        """Writes the rig, the JSON and markdown report and the plots into ``out``, as one
+        ``atomic.FileSet``: all of them, or (an OSError naming the file) none."""
+        out = check_folder(out)
+        figs = {out / f"{name}_{a.name}.png": fig for a in self.after for name, fig in a.figures().items()}
+        with FileSet() as files:
+            save_figures(files, figs)
+            save_rig(self.rig, files.path(out / "rig_identified.toml"))
+            write_json(out / "identification.json", self.to_dict(), files)
+            files.write_text(out / "report.md", self.markdown())
         return out / "report.md"
 
 
@@ -248,12 +245,19 @@ def _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar
     return z, nfev
 
 
-def _setup(records, rig, fit, mode: str, specimen: str, channels) -> tuple[list, Rig, bool, tuple, tuple]:
-    """(records, start rig, generic start?, keys, channels), validated."""
+def _setup(records, rig, fit, mode: str, specimen: str, channels, dt: float | None = None
+           ) -> tuple[list, Rig, bool, tuple, tuple]:
+    """(records, start rig, generic start?, keys, channels), validated (with the controller ``dt``)."""
     if mode not in LOOP_KEYS:
         raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(LOOP_KEYS)}")
-    recs = as_records(records)
+    recs = [check_record(r) for r in as_records(records)]
+    for r in recs:
+        controller_ratio(r.dt, r.time.size, dt)
     spec = specimen_keys(specimen)
+    x = np.asarray(recs[0].displacement, dtype=float)
+    if rig is None and np.ptp(x) == 0:  # the generic start scales from the motion
+        raise ValueError(f"{recs[0].path or 'record'}: invalid displacement = constant {float(x[0])!r}: the generic "
+                         "start scales the rig from the motion; give a start rig")
     start, generic = _start_rig(rig, recs)
     if generic:
         specimen_start(start, recs[0], specimen)
@@ -302,8 +306,10 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         progress: a tqdm bar over the simulations.
         workers: threads for the Jacobian's columns (default: up to 2).
     """
+    if isinstance(max_nfev, bool) or not isinstance(max_nfev, (int, np.integer)) or max_nfev < 1:
+        raise ValueError(f"invalid max_nfev = {max_nfev!r}: must be an integer >= 1")
     t_start = time.perf_counter()
-    recs, start, generic, keys, chans = _setup(records, rig, fit, mode, specimen, channels)
+    recs, start, generic, keys, chans = _setup(records, rig, fit, mode, specimen, channels, dt)
     coords = Coordinates.about(start, keys)
     runtime: dict[str, float] = {}
     z1, stage1_keys, nfev = np.zeros(len(keys)), [], {}

@@ -39,6 +39,9 @@ def identification_markdown(ident) -> str:
         for c in a.channels:
             lines.append(f"| {a.name} | {c} | {b.nrmse(c):.2f} | {a.nrmse(c):.2f} | "
                          f"[overlay](overlay_{a.name}.png), [FRF](frf_{a.name}.png) |")
+    notes = [f"- {a.name}: {w}" for a in ident.after for w in a.warnings]
+    if notes:
+        lines += ["", "## Warnings of the identified rig's runs", "", *notes]
     rt = ", ".join(f"{k} {v:.1f} s" for k, v in ident.runtime_s.items())
     lines += ["", f"Run time: {rt}; evaluations: {ident.nfev}.", ""]
     return "\n".join(lines)

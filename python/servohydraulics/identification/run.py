@@ -26,6 +26,8 @@ from ..timegrid import MAX_SAMPLES, positive
 
 #: the channels a record and a simulation share, compared in this order
 CHANNELS = ("displacement", "force")
+#: the channels compare and identify read from a record besides time
+REQUIRED_CHANNELS = ("command", *CHANNELS)
 
 
 def initial_displacement(record: Response, samples: int = 20) -> float:
@@ -33,15 +35,63 @@ def initial_displacement(record: Response, samples: int = 20) -> float:
     return float(np.median(np.asarray(record.displacement)[:samples]))
 
 
-def _ratio(record_dt: float, dt: float) -> tuple[int, bool]:
-    """(n, faster): the controller runs n times faster (True) or slower than the record."""
-    positive("dt", dt)
+def controller_ratio(record_dt: float, samples: int, dt: float | None) -> tuple[int, bool]:
+    """(n, faster): a controller sample ``dt`` [s] runs n times faster (True) or slower than a
+    record of ``samples`` samples at ``record_dt`` [s] (None: the record's own, (1, True)).
+    ValueError naming ``dt`` when it is not finite and > 0, neither divides nor is a multiple of
+    the record's sample, makes more samples than ``simulate`` allows (``MAX_SAMPLES``, checked
+    before any grid is allocated) or is too slow to give two samples of the record."""
+    if dt is None:
+        return 1, True
+    dt = positive("dt", dt)
     for a, b, faster in ((record_dt, dt, True), (dt, record_dt, False)):
         n = a / b
-        if abs(n - round(n)) <= 1e-6 * n and round(n) >= 1:
-            return int(round(n)), faster
+        if math.isfinite(n) and abs(n - round(n)) <= 1e-6 * n and round(n) >= 1:
+            n = int(round(n))
+            if faster and (samples - 1) * n + 1 > MAX_SAMPLES:
+                raise ValueError(f"invalid dt = {dt!r}: {(samples - 1) * n + 1:,} controller samples for the "
+                                 f"record's {samples:,} at {record_dt!r} s, more than the {MAX_SAMPLES:,} allowed")
+            if not faster and n > samples - 1:
+                raise ValueError(f"invalid dt = {dt!r}: longer than the record ({samples:,} samples at "
+                                 f"{record_dt!r} s), the controller would sample it once")
+            return n, faster
     raise ValueError(f"invalid dt = {dt!r}: the controller sample must divide the record's {record_dt!r} s "
                      "or be an integer multiple of it")
+
+
+#: largest magnitude of a record's value: its squares and their sums over any record stay finite
+MAX_ABS = 1e100
+
+
+def record_name(record: Response) -> str:
+    return record.path.stem if record.path is not None else "record"
+
+
+def check_record(record: Response) -> Response:
+    """``record`` when ``compare`` and ``identify`` can use it: at least ``frf.MIN_SAMPLES``
+    samples, every value of its time, command, displacement and force finite and within
+    ``MAX_ABS``, a command that varies; else a ValueError naming the record, the channel
+    (with the row) and the value."""
+    from .frf import MIN_SAMPLES
+
+    where = record.path if record.path is not None else "record"
+    n = np.asarray(record.time).size
+    if n < MIN_SAMPLES:
+        raise ValueError(f"{where}: invalid record length = {n} samples: compare and identify need at least "
+                         f"{MIN_SAMPLES} (an H1 estimate of six segments)")
+    for ch in ("time", *REQUIRED_CHANNELS):
+        if ch not in record.channels:
+            raise ValueError(f"{where}: missing channel {ch!r}")
+        v = np.asarray(record.channels[ch], dtype=float)
+        bad = np.flatnonzero(~(np.abs(v) <= MAX_ABS))
+        if bad.size:
+            raise ValueError(f"{where}: invalid {ch}[{bad[0]}] = {float(v[bad[0]])!r}: must be finite and within "
+                             f"+-{MAX_ABS:g}")
+    u = np.asarray(record.command, dtype=float)
+    if np.all(u == u[0]):
+        raise ValueError(f"{where}: invalid command = constant {float(u[0])!r}: no energy to estimate a frequency "
+                         "range from")
+    return record
 
 
 def delayed(u: np.ndarray, dt: float, tau: float) -> np.ndarray:
@@ -62,21 +112,22 @@ def simulate_command(rig: Rig, mode: str, command: np.ndarray, record_dt: float,
 
     Raises SimulationError (the solver's message, with the time) when the run fails."""
     u = delayed(np.asarray(command, dtype=float), record_dt, float(delay))
-    n, faster = (1, True) if dt is None else _ratio(record_dt, float(dt))
+    n, faster = controller_ratio(record_dt, u.size, dt)
     tr = np.arange(u.size) * record_dt
     if faster:
-        if (u.size - 1) * n + 1 > MAX_SAMPLES:  # simulate's cap, checked before the grid is allocated
-            raise ValueError(f"invalid dt = {dt!r}: {(u.size - 1) * n + 1:,} controller samples for the record's "
-                             f"{u.size:,} at {record_dt!r} s, more than the {MAX_SAMPLES:,} allowed")
         uc = u if n == 1 else np.interp(np.arange((u.size - 1) * n + 1) * (record_dt / n), tr, u)
         res = simulate(rig, mode=mode, command=uc, dt=record_dt / n, x0=x0, options=options)
         data = {k: np.asarray(v)[::n] for k, v in res.channels.items() if k != "time"}
+        if n > 1:  # a row's flags: every controller sample since the previous row (none is lost)
+            starts = np.r_[0, np.arange(u.size - 1) * n + 1]  # row k >= 1: controller rows (k-1) n + 1 .. k n
+            data["flags"] = np.bitwise_or.reduceat(np.asarray(res.flags), starts)
     else:
         uc = u[::n]
         res = simulate(rig, mode=mode, command=uc, dt=record_dt * n, x0=x0, options=options)
         ts = np.arange(uc.size) * record_dt * n
         data = {k: np.interp(tr, ts, np.asarray(v, dtype=float)) for k, v in res.channels.items()
                 if k not in ("time", "flags", "internal_steps", "rhs_evals")}
+        data["flags"] = np.asarray(res.flags)[np.minimum(np.arange(u.size) // n, uc.size - 1)]
     data["time"] = tr
     data["command"] = u
     return Response(data, kind="plant", mode=mode, dt=record_dt, rig=rig, work=res.work)
@@ -106,5 +157,6 @@ def nrmse_demeaned_pct(simulated: np.ndarray, measured: np.ndarray) -> float:
     return 100.0 * float(np.std(np.asarray(simulated, dtype=float) - m)) / float(np.std(m))
 
 
-__all__ = ["CHANNELS", "SimulationError", "delayed", "initial_displacement", "nrmse_demeaned_pct", "nrmse_pct",
-           "simulate_command", "simulate_record"]
+__all__ = ["CHANNELS", "MAX_ABS", "REQUIRED_CHANNELS", "SimulationError", "check_record", "controller_ratio",
+           "delayed", "initial_displacement", "nrmse_demeaned_pct", "nrmse_pct",
+           "record_name", "simulate_command", "simulate_record"]
