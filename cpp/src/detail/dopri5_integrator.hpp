@@ -2,7 +2,8 @@
 // Runge-Kutta pair with error control inside each controller sample (the
 // sample is the maximum step; first-same-as-last within a sample and across
 // samples while the held input and the state are unchanged), and an automatic
-// switch to CVODE for a sample where the pair turns stiff.
+// switch to CVODE for a sample where the pair turns stiff, checked by a shadow
+// CVODE at a looser tolerance that flags the samples it cannot vouch for.
 #pragma once
 
 #include <memory>
@@ -22,8 +23,14 @@ class Dopri5Integrator {
   void reset(const State& y, double t) noexcept;
   //! Integrates from t to t_next with the input held.  Stiffness (more than stiff_steps steps in the
   //! sample, a step below 1e-12 of the sample, or a non-finite stage) redoes the sample from its start
-  //! with CVODE (Status::stiff) and stays on CVODE for kImplicitHold samples; without the fallback it
+  //! with CVODE (Status::stiff; absolute tolerances kStiffAtolFactor of the pair's) and stays on CVODE for kImplicitHold samples; without the fallback it
   //! returns Status::Stiff.  More than max_steps_per_sample steps: TooMuchWork.
+  //! With the fallback, a stiff sample is verified: a shadow state, started from the state where
+  //! the stiff stretch began, is integrated by a second CVODE at kShadowLoosen x rtol; where its
+  //! displacement or load-cell force differs from the result's by more than kShadowLoosen x
+  //! kVerifyTolerance of the run's peak so far, the sample is flagged (Status::inaccurate): the
+  //! result is kept but is likely off by more than kVerifyTolerance (errors scale with the
+  //! tolerance; on high-gain rigs with stiff oil the loop amplifies them a million times).
   Status advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t, double t_next) noexcept;
 
   long total_steps() const noexcept { return steps_done_; }
@@ -33,6 +40,14 @@ class Dopri5Integrator {
 
   //! Samples that stay on CVODE after a stiff one before the pair is tried again.
   static constexpr int kImplicitHold = 16;
+  //! The accuracy the default states (of the run's peak displacement and force), which the
+  //! verification of stiff samples checks, and the factor by which the shadow's tolerance is looser.
+  static constexpr double kVerifyTolerance = 1e-3;
+  static constexpr double kShadowLoosen = 10.0;
+  //! The stiff samples' CVODE takes absolute tolerances this fraction of the pair's (rtol x
+  //! atol_fraction x state_scale): the rig's scales bound its states, not the small signals of a
+  //! stiff high-gain loop, which amplifies the error they let through.
+  static constexpr double kStiffAtolFactor = 1e-2;
 
  private:
   enum class Outcome { Done, Stiff, TooMuchWork };
@@ -43,6 +58,11 @@ class Dopri5Integrator {
   double trial_step(const Dynamics& dyn, const Dynamics::Input& in, const State& y, double h, State& y5) noexcept;
   Status implicit_sample(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t,
                          double t_next) noexcept;
+  //! Advances the shadow over the stiff sample just done from (y_start, t_start) to y and flags st.
+  void verify(const Dynamics& dyn, const Dynamics::Input& in, const State& y_start, double t_start,
+              const State& y, double t_next, Status& st) noexcept;
+  //! Raises the run's peaks of |displacement| and |force| to y's.
+  void track_peaks(const Dynamics& dyn, const Dynamics::Input& in, const State& y) noexcept;
 
   int n_;
   double rtol_;
@@ -51,6 +71,11 @@ class Dopri5Integrator {
   int stiff_steps_;
   double dt_;
   std::unique_ptr<CvodeIntegrator> implicit_;  // the stiff fallback, or null
+  std::unique_ptr<CvodeIntegrator> shadow_;    // its check at kShadowLoosen x rtol, or null
+  State shadow_y_{};           // the shadow's state at the current time, while shadow_live_
+  bool shadow_live_ = false;   // a stiff stretch is under way and the shadow follows it
+  double peak_x_ = 0.0, peak_f_ = 0.0;      // the run's largest |displacement| and |force| so far
+  double floor_x_ = 0.0, floor_f_ = 0.0;    // their least values in the check (a run at rest)
   State k_[7];         // the stages; k_[0] is the slope at the current state
   bool fsal_ = false;  // k_[0] is f(y, in) of the state and input the next sample starts from
   Dynamics::Input fsal_in_{};
