@@ -26,8 +26,10 @@ max |x - x_ref| / max |x_ref| and the same for the load-cell force.  A run is
 - ``silent``: not within and nothing said: a silent wrong answer (must be 0).
 
 ``flagged_within`` counts the false alarms (within, yet flagged); the flag's precision is
-flagged / (flagged + flagged_within), its recall flagged / (flagged + silent).  Rigs whose
-reference run fails are counted and skipped; RK4 is skipped on a rig whose automatic rule needs
+flagged / (flagged + flagged_within), its recall flagged / (flagged + silent).  Each reference is
+confirmed by the other one (CVODE at the same tolerances): a rig where they differ by more than
+REFERENCE_AGREEMENT is counted under ``reference_uncertain`` and skipped, as are rigs whose
+reference run fails; RK4 is skipped on a rig whose automatic rule needs
 more than RK4_MAX_SUBSTEPS substeps per sample (counted).  The "before" numbers of
 docs/benchmarks.md come from running this script against the core of the starting commit:
 
@@ -153,6 +155,8 @@ def family_case(sh, rng: np.random.Generator, duration: float, dt: float, family
 #: The references: ARKODE's explicit Dormand-Prince pair (no Newton, no Jacobian: independent of the
 #: default's CVODE fallback) or CVODE, at rtol 1e-10 with absolute tolerances a tenth of the default's.
 REFERENCES = ("arkode_erk", "cvode")
+#: Each run's reference is confirmed by the other one: they must agree to this (relative to the peaks).
+REFERENCE_AGREEMENT = 0.1 * min(TOLERANCE.values())
 
 #: RK4 is not run on a rig whose automatic rule needs more substeps per sample than this (the
 #: evaluation's cost; such a rig is counted under "rk4_skipped").
@@ -188,10 +192,18 @@ def run_case(sh, rig, mode: str, u: np.ndarray, dt: float, rtol: float | None = 
     try:
         ref = sh.simulate(rig, mode, u, dt=dt, options=_options(sh, "reference", reference=reference),
                           raise_on_failure=False)
+        other = next(r for r in REFERENCES if r != reference)
+        check = sh.simulate(rig, mode, u, dt=dt, options=_options(sh, "reference", reference=other),
+                            raise_on_failure=False)
     except ValueError as e:  # an invalid rig: setup, not a wrong answer
         return {"reference": f"error: {e}"}
-    if not ref.success:
-        return {"reference": ref.status}
+    if not ref.success or not check.success:
+        return {"reference": ref.status if not ref.success else f"{other}: {check.status}"}
+    # The two references must agree to a tenth of the tightest tolerance: where they do not (a rig
+    # that amplifies even a 1e-10 tolerance's error past 1e-4), no run can be judged against them.
+    gap = _error(check, ref)
+    if not gap <= REFERENCE_AGREEMENT:
+        return {"reference": f"uncertain: {other} departs from {reference} by {gap:.2e}"}
     out: dict = {"reference": "ok"}
     for which in methods:
         try:
@@ -235,13 +247,16 @@ def survey(sh, rigs: int, seed: int = 16, duration: float = 1.0, dt: float = 5e-
 
     rng = np.random.default_rng(seed)
     counts = {w: _new_counts() for w in methods}
-    skipped = 0
+    skipped, uncertain, cases = 0, 0, []
     for i in tqdm(range(rigs), disable=not progress, desc=f"{family} rigs"):
         rig, mode, u = family_case(sh, rng, duration, dt, family)
         res = run_case(sh, rig, mode, u, dt, rtol, reference, methods)
         if res["reference"] != "ok":
             skipped += 1
+            uncertain += res["reference"].startswith("uncertain")
             continue
+        cases.append([i, mode] + [[res[w].get("error"), res[w].get("flagged"), res[w].get("stiff_samples")]
+                                  for w in methods])
         for which in methods:
             r, c = res[which], counts[which]
             if r.get("skipped"):
@@ -264,7 +279,9 @@ def survey(sh, rigs: int, seed: int = 16, duration: float = 1.0, dt: float = 5e-
         _finish_counts(c)
     return {"family": family, "rigs": rigs, "seed": seed, "duration_s": duration, "dt_s": dt,
             "tolerance": TOLERANCE, "rtol": rtol, "reference": reference, "reference_failed": skipped,
-            "counts": counts}
+            "reference_uncertain": uncertain, "counts": counts,
+            "cases": {"columns": ["index", "mode"] + [f"{w}: [error, flagged, stiff samples]" for w in methods],
+                      "rows": cases}}
 
 
 def main(argv=None) -> int:

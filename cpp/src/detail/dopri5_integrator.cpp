@@ -37,9 +37,9 @@ Dopri5Integrator::Dopri5Integrator(const Dynamics& dyn, double dt, const SolverO
     SolverOptions stiff = opt;
     stiff.atol_fraction = opt.atol_fraction * kStiffAtolFactor;
     implicit_ = std::make_unique<CvodeIntegrator>(dyn, dt, stiff, y_prime);
-    SolverOptions loose = stiff;
-    loose.rtol = std::min(0.1, kShadowLoosen * opt.rtol);  // the absolute tolerances follow rtol
-    shadow_ = std::make_unique<CvodeIntegrator>(dyn, dt, loose, y_prime);
+    SolverOptions tight = stiff;
+    tight.rtol = opt.rtol / kShadowTighten;  // the absolute tolerances follow rtol
+    shadow_ = std::make_unique<CvodeIntegrator>(dyn, dt, tight, y_prime);
   }
   // A run that stays near rest is checked against a millionth of the rig's scales, not against zero.
   floor_x_ = 1e-6 * state_scale(dyn, kX);
@@ -52,6 +52,7 @@ void Dopri5Integrator::reset(const State& y, double t) noexcept {
   h_ = dt_;
   hold_ = 0;
   shadow_live_ = false;
+  since_stiff_ = 0;
   peak_x_ = peak_f_ = 0.0;
   if (implicit_) implicit_->reset(y, t);
   if (shadow_) shadow_->reset(y, t);
@@ -64,10 +65,10 @@ void Dopri5Integrator::track_peaks(const Dynamics& dyn, const Dynamics::Input& i
   peak_f_ = std::max(peak_f_, std::fabs(o.force));
 }
 
-// The error of CVODE's result scales with its tolerance: the shadow, kShadowLoosen times looser, is
-// off by about kShadowLoosen times as much, so the gap between the two is about kShadowLoosen times
-// the result's error.  The shadow follows the whole stiff stretch from the state where it began, so
-// that an error the loop amplifies from sample to sample shows in the gap as it does in the result.
+// The error of the result grows with its tolerance: the shadow, kShadowTighten times tighter, is
+// off by less, so the gap between the two measures the result's error (kShadowGap).  The shadow
+// follows the run from the state where the first stiff sample began, so that an error the loop
+// amplifies from sample to sample shows in the gap as it does in the result.
 void Dopri5Integrator::verify(const Dynamics& dyn, const Dynamics::Input& in, const State& y_start,
                               double t_start, const State& y, double t_next, Status& st) noexcept {
   if (!shadow_live_) {
@@ -79,7 +80,7 @@ void Dopri5Integrator::verify(const Dynamics& dyn, const Dynamics::Input& in, co
   const Status s = shadow_->advance(dyn, in, shadow_y_, ts, t_next);
   st.internal_steps += s.internal_steps;
   st.rhs_evals += s.rhs_evals;
-  if (!s.ok()) {  // the looser run failed where the result did not: restart the check next sample
+  if (!s.ok()) {  // the tighter run failed (too much work) where the result did not: restart next sample
     shadow_live_ = false;
     return;
   }
@@ -90,7 +91,7 @@ void Dopri5Integrator::verify(const Dynamics& dyn, const Dynamics::Input& in, co
   peak_f_ = std::max(peak_f_, std::fabs(o.force));
   const double gap = std::max(std::fabs(o.displacement - os.displacement) / std::max(peak_x_, floor_x_),
                               std::fabs(o.force - os.force) / std::max(peak_f_, floor_f_));
-  st.error_estimate = gap / (kShadowLoosen * kVerifyTolerance);
+  st.error_estimate = gap / (kShadowGap * kVerifyTolerance);
   st.inaccurate = !(st.error_estimate <= 1.0);
 }
 
@@ -169,6 +170,7 @@ Status Dopri5Integrator::implicit_sample(const Dynamics& dyn, const Dynamics::In
   implicit_->reset(y, t);
   Status st = implicit_->advance(dyn, in, y, t, t_next);
   if (st.ok() && shadow_) verify(dyn, in, y_start, t_start, y, t_next, st);
+  since_stiff_ = 0;
   ++restarts_;
   fsal_ = false;
   h_ = dt_;
@@ -201,8 +203,10 @@ Status Dopri5Integrator::advance(const Dynamics& dyn, const Dynamics::Input& in,
         fsal_ = false;
         h_ = dt_;
       }
+    } else if (shadow_live_ && ++since_stiff_ <= kShadowFollow) {
+      verify(dyn, in, y0, t0, y, t_next, st);  // the shadow still follows an error made in a stiff stretch
     } else {
-      shadow_live_ = false;  // the stiff stretch, if any, is over
+      shadow_live_ = false;
       if (shadow_) track_peaks(dyn, in, y);
     }
   }
