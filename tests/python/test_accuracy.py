@@ -68,7 +68,7 @@ def test_an_off_run_is_counted_silent():
 
 # Two rigs of evaluation/accuracy_random_rigs.py's high-gain family (stiff oil, strong valve, no
 # servovalve dynamics): nearly every sample is stiff for the explicit pair and CVODE takes it.
-HIGH_GAIN = {  # the loop amplifies the integration error about a million times (issue 26: 21 % off)
+HIGH_GAIN = {  # the loop amplifies the integration error about a million times: 20 % off, flagged
     "m": 43.7234, "k": 186749.0, "k_2": 110263.0, "c": 4174.69, "F_c": 0.0, "A": 0.0202267, "K_a": 1.52386e-14,
     "C_l": 5.57695e-11, "p_s": 13844800.0, "K_v": 0.294474, "K_s": 1.06603, "f_v": 166.112, "zeta_v": 0.721389,
     "G_p": 5.7417, "C_F_disp": 51.3314}

@@ -23,7 +23,7 @@ class Dopri5Integrator {
   void reset(const State& y, double t) noexcept;
   //! Integrates from t to t_next with the input held.  Stiffness (more than stiff_steps steps in the
   //! sample, a step below 1e-12 of the sample, or a non-finite stage) redoes the sample from its start
-  //! with CVODE (Status::stiff; absolute tolerances kStiffAtolFactor of the pair's) and stays on CVODE for kImplicitHold samples; without the fallback it
+  //! with CVODE (Status::stiff) and stays on CVODE for kImplicitHold samples; without the fallback it
   //! returns Status::Stiff.  More than max_steps_per_sample steps: TooMuchWork.
   //! With the fallback, a stiff sample is verified: a shadow state, started from the state at the
   //! first stiff sample, is integrated by a second CVODE at rtol / kShadowTighten over every sample
@@ -53,11 +53,7 @@ class Dopri5Integrator {
   static constexpr double kShadowGap = 0.5;
   //! Samples after the last stiff one over which the shadow still follows the (explicit) result: an
   //! error made in a stiff stretch and amplified after it shows there.
-  static constexpr int kShadowFollow = 200;
-  //! The stiff samples' CVODE takes absolute tolerances this fraction of the pair's (rtol x
-  //! atol_fraction x state_scale): the rig's scales bound its states, not the small signals of a
-  //! stiff high-gain loop, which amplifies the error they let through.
-  static constexpr double kStiffAtolFactor = 1e-2;
+  static constexpr int kShadowFollow = 32;
 
  private:
   enum class Outcome { Done, Stiff, TooMuchWork };
