@@ -1,30 +1,42 @@
-"""Randomized accuracy of the integrators on random valid rigs (issue 16):
+"""Randomized accuracy of the integrators on random valid rigs (issues 16 and 26):
 
-    python3 evaluation/accuracy_random_rigs.py --rigs 1200 --json evaluation/accuracy_random_rigs.json
+    python3 evaluation/accuracy_random_rigs.py --family wide --rigs 400 --json evaluation/accuracy_wide_rigs.json
 
-Each rig is drawn (fixed seed) from wide, physically valid ranges around the
-calibrated preset (mass, stiffness, damping, friction with or without LuGre,
-piston area, compressibility, leakage, supply pressure, valve gain and
-bandwidth, controller gain, conversion factors), in displacement or force
-control, under a sine command plus a step whose size is a random fraction of
-what the rig can deliver (stroke, or p_s A).  Every run is compared with the
-tight-tolerance reference: CVODE at rtol 1e-10 with the rig-scaled absolute
-tolerances.  Error: the larger of max |x - x_ref| / max |x_ref| and the same
-for the load-cell force.  A run is
+Three families of rigs, drawn with a fixed seed:
+
+- ``random`` (issue 16): wide, physically valid ranges around the calibrated preset (mass,
+  stiffness, damping, friction with or without LuGre, piston area, compressibility, leakage,
+  supply pressure, valve gain and bandwidth, controller gain, conversion factors);
+- ``wide`` (issue 26): the same keys over several decades (mass 1 kg-100 t, stiffness 1e3-1e8 N/m,
+  area 2 cm^2-0.1 m^2, compressibility 1e-14-1e-10 m^5/N, valve gain 1e-3-0.3, loop gain 0.1-30,
+  force conversion 1e-6-1e-3 V/N, ...);
+- ``high_gain`` (issue 26): the random family with a loop gain of 5-500, a strong valve and stiff
+  oil (compressibility down to 1e-14 m^5/N), where the default's stiff fallback missed by up to 47 %.
+
+Each rig runs in displacement or force control under a sine command plus a step whose size is a
+random fraction of what the rig can deliver (stroke, or p_s A).  Every run is compared with a
+tight-tolerance reference: ARKODE's explicit Dormand-Prince pair (no Newton iteration, no
+Jacobian: independent of the default's CVODE fallback; ``--reference cvode`` for CVODE) at rtol
+1e-10 with absolute tolerances a tenth of the default's scales.  Error: the larger of
+max |x - x_ref| / max |x_ref| and the same for the load-cell force.  A run is
 
 - ``within``: error <= the method's stated tolerance (TOLERANCE);
-- ``flagged``: not within, but the run says so: a non-ok status, or RK4
-  samples flagged inaccurate by its error estimate;
+- ``flagged``: not within, but the run says so: a non-ok status, or samples flagged inaccurate
+  (RK4's error estimate; the default's check of its stiff samples);
 - ``silent``: not within and nothing said: a silent wrong answer (must be 0).
 
-Rigs whose reference run fails are counted and skipped.  The "before" numbers
-of docs/benchmarks.md come from running this script against the core of the
-starting commit (no dopri5, no RK4 flag: the old default is CVODE with fixed
-absolute tolerances, the old RK4 rule is unflagged):
+``flagged_within`` counts the false alarms (within, yet flagged); the flag's precision is
+flagged / (flagged + flagged_within), its recall flagged / (flagged + silent).  Each reference is
+confirmed by the other one (CVODE at the same tolerances): a rig where they differ by more than
+REFERENCE_AGREEMENT is counted under ``reference_uncertain`` and skipped, as are rigs whose
+reference run fails; RK4 is skipped on a rig whose automatic rule needs
+more than RK4_MAX_SUBSTEPS substeps per sample (counted).  The "before" numbers of
+docs/benchmarks.md come from running this script against the core of the starting commit:
 
-    SERVOHYDRAULICS_CORE_DIR=<old core> python3 evaluation/accuracy_random_rigs.py --rigs 1200
+    SERVOHYDRAULICS_CORE_DIR=<old core> python3 evaluation/accuracy_random_rigs.py --family wide ...
 
-tests/python/test_accuracy.py runs the same check on fewer, shorter runs.
+tests/python/test_accuracy.py runs the same check on fewer, shorter runs, and an oracle test on
+two high-gain rigs.
 """
 
 from __future__ import annotations
@@ -84,10 +96,77 @@ def random_case(sh, rng: np.random.Generator, duration: float, dt: float):
     return rig, mode, u
 
 
-def _options(sh, which: str, rtol: float | None = None):
+def wide_rig(sh, rng: np.random.Generator):
+    """A random valid rig drawn over several decades (issue 26): mass, stiffness, piston area,
+    compressibility, leakage, valve gains, loop gain and conversion factors far beyond the preset."""
+    r = sh.zhao2003()
+    r.m = _log_uniform(rng, 1.0, 1e5)
+    r.k = _log_uniform(rng, 1e3, 1e8)
+    r.k_2 = r.k * rng.uniform(0.3, 1.0)
+    r.c = 2.0 * rng.uniform(0.005, 0.2) * math.sqrt(r.k * r.m)
+    r.F_c = 0.0 if rng.random() < 0.3 else _log_uniform(rng, 1.0, 5000.0)
+    r.effects.lugre_friction = bool(rng.random() < 0.2)
+    r.A = _log_uniform(rng, 2e-4, 1e-1)
+    r.K_a = _log_uniform(rng, 1e-14, 1e-10)
+    r.C_l = _log_uniform(rng, 1e-13, 1e-9)
+    r.p_s = _log_uniform(rng, 3e6, 3e7)
+    r.K_v = _log_uniform(rng, 1e-3, 3e-1)
+    r.K_s = _log_uniform(rng, 0.01, 3.0)
+    r.f_v = _log_uniform(rng, 10.0, 300.0)
+    r.zeta_v = rng.uniform(0.5, 1.2)
+    r.G_p = _log_uniform(rng, 0.1, 30.0)
+    r.C_F_disp = _log_uniform(rng, 10.0, 300.0)
+    r.C_F_force = _log_uniform(rng, 1e-6, 1e-3)
+    r.effects.servovalve_dynamics = bool(rng.random() < 0.8)
+    return r
+
+
+def high_gain_rig(sh, rng: np.random.Generator):
+    """A rig of the random family with a high loop gain, a strong valve and stiff oil (issue 26:
+    where the default's stiff fallback missed its tolerance by up to 47 %)."""
+    r = random_rig(sh, rng)
+    r.G_p = _log_uniform(rng, 5.0, 500.0)
+    r.K_v = _log_uniform(rng, 1e-2, 3e-1)
+    r.K_s = _log_uniform(rng, 0.1, 5.0)
+    r.K_a = _log_uniform(rng, 1e-14, 3e-12)
+    r.m = _log_uniform(rng, 1.0, 2000.0)
+    r.C_F_force = _log_uniform(rng, 1e-4, 1e-2)
+    return r
+
+
+#: The rig families: "random" (issue 16's draw, around the preset), "wide" and "high_gain" (issue 26).
+FAMILIES = {"random": random_rig, "wide": wide_rig, "high_gain": high_gain_rig}
+
+
+def family_case(sh, rng: np.random.Generator, duration: float, dt: float, family: str = "random"):
+    """(rig, mode, command) of a family: the command as random_case's."""
+    if family == "random":
+        return random_case(sh, rng, duration, dt)
+    rig = FAMILIES[family](sh, rng)
+    mode = "force" if rng.random() < 0.5 else "displacement"
+    scale = rig.stroke if mode == "displacement" else rig.p_s * rig.A
+    t = np.arange(int(round(duration / dt)) + 1) * dt
+    amp = scale * _log_uniform(rng, 0.01, 0.5)
+    u = amp * np.sin(2 * np.pi * _log_uniform(rng, 0.5, 10.0) * t)
+    u[t >= 0.6 * duration] += scale * rng.uniform(-0.3, 0.3)
+    return rig, mode, u
+
+
+#: The references: ARKODE's explicit Dormand-Prince pair (no Newton, no Jacobian: independent of the
+#: default's CVODE fallback) or CVODE, at rtol 1e-10 with absolute tolerances a tenth of the default's.
+REFERENCES = ("arkode_erk", "cvode")
+#: Each run's reference is confirmed by the other one: they must agree to this (relative to the peaks).
+REFERENCE_AGREEMENT = 0.1 * min(TOLERANCE.values())
+
+#: RK4 is not run on a rig whose automatic rule needs more substeps per sample than this (the
+#: evaluation's cost; such a rig is counted under "rk4_skipped").
+RK4_MAX_SUBSTEPS = 4000
+
+
+def _options(sh, which: str, rtol: float | None = None, reference: str = "arkode_erk"):
     methods = sh.simulate.__globals__["METHODS"]
     if which == "reference":
-        return sh.solver_options(method="cvode", rtol=1e-10, max_steps_per_sample=100000)
+        return sh.solver_options(method=reference, rtol=1e-10, atol_fraction=1e-3, max_steps_per_sample=1000000)
     kw = {} if rtol is None else {"rtol": rtol}
     if which == "default":
         return sh.solver_options(**kw) if "dopri5" in methods else sh.solver_options(method="cvode", **kw)
@@ -101,17 +180,36 @@ def _error(r, ref) -> float:
     return float(max(ex, ef))
 
 
-def run_case(sh, rig, mode: str, u: np.ndarray, dt: float, rtol: float | None = None) -> dict:
+def _rk4_substeps(sh, rig, mode: str, dt: float) -> int:
+    core = sh.simulate.__globals__["_core"]
+    return int(core.rk4_automatic_substeps(core.Dynamics(rig, sh.simulate.__globals__["MODES"][mode]), dt,
+                                           sh.solver_options(method="rk4")))
+
+
+def run_case(sh, rig, mode: str, u: np.ndarray, dt: float, rtol: float | None = None,
+             reference: str = "arkode_erk", methods: tuple = ("default", "rk4")) -> dict:
     """The reference and each method on one case: error, status, flags, time."""
     try:
-        ref = sh.simulate(rig, mode, u, dt=dt, options=_options(sh, "reference"), raise_on_failure=False)
-    except ValueError as e:  # e.g. RK4's automatic rule refusing the rig is per method; this is setup
+        ref = sh.simulate(rig, mode, u, dt=dt, options=_options(sh, "reference", reference=reference),
+                          raise_on_failure=False)
+        other = next(r for r in REFERENCES if r != reference)
+        check = sh.simulate(rig, mode, u, dt=dt, options=_options(sh, "reference", reference=other),
+                            raise_on_failure=False)
+    except ValueError as e:  # an invalid rig: setup, not a wrong answer
         return {"reference": f"error: {e}"}
-    if not ref.success:
-        return {"reference": ref.status}
+    if not ref.success or not check.success:
+        return {"reference": ref.status if not ref.success else f"{other}: {check.status}"}
+    # The two references must agree to a tenth of the tightest tolerance: where they do not (a rig
+    # that amplifies even a 1e-10 tolerance's error past 1e-4), no run can be judged against them.
+    gap = _error(check, ref)
+    if not gap <= REFERENCE_AGREEMENT:
+        return {"reference": f"uncertain: {other} departs from {reference} by {gap:.2e}"}
     out: dict = {"reference": "ok"}
-    for which in ("default", "rk4"):
+    for which in methods:
         try:
+            if which == "rk4" and _rk4_substeps(sh, rig, mode, dt) > RK4_MAX_SUBSTEPS:
+                out[which] = {"skipped": True}
+                continue
             t0 = time.perf_counter()
             r = sh.simulate(rig, mode, u, dt=dt, options=_options(sh, which, rtol), raise_on_failure=False)
             wall = time.perf_counter() - t0
@@ -127,33 +225,63 @@ def run_case(sh, rig, mode: str, u: np.ndarray, dt: float, rtol: float | None = 
     return out
 
 
+def _new_counts() -> dict:
+    return {"within": 0, "flagged": 0, "silent": 0, "worst_silent": 0.0, "worst": 0.0, "silent_cases": [],
+            "flagged_within": 0, "skipped": 0, "wall_s": 0.0}
+
+
+def _finish_counts(c: dict) -> None:
+    """Precision and recall of the run's flag as a detector of a miss (error > tolerance)."""
+    tp, fn, fp = c["flagged"], c["silent"], c["flagged_within"]
+    c["flag_precision"] = tp / (tp + fp) if tp + fp else None
+    c["flag_recall"] = tp / (tp + fn) if tp + fn else None
+    c["flag_rate_within"] = fp / c["within"] if c["within"] else None
+
+
 def survey(sh, rigs: int, seed: int = 16, duration: float = 1.0, dt: float = 5e-4, progress: bool = True,
-           rtol: float | None = None) -> dict:
-    """Runs `rigs` random cases and counts within / flagged / silent per method."""
+           rtol: float | None = None, family: str = "random", reference: str = "arkode_erk",
+           methods: tuple = ("default", "rk4")) -> dict:
+    """Runs `rigs` random cases of a family and counts within / flagged / silent per method, the
+    flag's false alarms (flagged_within) and its precision and recall."""
     from tqdm import tqdm
 
     rng = np.random.default_rng(seed)
-    counts = {w: {"within": 0, "flagged": 0, "silent": 0, "worst_silent": 0.0, "silent_cases": []}
-              for w in ("default", "rk4")}
-    skipped = 0
-    for i in tqdm(range(rigs), disable=not progress, desc="random rigs"):
-        rig, mode, u = random_case(sh, rng, duration, dt)
-        res = run_case(sh, rig, mode, u, dt, rtol)
+    counts = {w: _new_counts() for w in methods}
+    skipped, uncertain, cases = 0, 0, []
+    for i in tqdm(range(rigs), disable=not progress, desc=f"{family} rigs"):
+        rig, mode, u = family_case(sh, rng, duration, dt, family)
+        res = run_case(sh, rig, mode, u, dt, rtol, reference, methods)
         if res["reference"] != "ok":
             skipped += 1
+            uncertain += res["reference"].startswith("uncertain")
             continue
-        for which in ("default", "rk4"):
+        cases.append([i, mode] + [[res[w].get("error"), res[w].get("flagged"), res[w].get("stiff_samples")]
+                                  for w in methods])
+        for which in methods:
             r, c = res[which], counts[which]
+            if r.get("skipped"):
+                c["skipped"] += 1
+                continue
+            c["wall_s"] += r.get("wall_s", 0.0)
+            if math.isfinite(r["error"]):
+                c["worst"] = max(c["worst"], r["error"])
             if r["within"]:
                 c["within"] += 1
+                c["flagged_within"] += int(r["flagged"])
             elif r["flagged"]:
                 c["flagged"] += 1
             else:
                 c["silent"] += 1
                 c["worst_silent"] = max(c["worst_silent"], r["error"])
-                c["silent_cases"].append({"index": i, "mode": mode, "error": r["error"]})
-    return {"rigs": rigs, "seed": seed, "duration_s": duration, "dt_s": dt, "tolerance": TOLERANCE, "rtol": rtol,
-            "reference_failed": skipped, "counts": counts}
+                c["silent_cases"].append({"index": i, "mode": mode, "error": r["error"],
+                                          "stiff_samples": r["stiff_samples"]})
+    for c in counts.values():
+        _finish_counts(c)
+    return {"family": family, "rigs": rigs, "seed": seed, "duration_s": duration, "dt_s": dt,
+            "tolerance": TOLERANCE, "rtol": rtol, "reference": reference, "reference_failed": skipped,
+            "reference_uncertain": uncertain, "counts": counts,
+            "cases": {"columns": ["index", "mode"] + [f"{w}: [error, flagged, stiff samples]" for w in methods],
+                      "rows": cases}}
 
 
 def main(argv=None) -> int:
@@ -162,6 +290,9 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=16)
     ap.add_argument("--duration", type=float, default=1.0, help="record length [s]")
     ap.add_argument("--rtol", type=float, default=None, help="rtol of the default method (None: its default)")
+    ap.add_argument("--family", choices=sorted(FAMILIES), default="random", help="the rigs drawn")
+    ap.add_argument("--reference", choices=REFERENCES, default="arkode_erk")
+    ap.add_argument("--methods", default="default,rk4", help="comma-separated: default, rk4")
     ap.add_argument("--json", default="", help="write the counts here")
     ap.add_argument("--no-progress", action="store_true")
     args = ap.parse_args(argv)
@@ -169,7 +300,12 @@ def main(argv=None) -> int:
         sys.path.insert(0, str(ROOT / "python"))  # this tree's Python layer unless PYTHONPATH gives one
     import servohydraulics as sh
 
-    res = survey(sh, args.rigs, args.seed, args.duration, progress=not args.no_progress, rtol=args.rtol)
+    methods = tuple(m for m in args.methods.split(",") if m)
+    bad = [m for m in methods if m not in TOLERANCE]
+    if bad or not methods:
+        ap.error(f"invalid --methods = {args.methods!r}: expected a comma-separated subset of {sorted(TOLERANCE)}")
+    res = survey(sh, args.rigs, args.seed, args.duration, progress=not args.no_progress, rtol=args.rtol,
+                 family=args.family, reference=args.reference, methods=methods)
     print(json.dumps(res, indent=1))
     if args.json:
         Path(args.json).write_text(json.dumps(res, indent=1) + "\n")

@@ -5,8 +5,10 @@
 #   scripts/run.sh test    ruff, then all tests: C++ (ctest) and Python (pytest), but those marked slow
 #   scripts/run.sh test-all  the same with the slow diagnosis tests (minutes each)
 #   scripts/run.sh bench   the step-time benchmarks (docs/benchmarks.md)
-#   scripts/run.sh sanitize  the C++ tests (with the SUNDIALS failure injection) and a short
-#                          Python smoke run under AddressSanitizer, UBSan and LeakSanitizer
+#   scripts/run.sh sanitize  the C++ tests (with the SUNDIALS failure injection), the FMU binary
+#                          through its C ABI (a normal and a hostile host) and a short Python
+#                          smoke run (RTHS with a Python controller, identify, the FMU export
+#                          through fmpy) under AddressSanitizer, UBSan and LeakSanitizer
 #                          (docs/robustness.md)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -79,21 +81,23 @@ cxx_tests() {
   PATH="$venv/bin:$PATH" "$venv/bin/ctest" --test-dir "$b" --output-on-failure -j "$jobs"
 }
 
-# A small Debug build: the core and the C++ tests at -O1 with ASan + UBSan (+ LSan, part of
-# ASan on Linux), the Python module's glue at -O0 linked to them; nothing else (no packaging
+# A small Debug build: the core, the FMU binary and the C++ tests at -O1 with ASan + UBSan (+ LSan,
+# part of ASan on Linux), the Python module's glue at -O0 linked to them; nothing else (no packaging
 # test, no examples).  Any report fails the run.
 sanitize() {
   local b="$root/build/sanitize"
   local flags="-O1;-g;-fno-omit-frame-pointer;-fsanitize=address,undefined;-fno-sanitize-recover=all"
   local pybind; pybind=$("$venv/bin/python" -c 'import pybind11; print(pybind11.get_cmake_dir())')
   "$venv/bin/cmake" -S "$root" -B "$b" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG=-O0 \
-    -DSH_BUILD_TESTS=ON -DSH_BUILD_PYTHON=ON -DSH_SANITIZE="$flags" -DCMAKE_MAKE_PROGRAM="$venv/bin/ninja" \
+    -DSH_BUILD_TESTS=ON -DSH_BUILD_PYTHON=ON -DSH_BUILD_FMU=ON -DSH_SANITIZE="$flags" -DCMAKE_MAKE_PROGRAM="$venv/bin/ninja" \
     -DPython_EXECUTABLE="$venv/bin/python" -Dpybind11_DIR="$pybind" >/dev/null
   "$venv/bin/cmake" --build "$b" -j "$jobs"
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-  PATH="$venv/bin:$PATH" "$venv/bin/ctest" --test-dir "$b" --output-on-failure -j "$jobs" -L core
-  # Python smoke: the sanitized _core inside an unsanitized interpreter (libasan preloaded).
+  # core: the C++ tests; fmu: test_fmu_binary, a host that dlopens the sanitized FMU binary.
+  PATH="$venv/bin:$PATH" "$venv/bin/ctest" --test-dir "$b" --output-on-failure -j "$jobs" -L 'core|fmu'
+  # Python smoke: the sanitized _core (and, through fmpy, the sanitized FMU binary the export copies)
+  # inside an unsanitized interpreter (libasan preloaded).
   # The interpreter's own allocations at exit are not ours: leaks are checked by the C++ tests.
   # libstdc++ preloaded too: ASan must find the real __cxa_throw when it starts.
   local asan; asan="$(${CXX:-c++} -print-file-name=libasan.so) $(${CXX:-c++} -print-file-name=libstdc++.so)"

@@ -123,14 +123,19 @@ def _first_time(time: np.ndarray, flags: np.ndarray, bit: int) -> float:
 
 
 def solver_warnings(work: Any) -> list[str]:
-    """Notes on how the integrator coped: samples the real-time option (RK4) flagged as
-    inaccurate by its error estimate, samples the default pair found stiff (CVODE took them)."""
+    """Notes on how the integrator coped: samples flagged as inaccurate (by the real-time option's
+    (RK4) error estimate, or the default's check of its stiff samples), samples the default pair
+    found stiff (CVODE took them)."""
     out = []
     n_bad = getattr(work, "inaccurate_samples", 0) if work is not None else 0
-    if n_bad:
+    n_stiff = getattr(work, "stiff_samples", 0) if work is not None else 0
+    if n_bad and n_stiff:
+        out.append(f"{n_bad} stiff sample(s) flagged inaccurate: a looser run departs from the result by more "
+                   "than the default's 1e-3 of the peak displacement or force allows (a high-gain loop that "
+                   "amplifies the integration error); use a smaller rtol")
+    elif n_bad:
         out.append(f"{n_bad} sample(s) flagged inaccurate by the RK4 error estimate: use the default "
                    "method (dopri5), more rk4_substeps or rk4_max_refinements")
-    n_stiff = getattr(work, "stiff_samples", 0) if work is not None else 0
     if n_stiff:
         out.append(f"{n_stiff} sample(s) were stiff for the explicit pair and integrated by CVODE")
     return out

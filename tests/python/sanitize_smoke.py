@@ -1,12 +1,17 @@
 """A short smoke run of the Python surface for ``scripts/run.sh sanitize``: the
 sanitized ``_core`` (ASan + UBSan) through every binding that moves arrays or
 releases the GIL, the error paths (bad tables, bad options, concurrent use)
-and threads.  Not collected by pytest (no ``test_`` prefix); any sanitizer
+and threads; the RTHS loop calling a Python controller (and one that raises),
+``identify`` on a short record, and the FMU export with the exported (sanitized)
+FMU binary run through fmpy: a plant and an EFT controller in closed loop, equal
+to the library's run, and a hostile host.  Not collected by pytest (no ``test_`` prefix); any sanitizer
 report aborts the interpreter, so reaching the last line is the pass."""
 
 from __future__ import annotations
 
+import tempfile
 import threading
+from pathlib import Path
 
 import numpy as np
 
@@ -20,6 +25,87 @@ def expect(exc: type[BaseException], f, *args) -> None:
     except exc:
         return
     raise AssertionError(f"{f} did not raise {exc.__name__}")
+
+
+class Proportional:
+    """A Python controller in the C++ RTHS loop: a gain on the tracking error; raises at sample ``fail_at``."""
+
+    def __init__(self, fail_at: int = -1):
+        self.k, self.fail_at = 0, fail_at
+
+    def reset(self):
+        self.k = 0
+
+    def command(self, desired, desired_velocity, desired_acceleration, measured, measured_force):
+        self.k += 1
+        if self.k == self.fail_at:
+            raise ValueError("deliberate")
+        return desired + 0.5 * (desired - measured)
+
+
+def rths_with_python_controller() -> None:
+    from servohydraulics import rths
+
+    case, rec = rths.embedded_case(1), rths.synthetic_record(duration=1.0)
+    t = rths.run_trial(case, rec, Proportional(), keep_signals=True)
+    assert t.ok and np.all(np.isfinite(t.J))
+    expect(RuntimeError, rths.run_trial, case, rec, Proportional(fail_at=50))  # raised through the C++ loop
+
+
+def identify_short_record() -> None:
+    truth = sh.zhao2003()
+    dt = 1e-3
+    t = np.arange(1000) * dt
+    u = 2e-3 * np.sin(2 * np.pi * (0.5 + 2.0 * t) * t)
+    sim = sh.simulate(truth, "displacement", u, dt=dt)
+    rec = sh.Response({"time": t, "command": u, "displacement": sim.displacement, "force": sim.force})
+    start = sh.zhao2003()
+    start.G_p *= 1.3
+    ident = sh.identify([rec], rig=start, fit=["G_p"], mode="displacement", max_nfev=4,
+                         frequency_stage=False, progress=False)
+    assert np.isfinite(ident.values["G_p"])
+
+
+def fmu_through_fmpy() -> None:
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    from servohydraulics.fmu import cosimulate
+
+    rig = sh.zhao2003()
+    with tempfile.TemporaryDirectory(prefix="sh_sanitize_") as d:
+        plant = sh.export_fmu(rig, Path(d) / "plant.fmu", kind="plant", mode="force")
+        eft = sh.export_fmu(rig, Path(d) / "eft.fmu", kind="eft")
+        ag = 3.0 * np.sin(2 * np.pi * 1.5 * np.arange(300) * 5e-4)
+        res, ref = cosimulate(plant, eft, ag), sh.run_eft(rig, ag)
+        assert np.array_equal(res.channels["displacement"], ref.displacement)
+        expect(ValueError, sh.export_fmu, rig, Path(d) / "bad.fmu", "plant", "force", float("nan"))
+        # a hostile host through fmpy: a NaN command, a bad step, steps after an error, reset
+        unzipped = extract(str(plant), unzipdir=str(Path(d) / "x"))
+        md = read_model_description(unzipped)
+        vr = {v.name: v.valueReference for v in md.modelVariables}
+        s = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
+                      instanceName="hostile")
+        s.instantiate()
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+        s.exitInitializationMode()
+        for call in (lambda: s.setReal([vr["command"]], [float("nan")]), lambda: s.doStep(0.0, -1.0),
+                     lambda: s.doStep(1.0, 5e-4), lambda: s.getReal([10**6])):
+            expect(Exception, call)
+        s.setReal([vr["command"]], [1e12])
+        try:
+            for k in range(100):
+                s.doStep(k * 5e-4, 5e-4)
+        except Exception:
+            expect(Exception, s.doStep, 0.0, 5e-4)
+        s.reset()
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+        s.exitInitializationMode()
+        s.doStep(0.0, 5e-4)
+        s.terminate()
+        s.freeInstance()
 
 
 def main() -> None:
@@ -74,6 +160,9 @@ def main() -> None:
         t.start()
     for t in threads:
         t.join()
+    rths_with_python_controller()
+    identify_short_record()
+    fmu_through_fmpy()
     print(f"sanitize smoke: ok ({len(errors)} concurrent-use error(s) raised on the shared plant)")
 
 

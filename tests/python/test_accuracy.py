@@ -64,3 +64,58 @@ def test_an_off_run_is_counted_silent():
     assert ar._error(two, ref) > ar.TOLERANCE["rk4"]
     assert two.work.inaccurate_samples > 0  # and the run flags it
     assert any("flagged inaccurate" in w for w in two.warnings())
+
+
+# Two rigs of evaluation/accuracy_random_rigs.py's high-gain family (stiff oil, strong valve, no
+# servovalve dynamics): nearly every sample is stiff for the explicit pair and CVODE takes it.
+HIGH_GAIN = {  # the loop amplifies the integration error about a million times: 20 % off, flagged
+    "m": 43.7234, "k": 186749.0, "k_2": 110263.0, "c": 4174.69, "F_c": 0.0, "A": 0.0202267, "K_a": 1.52386e-14,
+    "C_l": 5.57695e-11, "p_s": 13844800.0, "K_v": 0.294474, "K_s": 1.06603, "f_v": 166.112, "zeta_v": 0.721389,
+    "G_p": 5.7417, "C_F_disp": 51.3314}
+HIGH_GAIN_CALM = {  # as stiff, but the loop damps the error: the default is within 1e-3
+    "m": 72.7327, "k": 205894.0, "k_2": 148600.0, "c": 915.038, "F_c": 0.0, "A": 0.00924061, "K_a": 1.36924e-13,
+    "C_l": 8.8169e-11, "p_s": 19268200.0, "K_v": 0.0125616, "K_s": 0.924741, "f_v": 25.3585, "zeta_v": 0.564861,
+    "G_p": 83.5975, "C_F_disp": 173.376}
+
+
+def _high_gain_case(values: dict, amp: float, freq: float, step: float, duration: float = 0.5, dt: float = 5e-4):
+    rig = sh.zhao2003()
+    for k, v in values.items():
+        setattr(rig, k, v)
+    rig.effects.servovalve_dynamics = False
+    t = np.arange(int(round(duration / dt)) + 1) * dt
+    u = amp * np.sin(2 * np.pi * freq * t)
+    u[t >= 0.6 * duration] += step
+    return rig, u
+
+
+def _run(rig, u, **kw):
+    return sh.simulate(rig, "displacement", u, options=sh.solver_options(**kw))
+
+
+def test_stiff_samples_that_miss_the_stated_accuracy_are_flagged():
+    """Issue 26, defect 4: against ARKODE's explicit pair at rtol 1e-10 (no CVODE, no Newton), a
+    stiff high-gain rig's run is within 1e-3 of the peak displacement and force or flags samples
+    inaccurate; a looser rtol that misses by far is flagged, with a warning that says why."""
+    rig, u = _high_gain_case(HIGH_GAIN, 0.00262353, 1.50547, -0.0148819)
+    ref = sh.simulate(rig, "displacement", u, options=sh.solver_options(
+        "arkode_erk", rtol=1e-10, atol_fraction=1e-3, max_steps_per_sample=1000000))
+    default = _run(rig, u)
+    assert default.work.stiff_samples > 0.9 * u.size
+    assert ar._error(default, ref) <= ar.TOLERANCE["default"] or default.work.inaccurate_samples > 0
+    loose = _run(rig, u, rtol=1e-7)
+    assert ar._error(loose, ref) > 10 * ar.TOLERANCE["default"]
+    assert loose.work.inaccurate_samples > 0
+    assert any("stiff sample(s) flagged inaccurate" in w for w in loose.warnings())
+
+
+def test_stiff_samples_within_the_stated_accuracy_are_not_flagged():
+    """The flag means something: on an equally stiff rig whose loop does not amplify the error,
+    the default is within 1e-3 of the reference and flags nothing."""
+    rig, u = _high_gain_case(HIGH_GAIN_CALM, 0.062815, 0.799468, 0.0238396)
+    ref = sh.simulate(rig, "displacement", u, options=sh.solver_options(
+        "arkode_erk", rtol=1e-10, atol_fraction=1e-3, max_steps_per_sample=1000000))
+    default = _run(rig, u)
+    assert default.work.stiff_samples > 0.5 * u.size
+    assert ar._error(default, ref) <= ar.TOLERANCE["default"]
+    assert default.work.inaccurate_samples == 0

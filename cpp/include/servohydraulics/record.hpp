@@ -45,7 +45,7 @@ struct RunSummary {
   long restarts = 0;              //!< CVodeReInit calls in the run
   int max_internal_steps = 0;     //!< the largest number in one sample
   long stiff_samples = 0;         //!< samples the default pair found stiff and CVODE integrated (Status::stiff)
-  long inaccurate_samples = 0;    //!< Rk4 samples whose error estimate exceeded the tolerance (Status::inaccurate)
+  long inaccurate_samples = 0;    //!< samples flagged Status::inaccurate (Rk4's estimate, dopri5's stiff-sample check)
   std::uint32_t flags_any = 0;    //!< OR of every row's OutputFlag bits
   //! max |force| [N]: the load cell (run_record, EFT, RPsD), the actuator force Force_act (RTHS)
   double peak_force = 0.0;

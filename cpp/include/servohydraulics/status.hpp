@@ -19,10 +19,14 @@ struct Status {
   int rhs_evals = 0;       //!< right-hand-side evaluations in this sample
   bool restarted = false;  //!< CVodeReInit was called at the start of this sample
   bool stiff = false;      //!< Dopri5: the sample was stiff for the explicit pair and CVODE integrated it
-  //! Rk4: the sample's embedded error estimate exceeded the tolerance (rk4_flag_rtol) after any
-  //! refinement: the result is kept, the code stays Ok, the flag says it is not to be trusted.
+  //! The result is kept, the code stays Ok, the flag says it is not to be trusted.  Rk4: the sample's
+  //! embedded error estimate exceeded the tolerance (rk4_flag_rtol) after any refinement.  Dopri5:
+  //! a stiff sample whose CVODE result a looser shadow run does not confirm to the default's stated
+  //! accuracy (dopri5_integrator.hpp, kVerifyTolerance of the run's peak displacement and force).
   bool inaccurate = false;
-  double error_estimate = 0.0;  //!< Rk4: the weighted RMS norm of the sample's estimated error (<= 1: within)
+  //! Rk4: the weighted RMS norm of the sample's estimated error; Dopri5 on a stiff sample: the
+  //! shadow's gap over its bound (<= 1: within)
+  double error_estimate = 0.0;
 
   bool ok() const noexcept { return code == Ok; }
   const char* message() const noexcept;  //!< static text for the code
