@@ -35,6 +35,10 @@ docs/benchmarks.md come from running this script against the core of the startin
 
     SERVOHYDRAULICS_CORE_DIR=<old core> python3 evaluation/accuracy_random_rigs.py --family wide ...
 
+``--rk4-flag-rtols 5e-5,2e-4`` reruns RK4 at each flag tolerance (same states, only its flag
+differs) and counts the flag's precision and recall at each (``rk4_flag_sweep``): how the default
+``rk4_flag_rtol`` was calibrated (docs/benchmarks.md).
+
 tests/python/test_accuracy.py runs the same check on fewer, shorter runs, and an oracle test on
 two high-gain rigs.
 """
@@ -163,14 +167,15 @@ REFERENCE_AGREEMENT = 0.1 * min(TOLERANCE.values())
 RK4_MAX_SUBSTEPS = 4000
 
 
-def _options(sh, which: str, rtol: float | None = None, reference: str = "arkode_erk"):
+def _options(sh, which: str, rtol: float | None = None, reference: str = "arkode_erk",
+             flag_rtol: float | None = None):
     methods = sh.simulate.__globals__["METHODS"]
     if which == "reference":
         return sh.solver_options(method=reference, rtol=1e-10, atol_fraction=1e-3, max_steps_per_sample=1000000)
     kw = {} if rtol is None else {"rtol": rtol}
     if which == "default":
         return sh.solver_options(**kw) if "dopri5" in methods else sh.solver_options(method="cvode", **kw)
-    return sh.solver_options(method="rk4")
+    return sh.solver_options(method="rk4", **({} if flag_rtol is None else {"rk4_flag_rtol": flag_rtol}))
 
 
 def _error(r, ref) -> float:
@@ -187,8 +192,9 @@ def _rk4_substeps(sh, rig, mode: str, dt: float) -> int:
 
 
 def run_case(sh, rig, mode: str, u: np.ndarray, dt: float, rtol: float | None = None,
-             reference: str = "arkode_erk", methods: tuple = ("default", "rk4")) -> dict:
-    """The reference and each method on one case: error, status, flags, time."""
+             reference: str = "arkode_erk", methods: tuple = ("default", "rk4"), flag_rtols: tuple = ()) -> dict:
+    """The reference and each method on one case: error, status, flags, time; RK4 is also run at each
+    of `flag_rtols` (its flag's tolerance: same states, only the flag differs) to calibrate it."""
     try:
         ref = sh.simulate(rig, mode, u, dt=dt, options=_options(sh, "reference", reference=reference),
                           raise_on_failure=False)
@@ -222,6 +228,11 @@ def run_case(sh, rig, mode: str, u: np.ndarray, dt: float, rtol: float | None = 
                       "within": bool(r.success and err <= TOLERANCE[which]),
                       "stiff_samples": int(getattr(r.work, "stiff_samples", 0)),
                       "inaccurate_samples": int(getattr(r.work, "inaccurate_samples", 0)), "wall_s": wall}
+        if which == "rk4":
+            out[which]["flag_sweep"] = {}
+            for fr in flag_rtols:
+                rf = sh.simulate(rig, mode, u, dt=dt, options=_options(sh, which, flag_rtol=fr), raise_on_failure=False)
+                out[which]["flag_sweep"][fr] = bool((not rf.success) or rf.work.inaccurate_samples > 0)
     return out
 
 
@@ -240,17 +251,19 @@ def _finish_counts(c: dict) -> None:
 
 def survey(sh, rigs: int, seed: int = 16, duration: float = 1.0, dt: float = 5e-4, progress: bool = True,
            rtol: float | None = None, family: str = "random", reference: str = "arkode_erk",
-           methods: tuple = ("default", "rk4")) -> dict:
+           methods: tuple = ("default", "rk4"), flag_rtols: tuple = ()) -> dict:
     """Runs `rigs` random cases of a family and counts within / flagged / silent per method, the
-    flag's false alarms (flagged_within) and its precision and recall."""
+    flag's false alarms (flagged_within) and its precision and recall; for RK4 also at each of
+    `flag_rtols` (rk4_flag_sweep)."""
     from tqdm import tqdm
 
     rng = np.random.default_rng(seed)
     counts = {w: _new_counts() for w in methods}
+    sweep = {fr: _new_counts() for fr in flag_rtols}
     skipped, uncertain, cases = 0, 0, []
     for i in tqdm(range(rigs), disable=not progress, desc=f"{family} rigs"):
         rig, mode, u = family_case(sh, rng, duration, dt, family)
-        res = run_case(sh, rig, mode, u, dt, rtol, reference, methods)
+        res = run_case(sh, rig, mode, u, dt, rtol, reference, methods, flag_rtols)
         if res["reference"] != "ok":
             skipped += 1
             uncertain += res["reference"].startswith("uncertain")
@@ -275,11 +288,20 @@ def survey(sh, rigs: int, seed: int = 16, duration: float = 1.0, dt: float = 5e-
                 c["worst_silent"] = max(c["worst_silent"], r["error"])
                 c["silent_cases"].append({"index": i, "mode": mode, "error": r["error"],
                                           "stiff_samples": r["stiff_samples"]})
-    for c in counts.values():
+            for fr, flagged in r.get("flag_sweep", {}).items():
+                s = sweep[fr]
+                key = ("flagged_within" if flagged else "") if r["within"] else ("flagged" if flagged else "silent")
+                s["within"] += int(r["within"])
+                if key:
+                    s[key] += 1
+    for c in list(counts.values()) + list(sweep.values()):
         _finish_counts(c)
     return {"family": family, "rigs": rigs, "seed": seed, "duration_s": duration, "dt_s": dt,
             "tolerance": TOLERANCE, "rtol": rtol, "reference": reference, "reference_failed": skipped,
             "reference_uncertain": uncertain, "counts": counts,
+            "rk4_flag_sweep": {str(fr): {k: s[k] for k in ("within", "flagged", "silent", "flagged_within",
+                                                           "flag_precision", "flag_recall", "flag_rate_within")}
+                               for fr, s in sweep.items()},
             "cases": {"columns": ["index", "mode"] + [f"{w}: [error, flagged, stiff samples]" for w in methods],
                       "rows": cases}}
 
@@ -293,6 +315,8 @@ def main(argv=None) -> int:
     ap.add_argument("--family", choices=sorted(FAMILIES), default="random", help="the rigs drawn")
     ap.add_argument("--reference", choices=REFERENCES, default="arkode_erk")
     ap.add_argument("--methods", default="default,rk4", help="comma-separated: default, rk4")
+    ap.add_argument("--rk4-flag-rtols", default="",
+                    help="comma-separated rk4_flag_rtol values: RK4's flag counted at each (calibration)")
     ap.add_argument("--json", default="", help="write the counts here")
     ap.add_argument("--no-progress", action="store_true")
     args = ap.parse_args(argv)
@@ -305,7 +329,8 @@ def main(argv=None) -> int:
     if bad or not methods:
         ap.error(f"invalid --methods = {args.methods!r}: expected a comma-separated subset of {sorted(TOLERANCE)}")
     res = survey(sh, args.rigs, args.seed, args.duration, progress=not args.no_progress, rtol=args.rtol,
-                 family=args.family, reference=args.reference, methods=methods)
+                 family=args.family, reference=args.reference, methods=methods,
+                 flag_rtols=tuple(float(v) for v in args.rk4_flag_rtols.split(",") if v))
     print(json.dumps(res, indent=1))
     if args.json:
         Path(args.json).write_text(json.dumps(res, indent=1) + "\n")

@@ -74,7 +74,6 @@ Rk4Integrator::Rk4Integrator(const Dynamics& dyn, double dt, const SolverOptions
 double Rk4Integrator::sweep(const Dynamics& dyn, const Dynamics::Input& in, State& y, int n, double h) const
     noexcept {
   State k1, k2, k3, k4, tmp, err{};
-  const State y0 = y;
   const int m = n_;
   dyn.rhs(y.data(), in, k1.data());
   for (int s = 0; s < n; ++s) {
@@ -90,10 +89,20 @@ double Rk4Integrator::sweep(const Dynamics& dyn, const Dynamics::Input& in, Stat
   }
   double sum = 0.0;
   for (int i = 0; i < m; ++i) {
-    const double q = err[i] / (atol_[i] + rtol_ * std::max(std::fabs(y0[i]), std::fabs(y[i])));
+    const double q = err[i] / (atol_[i] + rtol_ * std::max(peak_[i], std::fabs(y[i])));
     sum += q * q;
   }
   return std::sqrt(sum / m);  // NaN if the state blew up: flagged, and the plant's guard fails the sample
+}
+
+void Rk4Integrator::reset(const State& y0, double) noexcept {
+  steps_done_ = rhs_done_ = flagged_ = 0;
+  for (int i = 0; i < n_; ++i) peak_[i] = 0.0;
+  track_peak(y0);
+}
+
+void Rk4Integrator::track_peak(const State& y) noexcept {
+  for (int i = 0; i < n_; ++i) peak_[i] = std::max(peak_[i], std::fabs(y[i]));
 }
 
 Status Rk4Integrator::advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t,
@@ -101,6 +110,7 @@ Status Rk4Integrator::advance(const Dynamics& dyn, const Dynamics::Input& in, St
   Status st;
   const State y0 = y;
   int n = substeps > 0 ? substeps : substeps_;
+  track_peak(y0);
   for (int r = 0;; ++r) {
     st.error_estimate = sweep(dyn, in, y, n, (t_next - t) / n);
     st.internal_steps += n;
@@ -113,6 +123,7 @@ Status Rk4Integrator::advance(const Dynamics& dyn, const Dynamics::Input& in, St
     n *= 2;
   }
   if (st.inaccurate) ++flagged_;
+  track_peak(y);
   t = t_next;
   steps_done_ += st.internal_steps;
   rhs_done_ += st.rhs_evals;

@@ -14,11 +14,14 @@ class Rk4Integrator {
   //! options.rk4_substeps per sample of dt [s], or the automatic rule if 0 (may throw Error).
   Rk4Integrator(const Dynamics& dyn, double dt, const SolverOptions& options);
 
-  void reset(const State&, double) noexcept { steps_done_ = rhs_done_ = flagged_ = 0; }
+  void reset(const State& y0, double) noexcept;
   //! The classical RK4 over substeps() equal substeps, and the estimate of its error: the classical
   //! stages with k5 = f(y_next) (the next substep's k1; one extra evaluation per sample) give the
   //! 3rd-order companion b^ = (1/6, 1/3, 1/3, 0, 1/6), so e = h (k4 - k5) / 6 per substep, summed in
-  //! absolute value over the sample and measured in the weighted RMS norm of (rk4_flag_rtol, atol).
+  //! absolute value over the sample and measured in the weighted RMS norm of (rk4_flag_rtol, atol)
+  //! relative to each state's running peak |y| since the last reset: the accuracy asked of a run is
+  //! relative to its signals' peak, so a sample near a zero crossing is not judged against its own
+  //! small |y| (which flagged accurate runs).
   //! Above 1: Status::inaccurate, and the sample is redone with twice the substeps up to
   //! rk4_max_refinements times (the flag stays: a local estimate does not bound the error carried on).
   //! `substeps` > 0 replaces the configured count (the plant passes a share of it for each part of a
@@ -35,12 +38,14 @@ class Rk4Integrator {
  private:
   //! n substeps of size h from y (updated); returns the weighted norm of the error estimate.
   double sweep(const Dynamics& dyn, const Dynamics::Input& in, State& y, int n, double h) const noexcept;
+  void track_peak(const State& y) noexcept;
 
   int n_;
   int substeps_;
   int max_refinements_;
   double rtol_;
   double atol_[kMaxStates];
+  double peak_[kMaxStates] = {};  //!< max |y_i| over the samples since the last reset
   long steps_done_ = 0, rhs_done_ = 0, flagged_ = 0;
 };
 
