@@ -64,28 +64,38 @@ def _log_uniform(rng: np.random.Generator, lo: float, hi: float) -> float:
     return float(math.exp(rng.uniform(math.log(lo), math.log(hi))))
 
 
+#: Each family's draw ranges, in the order they are drawn (log-uniform unless noted; the order
+#: fixes the seeded draws, so the committed results stay reproducible).
+RANDOM_RANGES = dict(m=(50.0, 20000.0), k=(1e4, 1e7), zeta=(0.005, 0.1), F_c_off=0.2, F_c=(1.0, 2000.0),
+                     A=(2e-3, 5e-2), K_a=(3e-13, 1e-11), C_l=(1e-12, 1e-10), p_s=(7e6, 3e7), K_v=(2e-3, 5e-2),
+                     K_s=(0.02, 1.0), f_v=(20.0, 200.0), G_p=(0.3, 4.0), C_F_disp=(20.0, 200.0),
+                     C_F_force=(1e-5, 5e-4), valve_on=0.9)
+WIDE_RANGES = dict(m=(1.0, 1e5), k=(1e3, 1e8), zeta=(0.005, 0.2), F_c_off=0.3, F_c=(1.0, 5000.0),
+                   A=(2e-4, 1e-1), K_a=(1e-14, 1e-10), C_l=(1e-13, 1e-9), p_s=(3e6, 3e7), K_v=(1e-3, 3e-1),
+                   K_s=(0.01, 3.0), f_v=(10.0, 300.0), G_p=(0.1, 30.0), C_F_disp=(10.0, 300.0),
+                   C_F_force=(1e-6, 1e-3), valve_on=0.8)
+
+
+def _draw_rig(sh, rng: np.random.Generator, R: dict):
+    r = sh.zhao2003()
+    r.m = _log_uniform(rng, *R["m"])
+    r.k = _log_uniform(rng, *R["k"])
+    r.k_2 = r.k * rng.uniform(0.3, 1.0)
+    r.c = 2.0 * rng.uniform(*R["zeta"]) * math.sqrt(r.k * r.m)
+    r.F_c = 0.0 if rng.random() < R["F_c_off"] else _log_uniform(rng, *R["F_c"])
+    r.effects.lugre_friction = bool(rng.random() < 0.2)
+    for key in ("A", "K_a", "C_l", "p_s", "K_v", "K_s", "f_v"):
+        setattr(r, key, _log_uniform(rng, *R[key]))
+    r.zeta_v = rng.uniform(0.5, 1.2)
+    for key in ("G_p", "C_F_disp", "C_F_force"):
+        setattr(r, key, _log_uniform(rng, *R[key]))
+    r.effects.servovalve_dynamics = bool(rng.random() < R["valve_on"])
+    return r
+
+
 def random_rig(sh, rng: np.random.Generator):
     """A random valid rig: every parameter drawn in a wide range around the preset."""
-    r = sh.zhao2003()
-    r.m = _log_uniform(rng, 50.0, 20000.0)
-    r.k = _log_uniform(rng, 1e4, 1e7)
-    r.k_2 = r.k * rng.uniform(0.3, 1.0)
-    r.c = 2.0 * rng.uniform(0.005, 0.1) * math.sqrt(r.k * r.m)
-    r.F_c = 0.0 if rng.random() < 0.2 else _log_uniform(rng, 1.0, 2000.0)
-    r.effects.lugre_friction = bool(rng.random() < 0.2)
-    r.A = _log_uniform(rng, 2e-3, 5e-2)
-    r.K_a = _log_uniform(rng, 3e-13, 1e-11)
-    r.C_l = _log_uniform(rng, 1e-12, 1e-10)
-    r.p_s = _log_uniform(rng, 7e6, 3e7)
-    r.K_v = _log_uniform(rng, 2e-3, 5e-2)
-    r.K_s = _log_uniform(rng, 0.02, 1.0)
-    r.f_v = _log_uniform(rng, 20.0, 200.0)
-    r.zeta_v = rng.uniform(0.5, 1.2)
-    r.G_p = _log_uniform(rng, 0.3, 4.0)
-    r.C_F_disp = _log_uniform(rng, 20.0, 200.0)
-    r.C_F_force = _log_uniform(rng, 1e-5, 5e-4)
-    r.effects.servovalve_dynamics = bool(rng.random() < 0.9)
-    return r
+    return _draw_rig(sh, rng, RANDOM_RANGES)
 
 
 def random_case(sh, rng: np.random.Generator, duration: float, dt: float):
@@ -103,26 +113,7 @@ def random_case(sh, rng: np.random.Generator, duration: float, dt: float):
 def wide_rig(sh, rng: np.random.Generator):
     """A random valid rig drawn over several decades (issue 26): mass, stiffness, piston area,
     compressibility, leakage, valve gains, loop gain and conversion factors far beyond the preset."""
-    r = sh.zhao2003()
-    r.m = _log_uniform(rng, 1.0, 1e5)
-    r.k = _log_uniform(rng, 1e3, 1e8)
-    r.k_2 = r.k * rng.uniform(0.3, 1.0)
-    r.c = 2.0 * rng.uniform(0.005, 0.2) * math.sqrt(r.k * r.m)
-    r.F_c = 0.0 if rng.random() < 0.3 else _log_uniform(rng, 1.0, 5000.0)
-    r.effects.lugre_friction = bool(rng.random() < 0.2)
-    r.A = _log_uniform(rng, 2e-4, 1e-1)
-    r.K_a = _log_uniform(rng, 1e-14, 1e-10)
-    r.C_l = _log_uniform(rng, 1e-13, 1e-9)
-    r.p_s = _log_uniform(rng, 3e6, 3e7)
-    r.K_v = _log_uniform(rng, 1e-3, 3e-1)
-    r.K_s = _log_uniform(rng, 0.01, 3.0)
-    r.f_v = _log_uniform(rng, 10.0, 300.0)
-    r.zeta_v = rng.uniform(0.5, 1.2)
-    r.G_p = _log_uniform(rng, 0.1, 30.0)
-    r.C_F_disp = _log_uniform(rng, 10.0, 300.0)
-    r.C_F_force = _log_uniform(rng, 1e-6, 1e-3)
-    r.effects.servovalve_dynamics = bool(rng.random() < 0.8)
-    return r
+    return _draw_rig(sh, rng, WIDE_RANGES)
 
 
 def high_gain_rig(sh, rng: np.random.Generator):
