@@ -57,6 +57,41 @@ def _fitted(params: dict, pk: str, answer: dict) -> dict:
     return {"value": float(np.interp(answer["opening"], opening, flow)), "interval_95": [None, None]}
 
 
+#: the subsets the metrics are computed over (label, which answer-key rows)
+SUBSETS = (("snr>=30", lambda k: k["snr"] >= 30), ("snr=55", lambda k: k["snr"] == 55),
+           ("snr=40", lambda k: k["snr"] == 40), ("snr=30", lambda k: k["snr"] == 30),
+           ("snr=20", lambda k: k["snr"] == 20), ("all", lambda k: True),
+           ("issue13", lambda k: k.get("set") == "issue13"),
+           ("issue13 snr>=30", lambda k: k.get("set") == "issue13" and k["snr"] >= 30),
+           ("issue25", lambda k: k.get("set") == "issue25"),
+           ("issue25 snr>=30", lambda k: k.get("set") == "issue25" and k["snr"] >= 30))
+
+
+def coverage_rows(results: list[dict], key: list[dict], snr_min: float = 30) -> list[dict]:
+    """Every in-library parameter of a correctly named single effect (SNR >= ``snr_min``): its truth,
+    value, 95 % interval, status and whether the interval covers the truth (the coverage figure's
+    parameters; a parameter "at bound" or "not identified" has no interval to cover with)."""
+    ans = {k["id"]: k for k in key}
+    out = []
+    for r in results:
+        k = ans[r["id"]]
+        if k["snr"] < snr_min or k["kind"] != "single" or k["runtime_check"]:
+            continue
+        a = k["answers"][0]
+        if a["name"] not in r["named"] or not a.get("in_library", True):
+            continue
+        i = r["named"].index(a["name"])
+        for pk, tv in a["parameters"].items():
+            p = _fitted(r["parameters"][i], pk, a)
+            lo, hi = p["interval_95"]
+            status = p.get("status", "identified")
+            covers = (lo <= tv <= hi) if status == "identified" and lo is not None and hi is not None else None
+            out.append({"id": r["id"], "form": k["forms"][0].split(":")[0], "rig": k.get("rig", "paper"),
+                        "snr": k["snr"], "key": pk, "truth": tv, "value": p["value"], "interval": [lo, hi],
+                        "status": status, "covers": covers})
+    return out
+
+
 def _frac(a, b) -> float | None:
     return a / b if b else None
 
@@ -69,10 +104,7 @@ def metrics(results: list[dict], key: list[dict]) -> dict:
         rows.append((r, k))
     out: dict = {}
     names = sorted({a["name"] for k in key for a in k["answers"]})
-    for label, sel in (("snr>=30", lambda k: k["snr"] >= 30), ("snr=40", lambda k: k["snr"] == 40),
-                       ("snr=30", lambda k: k["snr"] == 30), ("snr=20", lambda k: k["snr"] == 20),
-                       ("all", lambda k: True), ("issue13", lambda k: k.get("set") == "issue13"),
-                       ("issue13 snr>=30", lambda k: k.get("set") == "issue13" and k["snr"] >= 30)):
+    for label, sel in SUBSETS:
         rs = [(r, k) for r, k in rows if sel(k) and not k["runtime_check"]]
         singles = [(r, k) for r, k in rs if k["kind"] == "single"]
         nones = [(r, k) for r, k in rs if k["kind"] == "none"]
@@ -81,7 +113,7 @@ def metrics(results: list[dict], key: list[dict]) -> dict:
         right_any = [(r, k) for r, k in singles if k["answers"][0]["name"] in r["named"]]
         amb = [(r, k) for r, k in singles if r["verdict"] == "ambiguous" and not r["named"]]
         fp = [(r, k) for r, k in nones if r["named"]]
-        perr, cover, inlib, inlib_c, perr_alt = [], [], [], [], []
+        perr, cover, inlib, inlib_c, perr_alt, unsure = [], [], [], [], [], []
         for r, k in right_any:
             a = k["answers"][0]
             i = r["named"].index(a["name"])
@@ -91,7 +123,9 @@ def metrics(results: list[dict], key: list[dict]) -> dict:
                     perr.append(abs(p["value"] - tv) / abs(tv))
                     inlib.append(a.get("in_library", True))
                     lo, hi = p["interval_95"]
-                    if lo is not None and hi is not None:
+                    if p.get("status", "identified") != "identified":
+                        unsure.append(a.get("in_library", True))  # at bound / not identified: no interval
+                    elif lo is not None and hi is not None:
                         cover.append(lo <= tv <= hi)
                         inlib_c.append(a.get("in_library", True))
             for pk, tv in a.get("alt_parameters", {}).items():
@@ -112,7 +146,8 @@ def metrics(results: list[dict], key: list[dict]) -> dict:
                     if p["value"] is not None and tv:
                         pair_err.append(abs(p["value"] - tv) / abs(tv))
                         lo, hi = p["interval_95"]
-                        pair_cover.append(lo is not None and hi is not None and lo <= tv <= hi)
+                        if p.get("status", "identified") == "identified":
+                            pair_cover.append(lo is not None and hi is not None and lo <= tv <= hi)
         pair_both = [(r, k) for r, k in pairs if all(a["name"] in r["named"] for a in k["answers"])]
         pair_one = [(r, k) for r, k in pairs if any(a["name"] in r["named"] for a in k["answers"])]
         per_name = {}
@@ -137,6 +172,8 @@ def metrics(results: list[dict], key: list[dict]) -> dict:
             "param_within_20pct_in_library": _frac(int((perr_a[inlib_a] <= 0.2).sum()), int(inlib_a.sum())),
             "param_within_20pct_out_of_library": _frac(int((perr_a[~inlib_a] <= 0.2).sum()), int((~inlib_a).sum())),
             "n_param_in_library": int(inlib_a.sum()), "n_param_out_of_library": int((~inlib_a).sum()),
+            "n_interval_in_library": int(inlib_ca.sum()),
+            "n_at_bound_or_unidentified_in_library": int(sum(unsure)),
             "friction_alt_truth_within_20pct": _frac(sum(e <= 0.2 for e in perr_alt), len(perr_alt)),
             "gap_closed_median": float(np.median(closed)) if closed else None,
             "gap_closed_at_least_80pct": _frac(sum(c >= 0.8 for c in closed), len(closed)),
@@ -172,30 +209,109 @@ def _p(v) -> str:
     return "-" if v is None else f"{100 * v:.0f} %"
 
 
-def _issue13_section(m: dict, per: list[dict], ans: dict) -> list[str]:
-    """The cases added for issue 13 (in-loop and command delays, load pressure + 400 N Coulomb, Bouc-Wen
-    specimens, other rigs in displacement and force control): their own recall, false positives, gap closed."""
-    L = ["", "## The cases added for issue 13", "",
-         "In-loop (true transport) and command delays, load pressure with 400 N of Coulomb friction, Bouc-Wen "
-         "specimens, and two rigs other than the paper's (rigB: 2.5 t, 250 kN/m, 50 cm^2, 40 Hz valve; rigC: "
-         "80 kg, 20 kN/m, 10 cm^2, 120 Hz valve) in displacement and force control "
-         "(`plan_new` in evaluation/diagnose_eval/generate.py).", "",
+#: the sections of the cases added for an issue: (subset label, heading, what they are)
+CASE_SETS = {
+    "issue13": ("The cases added for issue 13",
+                "In-loop (true transport) and command delays, load pressure with 400 N of Coulomb friction, Bouc-Wen "
+                "specimens, and two rigs other than the paper's (rigB: 2.5 t, 250 kN/m, 50 cm^2, 40 Hz valve; rigC: "
+                "80 kg, 20 kN/m, 10 cm^2, 120 Hz valve) in displacement and force control "
+                "(`plan_new` in evaluation/diagnose_eval/generate.py)."),
+    "issue25": ("The cases added for issue 25 (the kinds of the two blind misses)",
+                "A piston mass that is a large share of a small rig's moving mass (rigD: 150 kg, 50 kN/m, 6 cm^2, "
+                "50 Hz valve; m_p 30, 60 and 120 kg in displacement control, 60 kg in force control; rigC, 40 kg), "
+                "and the load-pressure term with a second effect (Coulomb friction 250-600 N, viscous damping "
+                "4 kN s/m) on records of large forces (the standard command enlarged 1.3-1.7 times: forces to "
+                "65-95 kN on the paper's rig, load pressures to 0.8-1.2 of the supply) at 55 and 40 dB, on the "
+                "paper's rig and rigB; no-effect records of rigD (`plan_issue25` in "
+                "evaluation/diagnose_eval/generate.py)."),
+}
+
+
+def _case_section(m: dict, label: str) -> list[str]:
+    """The cases added for an issue: their own recall, false positives, gap closed, pairs."""
+    head, what = CASE_SETS[label]
+    L = ["", f"## {head}", "", what, "",
          "| subset | single: right first | right anywhere | false positives | param within 20 % | gap closed "
          "(median) | pairs: both named |", "|---|---|---|---|---|---|---|"]
-    for lab in ("issue13 snr>=30", "issue13"):
+    for lab in (f"{label} snr>=30", label):
         s = m[lab]
-        L.append(f"| {lab.replace('issue13', 'issue-13 cases').replace('cases snr', 'cases, SNR')} "
+        L.append(f"| {lab.replace(label, 'these cases').replace('cases snr', 'cases, SNR')} "
                  f"({s['n_single']} single, {s['n_none']} none, {s['n_pair']} pairs) | {_p(s['single_right_first'])} | "
                  f"{_p(s['single_right_any'])} | {_p(s['false_positive_rate'])} | {_p(s['param_within_20pct'])} | "
                  f"{_p(s['gap_closed_median'])} | {_p(s['pair_both_named'])} |")
     L += ["", "| name | recall | precision | records with it | times named |", "|---|---|---|---|---|"]
-    for n, v in m["issue13"]["per_name"].items():
+    for n, v in m[label]["per_name"].items():
         if v["n_truth"] or v["n_named"]:
             L.append(f"| {n} | {_p(v['recall'])} | {_p(v['precision'])} | {v['n_truth']} | {v['n_named']} |")
     return L
 
 
-def write_doc(m: dict, per: list[dict], key: list[dict], doc: Path, cmd: str, wall: float, jobs: int) -> None:
+def _coverage_section(results: list[dict], key: list[dict]) -> list[str]:
+    """The coverage figure's parameters, one by one: the misses and those without an interval."""
+    rows = coverage_rows(results, key)
+    judged = [r for r in rows if r["covers"] is not None]
+    L = ["", "## Coverage of the 95 % intervals, parameter by parameter", "",
+         "Coverage (the figure above): of the in-library parameters of correctly named single effects at SNR >= "
+         "30 dB, the share whose 95 % interval contains the truth; a parameter reported \"at bound / not "
+         f"identified\" has no interval and is counted apart.  {sum(r['covers'] for r in judged)} of "
+         f"{len(judged)} intervals cover; {len(rows) - len(judged)} parameters without an interval.", "",
+         "| record | form | rig | SNR | parameter | truth | fitted | 95 % interval | status |",
+         "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        if r["covers"] is not False and r["status"] == "identified":
+            continue
+        lo, hi = r["interval"]
+        iv = f"[{lo:.5g}, {hi:.5g}]" if lo is not None and hi is not None else "-"
+        val = "-" if r["value"] is None else f"{r['value']:.5g}"
+        L.append(f"| {r['id']} | {r['form']} | {r['rig']} | {r['snr']} | {r['key']} | {r['truth']:.5g} | {val} | "
+                 f"{iv} | {r['status'] if r['covers'] is None else 'misses'} |")
+    return L
+
+
+#: the headline figures of the before/after table: (label, subset, metric key)
+HEADLINE = (("single effects: right name first", "snr>=30", "single_right_first"),
+            ("single effects: right name first (all SNR)", "all", "single_right_first"),
+            ("no-effect records: false names", "all", "false_positive_rate"),
+            ("pairs: both named (all SNR)", "all", "pair_both_named"),
+            ("95 % coverage, in-library (SNR >= 30)", "snr>=30", "interval_coverage_in_library"),
+            ("95 % coverage, out-of-library (SNR >= 30)", "snr>=30", "interval_coverage_out_of_library"),
+            ("issue-25 cases: singles right first", "issue25", "single_right_first"),
+            ("issue-25 cases: pairs both named", "issue25", "pair_both_named"),
+            ("issue-25 cases: false names", "issue25", "false_positive_rate"))
+
+
+def _before_after_section(m: dict, per: list[dict], before: dict, key: list[dict]) -> list[str]:
+    """The same records diagnosed before this issue's changes (``before``: that run's JSON) and now."""
+    mb = metrics(before["records"], key)
+    L = ["", "## Before and after (issue 25)", "",
+         f"Before: the same records, diagnosed by the code before issue 25 "
+         f"(`{before.get('code', 'the base commit')}`); both columns computed by this script's metrics.", "",
+         "| measure | before | after |", "|---|---|---|"]
+    for label, sub, k in HEADLINE:
+        L.append(f"| {label} | {_p(mb[sub][k])} | {_p(m[sub][k])} |")
+    cb = [r for r in coverage_rows(before["records"], key) if r["covers"] is not None]
+    ca = [r for r in coverage_rows(per, key) if r["covers"] is not None]
+    L.append(f"| coverage counts (SNR >= 30, in-library) | {sum(r['covers'] for r in cb)} of {len(cb)} | "
+             f"{sum(r['covers'] for r in ca)} of {len(ca)} |")
+    ans = {k["id"]: k for k in key}
+    old = {r["id"]: r for r in before["records"]}
+    L += ["", "Records whose names changed:", "", "| record | hidden | before | after |", "|---|---|---|---|"]
+    for r in per:
+        b = old.get(r["id"])
+        if b is None or (b["named"] == r["named"] and b["verdict"] == r["verdict"]):
+            continue
+        k = ans[r["id"]]
+
+        def said(x):
+            return ", ".join(x["named"]) or ("/".join(x["ambiguous"]) + " (ambiguous)" if x["ambiguous"] else
+                                             x["verdict"])
+        L.append(f"| {r['id']} ({k.get('rig', 'paper')} {k['mode']}, {k['snr']} dB) | "
+                 f"{'; '.join(f.split(':')[0] for f in k['forms']) or 'none'} | {said(b)} | {said(r)} |")
+    return L
+
+
+def write_doc(m: dict, per: list[dict], key: list[dict], doc: Path, cmd: str, wall: float, jobs: int,
+              before: dict | None = None) -> None:
     ans = {k["id"]: k for k in key}
     L = ["# Diagnose: evaluation on hidden effects", "",
          "Made by (every number below):", "", "```", cmd, "```", "",
@@ -269,13 +385,17 @@ def write_doc(m: dict, per: list[dict], key: list[dict], doc: Path, cmd: str, wa
           "entry), except the table bending from 2 % opening, whose 15 kN sweep opens the spool to about 0.07 "
           "only: its truth is g_peak = g(x_peak) at the record's peak opening (g(1) is outside the record; "
           "shown as the second truth); filter delay -> the Bessel filter's DC group delay."]
-    if m["issue13"]["n_single"] + m["issue13"]["n_none"] + m["issue13"]["n_pair"]:
-        L += _issue13_section(m, per, ans)
+    for label in CASE_SETS:
+        if m[label]["n_single"] + m[label]["n_none"] + m[label]["n_pair"]:
+            L += _case_section(m, label)
+    L += _coverage_section(per, key)
+    if before is not None:
+        L += _before_after_section(m, per, before, key)
     L += ["", "## By noise level", "",
           "| SNR | single: right first | right anywhere | ambiguous | false positives | param within 20 % | "
           "coverage | gap closed (median) | pairs: both named | pairs: one named |",
           "|---|---|---|---|---|---|---|---|---|---|"]
-    for lab in ("snr=40", "snr=30", "snr=20", "all"):
+    for lab in ("snr=55", "snr=40", "snr=30", "snr=20", "all"):
         s = m[lab]
         L.append(f"| {lab} | {_p(s['single_right_first'])} | {_p(s['single_right_any'])} | "
                  f"{_p(s['single_ambiguous'])} | {_p(s['false_positive_rate'])} | {_p(s['param_within_20pct'])} | "
@@ -322,6 +442,9 @@ def main() -> None:
     p.add_argument("--jobs", type=int, default=2)
     p.add_argument("--doc", default="docs/diagnose_eval.md")
     p.add_argument("--from-json", action="store_true", help="re-render the doc from the saved JSON (no diagnoses)")
+    p.add_argument("--before", help="the JSON of the same evaluation before issue 25 (its before/after section)")
+    p.add_argument("--cache", help="a JSON-lines file of the diagnoses done so far: each result is appended as it "
+                                   "comes, and records already in it are not diagnosed again (a long run resumes)")
     a = p.parse_args()
     from servohydraulics.workers import check_workers, process_pool
 
@@ -331,22 +454,33 @@ def main() -> None:
         p.error(str(e))
     data = Path(a.data)
     doc = Path(a.doc)
+    before = json.loads(Path(a.before).read_text()) if a.before else None
     if a.from_json:
         saved = json.loads(doc.with_suffix(".json").read_text())
         key = json.loads((data / "answer_key.json").read_text())
         write_doc(metrics(saved["records"], key), saved["records"], key, doc, saved["command"], saved["wall_s"],
-                  a.jobs)
+                  a.jobs, before)
         return
     manifest = json.loads((data / "manifest.json").read_text())
-    jobs = [(m["id"], str(data / m["record"]), str(data / m["rig"]), m["mode"]) for m in manifest]
+    done = {}
+    if a.cache and Path(a.cache).exists():
+        for line in Path(a.cache).read_text().splitlines():
+            if line.strip():
+                r = json.loads(line)
+                done[r["id"]] = r
+    jobs = [(m["id"], str(data / m["record"]), str(data / m["rig"]), m["mode"]) for m in manifest
+            if m["id"] not in done]
     t0 = time.time()
-    results = []
     from tqdm import tqdm
 
     with process_pool(a.jobs, "--jobs") as ex:  # workers that die with this process
         for r in tqdm(ex.map(run_one, jobs), total=len(jobs), file=sys.stderr, desc="diagnose"):
-            results.append(r)
-    wall = time.time() - t0
+            done[r["id"]] = r
+            if a.cache:
+                with open(a.cache, "a") as f:
+                    f.write(json.dumps(r, default=str) + "\n")
+    results = [done[m["id"]] for m in manifest]
+    wall = time.time() - t0 + sum(r["runtime"] for r in done.values() if r["id"] not in {j[0] for j in jobs})
     key = json.loads((data / "answer_key.json").read_text())  # read only now, after every diagnosis
     m = metrics(results, key)
     gen = data / "generate.json"
@@ -354,7 +488,7 @@ def main() -> None:
                else f"python evaluation/diagnose_eval/generate.py --out {a.data}")
     cmd = (f"{gen_cmd} --jobs {a.jobs}\n"
            f"python evaluation/diagnose_eval/evaluate.py --data {a.data} --jobs {a.jobs}")
-    write_doc(m, results, key, doc, cmd, wall, a.jobs)
+    write_doc(m, results, key, doc, cmd, wall, a.jobs, before)
     doc.with_suffix(".json").write_text(json.dumps({"metrics": m, "records": results, "command": cmd,
                                                     "wall_s": wall}, indent=1, default=str))
     print(f"wrote {doc} ({wall:.0f} s)")

@@ -103,6 +103,10 @@ RIGS = {
     # a light, soft, fast rig (a damper frame): 80 kg, 20 kN/m, 10 cm^2 piston, 120 Hz valve
     "rigC": ({"m": 80.0, "c": 50.0, "k": 20e3, "k_2": 10e3, "m_p": 5.0, "A": 10e-4, "K_a": 0.2e-12, "C_l": 1e-11,
               "K_v": 2.5e-3, "f_v": 120.0, "zeta_v": 0.8, "G_p": 1.2, "C_F_force": 0.6e-3}, 0.4, 0.01),
+    # a small rig (issue 25, the blind piston-mass miss): 150 kg structure, 6 cm^2 piston, 50 Hz valve; a piston
+    # of tens of kg is then a large share of the moving mass
+    "rigD": ({"m": 150.0, "c": 200.0, "k": 50e3, "k_2": 25e3, "m_p": 5.0, "A": 6e-4, "K_a": 0.1e-12, "C_l": 1e-11,
+              "K_v": 1.5e-3, "f_v": 50.0, "zeta_v": 0.8, "G_p": 1.2, "C_F_force": 0.6e-3}, 0.4, 0.02),
 }
 
 
@@ -221,6 +225,42 @@ def plan_new(snrs) -> list[dict]:
     return out
 
 
+def plan_issue25(snrs_pairs=(55, 40), snrs_singles=(40, 30)) -> list[dict]:
+    """The cases added for issue 25, of the kinds of the two blind misses at other magnitudes, rigs and seeds:
+    a piston mass that is a large share of a small rig's moving mass (the load cell sees its inertia, F = p A -
+    m_p a), and the load-pressure term with a second effect on records of large forces and low noise (the
+    second effect ten or more times the force noise, named after the first).  ``cmd_scale`` enlarges the
+    standard command (1.45: forces to about 67 kN on the paper's rig)."""
+    singles = [
+        # (key, mode, strength, rig)
+        ("piston", "displacement", 60.0, "rigD"),
+        ("piston", "displacement", 30.0, "rigD"),
+        ("piston", "displacement", 120.0, "rigD"),
+        ("piston", "force", 60.0, "rigD"),
+        ("piston", "displacement", 40.0, "rigC"),
+    ]
+    pairs = [
+        # (effects, rig, cmd_scale)
+        ((("load_pressure", 10e6), ("coulomb", 400.0)), "paper", 1.45),
+        ((("load_pressure", 12e6), ("coulomb", 250.0)), "paper", 1.7),
+        ((("load_pressure", 8e6), ("coulomb", 600.0)), "paper", 1.3),
+        ((("load_pressure", 10e6), ("viscous", 4000.0)), "paper", 1.45),
+        ((("load_pressure", 8e6), ("coulomb", 300.0)), "rigB", 1.5),
+    ]
+    out = []
+    for snr in snrs_singles:
+        for key, mode, v, rig in singles:
+            out.append({"kind": "single", "effects": [(key, v)], "mode": mode, "cmd": "std", "snr": snr, "rig": rig,
+                        "set": "issue25"})
+        out.append({"kind": "none", "effects": [], "mode": "displacement", "cmd": "std", "snr": snr, "rig": "rigD",
+                    "set": "issue25"})
+    for snr in snrs_pairs:
+        for effects, rig, scale in pairs:
+            out.append({"kind": "pair", "effects": list(effects), "mode": "displacement", "cmd": "std", "snr": snr,
+                        "rig": rig, "cmd_scale": scale, "set": "issue25"})
+    return out
+
+
 def plan(size: str, cases: str = "all") -> list[dict]:
     """The records: single effects at graded strengths, no effect, two effects."""
     singles = [
@@ -257,6 +297,8 @@ def plan(size: str, cases: str = "all") -> list[dict]:
         pairs = pairs[:1]
     if cases == "new":
         return plan_new(snrs)
+    if cases == "issue25":
+        return plan_issue25()
     out = []
     for snr in snrs:
         for key, mode, strengths in singles:
@@ -268,7 +310,7 @@ def plan(size: str, cases: str = "all") -> list[dict]:
             out.append({"kind": "none", "effects": [], "mode": mode, "cmd": cmd, "snr": snr})
         for a, b in pairs:
             out.append({"kind": "pair", "effects": [a, b], "mode": "displacement", "cmd": "std", "snr": snr})
-    return out + (plan_new(snrs) if cases == "all" else [])
+    return out + (plan_new(snrs) + plan_issue25() if cases == "all" else [])
 
 
 IN_LIBRARY = {"coulomb", "viscous", "spring", "load_pressure", "flow", "delay", "valve", "leakage", "piston",
@@ -285,7 +327,7 @@ def make_record(args: tuple) -> tuple[dict, dict, dict]:
     rig = it.get("rig", "paper")
     dur = it.get("duration", duration)
     u, x0 = command(mode, it["cmd"], dur, rng)
-    u = u * RIGS[rig][1 if mode == "displacement" else 2] if mode != "free" else u
+    u = u * RIGS[rig][1 if mode == "displacement" else 2] * it.get("cmd_scale", 1.0) if mode != "free" else u
     tr = base_truth(mode, rig)
     peak = float(np.max(np.abs(ip.simulate(tr, mode, u, DT, x0, substeps=2)["spool"]))) \
         if any(k == "spool" for k, _ in it["effects"]) else 0.0
@@ -368,8 +410,8 @@ def main() -> None:
     p.add_argument("--seed", type=int, default=2003)
     p.add_argument("--duration", type=float, default=4.0, help="record length [s]")
     p.add_argument("--jobs", type=int, default=2, help="worker processes")
-    p.add_argument("--cases", choices=["all", "new", "old"], default="all",
-                   help="all cases, only those added for issue 13, or only the earlier ones")
+    p.add_argument("--cases", choices=["all", "new", "old", "issue25"], default="all",
+                   help="all cases, only those added for issue 13 (new) or 25, or only the earlier ones")
     a = p.parse_args()
     try:
         generate(Path(a.out), a.size, a.seed, a.duration, a.jobs, a.cases)

@@ -18,7 +18,7 @@ import pytest
 
 import servohydraulics as sh
 from servohydraulics.cli import main
-from servohydraulics.diagnosis import LIBRARY, engine
+from servohydraulics.diagnosis import LIBRARY, effects, engine
 from servohydraulics.diagnosis.confirm import fit_space
 from servohydraulics.diagnosis.effects import Context
 from servohydraulics.records import Record
@@ -94,7 +94,7 @@ def _spaces(ctx: Context, interacting: bool):
     for name, cand in LIBRARY.items():
         if "displacement" not in cand.modes or cand.exercised(ctx):
             continue
-        yield name, engine.Space(cand, ctx, cand.interacts if interacting else ())
+        yield name, engine.Space(cand, ctx, effects.interacting(cand, ctx.rig, ctx.mode) if interacting else ())
 
 
 def test_absent_value_of_every_candidate_reproduces_the_current_model() -> None:
@@ -115,6 +115,10 @@ def test_absent_value_of_every_candidate_reproduces_the_current_model() -> None:
         checked.append(name)
     assert {"command_delay", "loop_delay", "bouc_wen_hysteresis", "coulomb_friction", "servovalve_dynamics"} \
         <= set(checked), checked
+    # the model's load-pressure term is re-fitted with the force candidates (over its whole range): "absent"
+    # holds it at its value
+    space = dict(_spaces(ctx, interacting=True))["coulomb_friction"]
+    assert [k for k, _ in space.interacting] == ["c", "p_s"] and space.rec[-1]
 
 
 @pytest.mark.slow  # minutes: excluded from scripts/run.sh test, run by scripts/run.sh test-all

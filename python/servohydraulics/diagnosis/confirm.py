@@ -11,26 +11,55 @@ import math
 import numpy as np
 
 from ..identification.fit import best
+from ..identification.stats import LEVEL, bound_status, inseparable_groups, quantile
 from . import engine
-from .effects import Context
+from .effects import LOAD_TERMS, Context
 from .types import Case, Fit, Refit
 
 
 def param_report(space, z: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> dict:
-    """The fitted parameters as diagnosis.json writes them: per key its value,
-    unit, 95 % interval, value meaning "absent" (external units) and rig key."""
+    """The fitted parameters as diagnosis.json writes them: per key its value, unit, 95 % interval,
+    value meaning "absent" (external units), rig key, ``status`` (``stats.bound_status``:
+    "identified", "at bound" for a parameter that ended at a limit of its plausible range, its
+    interval then that whole range, or "not identified", its interval null) and ``relative_sd``
+    (the standard error over the value, in the fitting coordinates).  An identified parameter's
+    interval is cut to the plausible range (a friction level's interval does not go below 0)."""
+    z = np.asarray(z, float)
+    n = space.lo.size
+    z, lo, hi = z[:n], np.asarray(lo, float)[:n], np.asarray(hi, float)[:n]
+    status = bound_status(z, space.lo, space.hi, np.isfinite(lo) & np.isfinite(hi))
+    q = quantile(LEVEL)
     ext = space.to_external(z)
-    elo, ehi = space.to_external(lo), space.to_external(hi)
     absent = space.to_external(space.absent)
     out = {}
     keys = [(p.key, p.unit, p.rig_key) for p in space.params] + \
-           [(k, u, "re-fitted nominal parameter") for k, u in space.interacting]
+           [(k, u, LOAD_TERMS[k].rig_key if k in LOAD_TERMS else "re-fitted nominal parameter")
+            for k, u in space.interacting]
     for i, (key, unit, where) in enumerate(keys):
-        a, b = (ehi[i], elo[i]) if space.rec[i] else (elo[i], ehi[i])
+        if status[i] == "at bound":
+            zl, zh = space.lo[i], space.hi[i]
+        else:
+            zl, zh = max(lo[i], space.lo[i]), min(hi[i], space.hi[i])
+        a, b = space.coords.values_at(i, float(zl)), space.coords.values_at(i, float(zh))
         a, b = min(a, b), max(a, b)
+        sd = (hi[i] - lo[i]) / (2 * q) if np.isfinite(hi[i] - lo[i]) else math.inf
         out[key] = {"value": _num(ext[i]), "unit": unit, "interval_95": [_num(a), _num(b)],
-                    "absent": _num(absent[i]), "rig_key": where}
+                    "absent": _num(absent[i]), "rig_key": where, "status": status[i],
+                    "relative_sd": _num(sd / abs(z[i])) if z[i] != 0 else None}
+        if status[i] == "not identified":
+            out[key]["interval_95"] = [None, None]
+        if key in LOAD_TERMS and not math.isfinite(ext[i]):
+            out[key]["note"] = "infinite: the term is switched off"
     return out
+
+
+def param_groups(space, corr: np.ndarray | None) -> list[list[str]]:
+    """The groups of the space's parameters that the records cannot tell apart
+    (``stats.inseparable_groups``), by key."""
+    if corr is None:
+        return []
+    keys = [p.key for p in space.params] + [k for k, _ in space.interacting]
+    return [[keys[i] for i in g] for g in inseparable_groups(corr)]
 
 
 def _num(v: float) -> float | None:
@@ -101,13 +130,13 @@ def fit_space(space, z0: np.ndarray, cases: list[Case], x0s, stats: dict, base_t
         res = dataclasses.replace(res, z=z, x0=x0)
     dbic = engine.bic(stats, 0, neff) - engine.bic(st_c, z.size, neff)
     lengths = engine.series_lengths(cases)
-    lo, hi = engine.intervals(space, res, lengths)
+    lo, hi, corr = engine.uncertainty(space, res, lengths)
     nm = space.n_main
     tested = np.concatenate([space.tests_absent[:nm], np.zeros(z.size - nm, bool)])
     joint, pval = engine.joint_excludes_absent(space, res, lengths, tested)
     if worse:
         joint, pval, lo, hi = False, 1.0, np.minimum(lo, z), np.maximum(hi, z)
-    return Fit(space=space, z=z, z_tr=z_tr, lo=lo, hi=hi, rig=rig_c, tau=tau_c, x0=x0, joint_excludes=joint,
+    return Fit(space=space, z=z, z_tr=z_tr, lo=lo, hi=hi, corr=corr, rig=rig_c, tau=tau_c, x0=x0, joint_excludes=joint,
                joint_p=pval, sims=sims_c, stats=st_c, neff=neff, dbic=dbic, held=held, held_lr=held_lr,
                ended_at_absent=bool(worse))
 

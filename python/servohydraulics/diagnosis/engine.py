@@ -10,7 +10,6 @@ statistics (``stats``: AR(1) effective samples and the one HAC covariance rule).
 
 from __future__ import annotations
 
-import copy
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -26,7 +25,7 @@ from ..identification.stats import LEVEL, ar1_coefficient, ar1_effective_n, quan
 from ..identification.stats import covariance as hac_covariance
 from ..rig import Rig
 from ..simulate import MODES, SimulationError, solver_options
-from .effects import INTERACT_SPAN, Candidate, Context, split_delay
+from .effects import INTERACT_SPAN, LOAD_TERMS, Candidate, Context, nominal_value, set_nominal, split_delay
 from .types import Case, FitResult, Screening, Sim
 
 #: Plant channels the diagnosis does not compare: the abscissa, the valve drive (a function of the
@@ -227,22 +226,32 @@ class Space:
         self.params = tuple(c.params[i] for i in self.main_idx)
         self.full_absent = np.asarray(c.absent(self.ctx), float)  #: every own parameter, external units
         self.n_main = len(self.params)
-        rec = [p.reciprocal for p in self.params] + [False] * len(self.interacting)
+        # interacting nominal parameters: +-INTERACT_SPAN about the current value, except the load-dependent
+        # loop terms (effects.LOAD_TERMS), which range over their whole span ("off" included)
+        terms = [LOAD_TERMS.get(k) for k, _ in self.interacting]
+        rec = [p.reciprocal for p in self.params] + [t is not None and t.reciprocal for t in terms]
         self.rec = np.array(rec, bool)
         self.coords = Coordinates.absolute([p.key for p in self.params] + [k for k, _ in self.interacting], self.rec)
         lo, hi = c.bounds(self.ctx)
         lo, hi = np.asarray(lo, float)[self.main_idx], np.asarray(hi, float)[self.main_idx]
-        cur = np.array([getattr(self.ctx.rig, k) for k, _ in self.interacting], float)
-        ext_lo = np.concatenate([lo, cur * (1 - INTERACT_SPAN)])
-        ext_hi = np.concatenate([hi, cur * (1 + INTERACT_SPAN)])
+        cur = np.array([nominal_value(self.ctx.rig, k) for k, _ in self.interacting], float)
+        span = [t.bounds(self.ctx) if t is not None else (v * (1 - INTERACT_SPAN), v * (1 + INTERACT_SPAN))
+                for t, v in zip(terms, cur)]
+        ext_lo = np.concatenate([lo, [a for a, _ in span]])
+        ext_hi = np.concatenate([hi, [b for _, b in span]])
         self.lo = np.where(self.rec, np.where(ext_hi >= 1e9, 0.0, 1.0 / ext_hi), ext_lo)
         self.hi = np.where(self.rec, 1.0 / np.maximum(ext_lo, 1e-300), ext_hi)
         self.absent = self.to_internal(np.concatenate([self.full_absent[self.main_idx], cur]))
         probe = self.to_internal(np.concatenate([np.asarray(c.probe(self.ctx), float)[self.main_idx], cur]))
         self.probe = np.clip(probe, self.lo, self.hi)
+        # the scale of each parameter (the least-squares x_scale and the covariance's column scaling): the probe's
+        # step from "absent"; where the probe does not move a parameter (a Bouc-Wen yield displacement while its
+        # yield force is "absent"), a tenth of its value (a scale of 1e-12 made its Jacobian column vanish in the
+        # covariance: its interval came out infinite or zero-wide, 6 of the 10 misses of the evaluation's coverage)
         step = np.abs(self.probe - self.absent)
-        self.scale = np.where(np.arange(step.size) < self.n_main, np.maximum(step, 1e-12),
-                              np.maximum(np.abs(cur) * 0.1, 1e-30) if cur.size else 1.0)
+        tenth = 0.1 * np.maximum(np.abs(self.absent), np.abs(self.probe))
+        self.scale = np.where(np.arange(step.size) < self.n_main, np.maximum(np.where(step > 0, step, tenth), 1e-12),
+                              np.maximum(np.abs(self.absent) * 0.1, 1e-30))
         #: own parameters whose interval is tested against "absent"
         self.tests_absent = np.array([p.tests_absent for p in self.params] + [False] * len(self.interacting), bool)
 
@@ -265,10 +274,8 @@ class Space:
         rig, tau = self.cand.apply(self.ctx.rig, main), base_tau
         if self.cand.delays_command:
             tau += split_delay(main[0])[1]
-        if self.interacting:
-            rig = copy.copy(rig) if rig is self.ctx.rig else rig
-            for (key, _), v in zip(self.interacting, ext[self.n_main:]):
-                setattr(rig, key, float(v))
+        for (key, _), v in zip(self.interacting, ext[self.n_main:]):
+            rig = set_nominal(rig, key, v)
         return rig, tau
 
 
@@ -352,10 +359,8 @@ class JointSpace:
             rig = sp.cand.apply(rig, main)
             if sp.cand.delays_command:
                 tau += split_delay(main[0])[1]
-        if self.interacting:
-            rig = copy.copy(rig) if rig is self.base else rig
-            for (key, _), v in zip(self.interacting, ext[self.n_main:]):
-                setattr(rig, key, float(v))
+        for (key, _), v in zip(self.interacting, ext[self.n_main:]):
+            rig = set_nominal(rig, key, v)
         return rig, tau
 
 
@@ -471,12 +476,21 @@ def covariance(space: Space, res: FitResult, lengths: list[int]) -> np.ndarray:
     return hac_covariance(res.jac, res.fun, scale, lengths).block(space.scale.size).matrix
 
 
-def intervals(space: Space, res: FitResult, lengths: list[int]) -> tuple[np.ndarray, np.ndarray]:
-    """95 % intervals (fitting coordinates) from the HAC sandwich ``covariance``."""
-    sd = np.sqrt(np.maximum(np.diag(covariance(space, res, lengths)), 0.0))
+def uncertainty(space: Space, res: FitResult, lengths: list[int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """95 % intervals (fitting coordinates) from the HAC sandwich ``covariance`` and the
+    parameters' correlation matrix (NaN where a variance is infinite or zero)."""
+    scale = np.concatenate([space.scale, res.nuisance_scale])[: res.jac.shape[1]]
+    cov = hac_covariance(res.jac, res.fun, scale, lengths).block(space.scale.size)
+    sd = np.sqrt(np.maximum(np.diag(cov.matrix), 0.0))
     z = res.z[: sd.size]
     q = quantile(LEVEL)
-    return z - q * sd, z + q * sd
+    return z - q * sd, z + q * sd, cov.correlation
+
+
+def intervals(space: Space, res: FitResult, lengths: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """95 % intervals (fitting coordinates) from the HAC sandwich ``covariance``."""
+    lo, hi, _ = uncertainty(space, res, lengths)
+    return lo, hi
 
 
 def joint_excludes_absent(space: Space, res: FitResult, lengths: list[int], tested: np.ndarray) -> tuple[bool, float]:

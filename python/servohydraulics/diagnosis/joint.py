@@ -22,14 +22,15 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..identification.stats import inseparable_groups
 from ..rig import Rig
 from . import engine
 from .confirm import param_report
-from .effects import split_delay
+from .effects import nominal_value, split_delay
 from .types import Accepted, Case, FitResult, JointRefit
 
 JOINT_MAX_NFEV = 30  #: most least-squares iterations of the joint re-fit
@@ -46,6 +47,7 @@ class JointModel:
     sims: list
     accepted: dict  #: name -> the re-fitted ``Accepted``
     parameters: dict  #: name -> its parameters as diagnosis.json writes them
+    groups: list = field(default_factory=list)  #: parameters ("effect: key") the records cannot tell apart
 
 
 def _partition(accepted: list[Accepted]) -> tuple[list[Accepted], list[str], list[str]]:
@@ -62,8 +64,11 @@ def _start(accepted: list[Accepted], js: engine.JointSpace, current: Rig, tau: f
     """The greedy values (a nominal parameter, or an effect's own parameter, that
     a later interacting re-fit moved starts from the model's value) and the base
     delay the effects' fitted delays add to."""
-    z0 = np.concatenate([a.z[: a.space.n_main] for a in accepted]
-                        + [np.array([float(getattr(current, kk)) for kk, _ in js.interacting])])
+    inter = np.array([nominal_value(current, kk) for kk, _ in js.interacting], float)
+    rec = js.rec[js.n_main:]
+    with np.errstate(divide="ignore"):
+        inter = np.where(rec, np.where(np.isinf(inter), 0.0, 1.0 / inter), inter)  # fitting coordinates
+    z0 = np.concatenate([a.z[: a.space.n_main] for a in accepted] + [inter])
     inter = [{kk for kk, _ in a.space.interacting} for a in accepted]
     for i, (a, blk) in enumerate(zip(accepted, js.blocks)):
         moved = set().union(*inter[i + 1:])
@@ -80,23 +85,36 @@ def _refitted(accepted: list[Accepted], js: engine.JointSpace, res: FitResult,
     parameters too where the joint fit has them) and whether its tested
     parameters exclude "absent" jointly."""
     z = res.z
-    lo, hi = engine.intervals(js, res, lengths)
+    lo, hi, corr = engine.uncertainty(js, res, lengths)
     out, excl = {}, {}
     for a, blk in zip(accepted, js.blocks):
         sp, nm = a.space, a.space.n_main
         zf, lof, hif = a.z.copy(), a.lo.copy(), a.hi.copy()
         zf[:nm], lof[:nm], hif[:nm] = z[blk], lo[blk], hi[blk]
+        idx = list(range(blk.start, blk.stop))
         for jj, (kk, _) in enumerate(sp.interacting):
-            idx = js.index_of(kk)
-            if idx is not None:
-                zf[nm + jj], lof[nm + jj], hif[nm + jj] = z[idx], lo[idx], hi[idx]
-        out[a.name] = Accepted(a.name, sp, zf, lof, hif)
+            j = js.index_of(kk)
+            idx.append(j if j is not None else -1)
+            if j is not None:
+                zf[nm + jj], lof[nm + jj], hif[nm + jj] = z[j], lo[j], hi[j]
+        sub = np.full((len(idx), len(idx)), np.nan)
+        ok = np.array([i >= 0 for i in idx])
+        ii = np.array([i for i in idx if i >= 0], int)
+        sub[np.ix_(ok, ok)] = corr[np.ix_(ii, ii)]
+        out[a.name] = Accepted(a.name, sp, zf, lof, hif, sub)
         tested = sp.tests_absent[:nm]
         outside = (sp.absent[:nm] < lo[blk]) | (sp.absent[:nm] > hi[blk])
         mask = np.zeros(z.size, bool)
         mask[blk] = tested
         excl[a.name] = bool(np.any(outside & tested)) or engine.joint_excludes_absent(js, res, lengths, mask)[0]
-    return out, excl
+    return out, excl, corr
+
+
+def joint_groups(accepted: list[Accepted], js: engine.JointSpace, corr: np.ndarray) -> list[list[str]]:
+    """Groups of the jointly fitted parameters ("effect: key") that the records cannot tell apart."""
+    names = [f"{a.name}: {prm.key}" for a in accepted for prm in a.space.params] + \
+            [f"re-fitted: {kk}" for kk, _ in js.interacting]
+    return [[names[i] for i in g] for g in inseparable_groups(corr)]
 
 
 def _values(parameters: dict) -> dict:
@@ -134,7 +152,7 @@ def joint_refit(accepted: list[Accepted], parameters: dict, current: Rig, tau: f
         return dataclasses.replace(info, reason="the jointly fitted model's simulation fails: kept the greedy fit",
                                    seconds=time.time() - t0), None
     b0, b1 = engine.bic(stats0, k, neff), engine.bic(engine.channel_stats(sims1, cases), k, neff)
-    refit, excl = _refitted(accepted, js, res, engine.series_lengths(cases))
+    refit, excl, corr = _refitted(accepted, js, res, engine.series_lengths(cases))
     reports = {n: param_report(a.space, a.z, a.lo, a.hi) for n, a in refit.items()}
     keep = b1 <= b0
     info = dataclasses.replace(
@@ -143,4 +161,5 @@ def joint_refit(accepted: list[Accepted], parameters: dict, current: Rig, tau: f
         parameters_joint={n: _values(r) for n, r in reports.items()}, excludes_absent_joint=excl,
         reason=("joint BIC not worse than the greedy one: kept the joint fit" if keep
                 else "joint BIC worse than the greedy one: kept the greedy fit"), seconds=time.time() - t0)
-    return info, (JointModel(rig1, tau1, res.x0, sims1, refit, reports) if keep else None)
+    return info, (JointModel(rig1, tau1, res.x0, sims1, refit, reports, joint_groups(accepted, js, corr))
+                  if keep else None)

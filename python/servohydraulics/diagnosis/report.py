@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import FileSet, WriteError
+from ..identification.stats import STATUS_WORDS
 from ..rig import save_rig
 
 
@@ -138,6 +139,10 @@ def _fmt(v) -> str:
     return str(v)
 
 
+def _status(p: dict) -> str:
+    return STATUS_WORDS.get(p.get("status") or "identified", str(p.get("status")))
+
+
 def _markdown(d, figs: dict) -> str:
     L = ["# Diagnosis", "", f"**Verdict: {d.verdict}.** {d.summary}", "",
          f"Mode: {d.mode}. Records: " + ", ".join(f"`{r}`" for r in d.records) + f". Runtime {d.runtime_s:.1f} s.",
@@ -162,15 +167,30 @@ def _markdown(d, figs: dict) -> str:
         for e in d.effects:
             L.append(f"### {e['name']}: {e['doc']}")
             L.append("")
-            L.append("| parameter | value | unit | 95 % interval | absent | rig key |")
-            L.append("|---|---|---|---|---|---|")
+            L.append("| parameter | value | unit | 95 % interval | status | absent | rig key |")
+            L.append("|---|---|---|---|---|---|---|")
             for k, p in e["parameters"].items():
                 L.append(f"| {k} | {_fmt(p['value'])} | {p['unit']} | [{_fmt(p['interval_95'][0])}, "
-                         f"{_fmt(p['interval_95'][1])}] | {_fmt(p['absent'])} | {p['rig_key']} |")
+                         f"{_fmt(p['interval_95'][1])}] | {_status(p)} | {_fmt(p['absent'])} | {p['rig_key']} |")
             L.append("")
             L.append(f"BIC improvement {e['delta_bic']:.1f}; held-out error down "
                      f"{100 * e['heldout_improvement']:.1f} %." + (f" Note: {e['note']}" if "note" in e else ""))
             L.append("")
+    if d.determined:
+        L += ["## What the records determine (best first)", "",
+              "Every fitted parameter, from the smallest relative standard error to the largest; parameters at a "
+              "limit of their plausible range or not determined by the records last (their interval is that "
+              "range, or none).", "", "| effect | parameter | value | unit | 95 % interval | rel. std. error | "
+              "status |", "|---|---|---|---|---|---|---|"]
+        for r in d.determined:
+            rel = r["relative_sd"]
+            L.append(f"| {r['effect']} | {r['key']} | {_fmt(r['value'])} | {r['unit']} | "
+                     f"[{_fmt(r['interval_95'][0])}, {_fmt(r['interval_95'][1])}] | "
+                     f"{'-' if rel is None else f'{100 * rel:.3g} %'} | {_status(r)} |")
+        L.append("")
+        if d.inseparable:
+            L += ["Groups the records cannot tell apart (|correlation| > 0.95: only a combination of each group is "
+                  "determined): " + "; ".join("{" + ", ".join(g) + "}" for g in d.inseparable) + ".", ""]
     if d.ambiguous_between:
         L += ["## Ambiguous", "", f"{d.ambiguous_between[0]} or {d.ambiguous_between[1]}: "
               f"{d.separating_experiment}.", ""]

@@ -113,6 +113,7 @@ class Fit:
     refit: Refit = field(default_factory=Refit)
     #: the fit ended worse than "absent" and was replaced by it (the invariant of ``confirm.fit_space``)
     ended_at_absent: bool = False
+    corr: np.ndarray | None = None  #: the parameters' correlation matrix (NaN where a variance is infinite or zero)
 
 
 @dataclass(frozen=True, eq=False)
@@ -124,6 +125,7 @@ class Accepted:
     z: np.ndarray
     lo: np.ndarray
     hi: np.ndarray
+    corr: np.ndarray | None = None  #: the parameters' correlation matrix
 
 
 @dataclass(frozen=True)

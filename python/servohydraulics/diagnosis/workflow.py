@@ -18,11 +18,12 @@ from typing import Any
 import numpy as np
 
 from ..identification.records import as_records
+from ..identification.stats import precision_order
 from ..rig import Rig, rig_to_dict
 from ..simulate import MODES
 from . import engine
-from .confirm import confirm, param_report
-from .effects import LIBRARY, Context, check_names, nested, separating_experiment
+from .confirm import confirm, param_groups, param_report
+from .effects import LIBRARY, Context, check_names, interacting, nested, separating_experiment
 from .joint import joint_refit
 from .types import Accepted, CandidateLog, Case, Fit, JointRefit, Round, Screening, Sim
 
@@ -58,6 +59,10 @@ class Diagnosis:
     separating_experiment: str = ""
     #: the joint re-fits of the accepted effects (one per round from the second effect on; the last is the final one)
     joint_refit: list[JointRefit] = field(default_factory=list)
+    #: every fitted parameter of the effects, from the best determined to the worst (``stats.precision_order``)
+    determined: list[dict[str, Any]] = field(default_factory=list)
+    #: groups of parameters ("effect: key") the records cannot tell apart (``stats.inseparable_groups``)
+    inseparable: list[list[str]] = field(default_factory=list)
     command_delay: float = 0.0  #: the model's command delay (rig command_delay + record shift) [s]
     record_shift: float = 0.0  #: the part of it < 0: the record's command shifted (response rows lead it) [s]
     summary: str = ""
@@ -72,6 +77,8 @@ class Diagnosis:
             "mode": self.mode,
             "records": self.records,
             "effects": self.effects,
+            "determined": self.determined,
+            "inseparable": self.inseparable,
             "joint_refit": [j.to_dict() for j in self.joint_refit],
             "gap_before": self.gap_before,
             "gap_after": self.gap_after,
@@ -163,6 +170,8 @@ class _State:
     joint_log: list[JointRefit] = field(default_factory=list)
     history: list[tuple[str, dict]] = field(default_factory=list)
     signatures: dict[str, Any] = field(default_factory=dict)
+    #: groups across effects the last kept joint re-fit could not tell apart (None: no joint re-fit kept)
+    joint_groups: list[list[str]] | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -300,9 +309,7 @@ def _screen_all(setup: _Setup, state: _State, ctx: Context, rnd: int) -> tuple[l
             log[nme] = CandidateLog(nme, rnd, rejection=why)
             continue
         cand = LIBRARY[nme]
-        inter = cand.interacts if setup.refit_interacting else ()
-        inter = tuple((k, u) for k, u in inter if getattr(state.rig, k) > 0
-                      and (k != "F_c" or state.rig.effects.coulomb_friction))
+        inter = interacting(cand, state.rig, setup.mode) if setup.refit_interacting else ()
         space = engine.Space(cand, ctx, inter)
         sc = engine.secant_screen(space, cases, state.x0, r0, state.tau)
         bal = (engine.balance_screen(state.rig, cases, cand.structural_signature)
@@ -446,9 +453,10 @@ def _accept(setup: _Setup, state: _State, outcome: Round) -> None:
     if LIBRARY[name].delays_command:
         eff["note"] = ("command_delay is the rig's [delays] command_delay (rig_updated.toml carries it) for a value "
                        ">= 0")
+    eff["inseparable"] = [[f"{name}: {k}" for k in g] for g in param_groups(fit.space, fit.corr)]
     state.effects.append(eff)
     state.accepted.append(Accepted(name, fit.space, np.asarray(fit.z, float).copy(),
-                                   np.asarray(fit.lo, float).copy(), np.asarray(fit.hi, float).copy()))
+                                   np.asarray(fit.lo, float).copy(), np.asarray(fit.hi, float).copy(), fit.corr))
     if setup.joint_refit and len(state.accepted) >= 2:
         _polish(setup, state, outcome.number)
 
@@ -467,6 +475,7 @@ def _polish(setup: _Setup, state: _State, rnd: int) -> None:
     state.accepted = [new.accepted.get(a.name, a) for a in state.accepted]
     for e in state.effects:
         e["parameters"] = new.parameters.get(e["name"], e["parameters"])
+    state.joint_groups = new.groups
     state.effects[-1]["gap_after"] = engine.gap(state.sims, setup.cases)
     state.history.append(("joint re-fit", state.effects[-1]["gap_after"]))
 
@@ -509,6 +518,16 @@ def _summary(verdict: str, effects: list, last: Round | None, joint_log: list[Jo
     return f"{head}. {summary}"
 
 
+def _determined(effects: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Every parameter of the effects, from the best determined to the worst (``stats.precision_order``:
+    identified ones by relative standard error, then those at a bound, then those not identified)."""
+    rows = [{"effect": e["name"], "key": k, **{f: p.get(f) for f in ("value", "unit", "interval_95", "status",
+                                                                       "relative_sd")}}
+            for e in effects for k, p in e["parameters"].items()]
+    rel = [r["relative_sd"] if r["relative_sd"] is not None else np.inf for r in rows]
+    return [rows[i] for i in precision_order(rel, [r["status"] or "identified" for r in rows])]
+
+
 def _result(setup: _Setup, state: _State, sims0: list, last: Round | None, runtime: float) -> Diagnosis:
     cases = setup.cases
     _alignment_notes(state.effects)
@@ -521,7 +540,10 @@ def _result(setup: _Setup, state: _State, sims0: list, last: Round | None, runti
                   gap_where=gap_where(sims0, cases),
                   ambiguous_between=list(last.ambiguous_between) if ambiguous else [],
                   separating_experiment=last.separating_experiment if ambiguous else "",
-                  joint_refit=state.joint_log, command_delay=state.rig.command_delay + state.tau,
+                  joint_refit=state.joint_log, determined=_determined(state.effects),
+                  inseparable=(state.joint_groups if state.joint_groups is not None
+                               else [g for e in state.effects for g in e.get("inseparable", [])]),
+                  command_delay=state.rig.command_delay + state.tau,
                   record_shift=state.tau,
                   summary=_summary(verdict, state.effects, last, state.joint_log), runtime_s=runtime)
     d.plots = {"cases": cases, "sims_before": sims0, "sims_after": state.sims, "history": state.history,

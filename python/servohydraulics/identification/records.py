@@ -41,18 +41,26 @@ from .fit import (
     StageResult,
     best,
     channel_weights,
+    default_workers,
     fit_frequency,
     fit_options,
     fit_time,
     keep_best,
     not_improved_flags,
     time_costs,
+    time_residual,
 )
 from .generic import generic_rig, specimen_start
 from .run import check_record, controller_ratio, simulate_record
-from .stats import LEVEL, ar1_coefficient, ar1_effective_n, covariance, quantile
-
-MAX_CORRELATION = 0.95  #: |corr| above which two keys are reported as not separable
+from .stats import (
+    LEVEL,
+    ar1_coefficient,
+    ar1_effective_n,
+    bound_status,
+    covariance,
+    inseparable_groups,
+    quantile,
+)
 
 
 @dataclass(eq=False)
@@ -158,21 +166,64 @@ COLLAPSED = 1e-6
 
 
 def key_status(coords: Coordinates, z: np.ndarray, identified: np.ndarray) -> list[str]:
-    """Per key: "at bound" (within 1e-6 of a bound of its coordinates, or a log key below
-    ``COLLAPSED`` times its start), else "not identified" (``stats.covariance``), else "identified"."""
+    """Per key: "at bound" (within 1e-6 of a bound of its coordinates, ``stats.bound_status``, or a
+    log key below ``COLLAPSED`` times its start), else "not identified" (``stats.covariance``), else
+    "identified"."""
     lo, hi = coords.bounds()
-    tol = 1e-6 * np.maximum(1.0, np.abs(z))
-    at = (np.isfinite(lo) & (z - lo <= tol)) | (np.isfinite(hi) & (hi - z <= tol))
-    at |= np.asarray(coords.log) & (z < np.log(COLLAPSED))
-    return ["at bound" if a else ("identified" if ok else "not identified") for a, ok in zip(at, identified)]
+    status = bound_status(z, lo, hi, identified)
+    collapsed = np.asarray(coords.log) & (np.asarray(z) < np.log(COLLAPSED))
+    return ["at bound" if c else s for s, c in zip(status, collapsed)]
 
 
-def uncertainty(stage: StageResult, coords: Coordinates, lengths: list[int]) -> dict[str, Any]:
+#: the chi-square 95 % point with one degree of freedom: a key whose removal (its value set to the
+#: bottom of its range) raises the cost by less than this, in units of its sandwich variance, is
+#: indistinguishable from zero
+CHI2_1_95 = 3.841458820694124
+
+
+def removal_statistics(stage: StageResult, coords: Coordinates, cov, residual) -> dict[int, float]:
+    """For each log key the fit left "identified": the test statistic of "the key is zero", from a
+    simulation with the key removed (at the bottom of its log range) rather than from the Jacobian.
+
+    In log coordinates the Jacobian column J_i is the linearised change of the residual when the key
+    goes from its value to zero, and the sandwich's Wald statistic of "zero" is 1 / sd_i^2.  The
+    statistic here scales that by the simulated change over the linearised one,
+    W_i = (2 dC_i / |J_i|^2) / sd_i^2 (dC_i: the rise of the cost, half the sum of squares): equal
+    to the Wald statistic where the linearisation holds, and small where the key's value no longer
+    does anything (a damper mass collapsed to 3.6e-11 kg, whose Jacobian column is the integrator's
+    noise and whose sandwich interval came out 6e-15 kg wide).  ``residual(z)`` gives the
+    weighted residual of ``stage.fun`` at z."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    lo, _ = coords.bounds()
+    sd = cov.sd
+    cost0 = 0.5 * float(stage.fun @ stage.fun)
+    cols = {int(i): float(stage.jac[:, i] @ stage.jac[:, i])
+            for i in np.flatnonzero(np.asarray(coords.log) & cov.identified)}
+    todo = [i for i, c in cols.items() if c > 0.0 and np.isfinite(sd[i]) and sd[i] > 0.0]
+
+    def removed(i: int) -> float:
+        z = np.array(stage.z, dtype=float)
+        z[i] = lo[i]
+        r = residual(z)
+        return float((2.0 * max(0.5 * float(r @ r) - cost0, 0.0) / cols[i]) / sd[i] ** 2)
+
+    with ThreadPoolExecutor(max_workers=default_workers()) as pool:  # the core releases the GIL
+        return dict(zip(todo, pool.map(removed, todo)))
+
+
+def uncertainty(stage: StageResult, coords: Coordinates, lengths: list[int], residual=None) -> dict[str, Any]:
     """The HAC covariance (``stats.covariance``) of the fit in its coordinates and, per key, its
     status, standard error and 95 % interval in the key's unit; plus the correlation matrix and
-    the AR(1) summary of the residual (lag-1 rho, effective samples)."""
+    the AR(1) summary of the residual (lag-1 rho, effective samples).  With ``residual`` (z -> the
+    weighted residual of the fit), a log key whose removal the records cannot tell from its value
+    (``removal_statistics`` below ``CHI2_1_95``) is "at bound" (collapsed to zero) as well."""
     cov = covariance(stage.jac, stage.fun, None, lengths)
     status = key_status(coords, stage.z, cov.identified)
+    removal = removal_statistics(stage, coords, cov, residual) if residual is not None else {}
+    for i, w in removal.items():
+        if status[i] == "identified" and w < CHI2_1_95:
+            status[i] = "at bound"
     zq, sd_z = quantile(LEVEL), cov.sd
     intervals, std = {}, {}
     for i, k in enumerate(coords.keys):
@@ -184,22 +235,25 @@ def uncertainty(stage: StageResult, coords: Coordinates, lengths: list[int]) -> 
             std[k] = float("inf")
     rho = ar1_coefficient(stage.fun)
     return {"status": dict(zip(coords.keys, status)), "intervals": intervals, "std": std,
-            "correlation": cov.correlation, "rho1": rho, "n_eff": ar1_effective_n(stage.fun.size, rho)}
+            "correlation": cov.correlation, "rho1": rho, "n_eff": ar1_effective_n(stage.fun.size, rho),
+            "removal": {coords.keys[i]: w for i, w in removal.items()}}
 
 
 def separability_flags(keys, values: dict, intervals: dict, corr: np.ndarray, status: dict | None = None) -> list[str]:
-    """Keys the records do not determine or that ended at a bound, pairs with |corr| > 0.95 and
-    keys whose 95 % interval is wider than the value."""
+    """Keys the records do not determine or that ended at a bound, the groups of keys the records
+    cannot tell apart (``stats.inseparable_groups``: linked by |corr| > 0.95) and keys whose 95 %
+    interval is wider than the value."""
     status = status or {}
     flags = [f"{k} is {status[k]}: the records do not determine it (its interval is its whole range)"
              if status[k] == "not identified" else
-             f"{k} is at a bound of its range (or collapsed towards zero) at {values[k]:.4g}: not identified, "
-             "its interval is its whole range" for k in keys if status.get(k, "identified") != "identified"]
-    for i, a in enumerate(keys):
-        for j in range(i + 1, len(keys)):
-            if abs(corr[i, j]) > MAX_CORRELATION:
-                flags.append(f"{a} and {keys[j]} cannot be separated by these records (correlation "
-                             f"{corr[i, j]:+.3f})")
+             f"{k} is at a bound of its range (or collapsed towards zero) at {values[k]:.4g}: at bound / not "
+             "identified, its interval is its whole range" for k in keys if status.get(k, "identified") != "identified"]
+    keys = list(keys)
+    c = np.asarray(corr, dtype=float)
+    for g in inseparable_groups(c):
+        top = max(abs(c[i, j]) for i in g for j in g if i != j)
+        flags.append(f"{' and '.join(keys[i] for i in g)} cannot be separated by these records (a group: "
+                     f"|correlation| up to {top:.3f}; only a combination of them is determined)")
     for k in keys:
         lo, hi = intervals[k]
         if status.get(k, "identified") == "identified" and hi - lo > abs(values[k]):
@@ -323,7 +377,8 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
                                                              options, dt, max_nfev, progress, workers)
     runtime["time"] = time.perf_counter() - t0
     lengths = [r.time.size for r in recs for _ in chans]
-    u = uncertainty(final, coords, lengths)
+    u = uncertainty(final, coords, lengths,
+                    residual=lambda z: time_residual(coords.apply(start, z), recs, mode, chans, options, dt, weights))
     values = {k: float(v) for k, v in zip(keys, coords.values(final.z))}
     s1_vals = coords.values(z1)
     out_rig = coords.apply(start, final.z)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .stats import STATUS_WORDS, inseparable_groups, precision_order
+
 
 def _v(x) -> str:
     return "-" if x is None else f"{x:.5g}"
@@ -18,12 +20,24 @@ def identification_markdown(ident) -> str:
              f"nonlinear simulation); the result is the {ident.kept} (the best by the time-domain cost).  "
              f"Intervals: {int(100 * d['level'])} %, the HAC sandwich at the result (autocorrelated residuals: "
              f"lag-1 rho = {ident.rho1:.3f}, AR(1) effective samples {ident.n_eff:.0f}); a key the records do not "
-             "determine, or at a bound, has its whole range.", "",
-             "| key | unit | start | stage 1 | identified | status | 95 % interval |", "|---|---|---|---|---|---|---|"]
-    for k, p in d["parameters"].items():
+             "determine, or at a bound (or collapsed to zero), has its whole range.  Listed from the best "
+             "determined (smallest relative standard error) to the worst.", "",
+             "| key | unit | start | stage 1 | identified | status | 95 % interval | rel. std. error |",
+             "|---|---|---|---|---|---|---|---|"]
+    params = d["parameters"]
+    keys = list(params)
+    rel = [params[k]["std"] / abs(params[k]["value"]) if params[k]["value"] else np.inf for k in keys]
+    for i in precision_order(rel, [params[k]["status"] for k in keys]):
+        k, p = keys[i], params[keys[i]]
         lo, hi = p["interval"]
+        r = f"{100 * rel[i]:.3g} %" if np.isfinite(rel[i]) else "-"
         lines.append(f"| `{k}` | {p['unit']} | {_v(p['start'])} | {_v(p['stage1'])} | {_v(p['value'])} | "
-                     f"{p['status']} | [{lo:.5g}, {hi:.5g}] |")
+                     f"{STATUS_WORDS.get(p['status'], p['status'])} | [{lo:.5g}, {hi:.5g}] | {r} |")
+    groups = inseparable_groups(ident.correlation)
+    if groups:
+        lines += ["", "Groups the records cannot tell apart (|correlation| > 0.95: only a combination of each "
+                  "group is determined): " + "; ".join("{" + ", ".join(f"`{keys[i]}`" for i in g) + "}"
+                                                      for g in groups) + "."]
     for k, v in d["derived"].items():
         lines.append(f"\nDerived: `{k}` = {v:.5g}")
     lines += ["", "## Correlations", "", "| | " + " | ".join(ident.keys) + " |",
