@@ -108,6 +108,39 @@ def section(js: dict, how: str, record: str, end: float | None, cmd: str, t_iden
     return "\n".join(L)
 
 
+#: the runs of issue 25's table: (label, the rig's record, the diagnosed record); the rigs are the committed
+#: identifications evaluation/utfsm_rigs/identified_from_<record>.toml (``servohydraulics identify REC.csv --mode
+#: displacement --specimen mr_damper``, made by evaluation/utfsm_eval.py)
+RUNS = (("june_0A_to_1A", "chirp20Hz_0A", "chirp20Hz_1A"), ("june_1A_to_0A", "chirp20Hz_1A", "chirp20Hz_0A"),
+        ("may_0A_to_1A", "sweep15Hz_0A", "sweep15Hz_1A"), ("may_1A_to_0A", "sweep15Hz_1A", "sweep15Hz_0A"))
+SUMMARY = "summary"
+
+
+def summary_section(out: Path) -> str:
+    """The table of every run of ``RUNS`` whose JSON is under OUT/<label>/ (between the summary markers)."""
+    START, END = markers(SUMMARY)
+    L = [START, "", "| campaign, direction | record (window) | verdict: effects named | force gap: nominal -> "
+         "diagnosed (closed) | displacement gap: nominal -> diagnosed | run time |", "|---|---|---|---|---|---|"]
+    for label, rig_from, record in RUNS:
+        path = out / label / "utfsm_diagnose.json"
+        if not path.exists():
+            L.append(f"| {label} | `{record}` | (not run) | | | |")
+            continue
+        saved = json.loads(path.read_text())
+        js = saved["diagnosis"]
+        g0, g1, closed = js["gap_before"], js["gap_after"], js["gap_closed"]
+        names = ", ".join(f"`{e['name']}`" for e in js["effects"]) or "-"
+        window = f"first {saved['end']:g} s" if saved["end"] else "all"
+        fc = closed.get("force")
+        L.append(f"| {label.replace('_', ' ')} (rig from `{rig_from}`) | `{record}` ({window}) | {js['verdict']}: "
+                 f"{names} | {100 * g0['force']:.1f} % -> {100 * g1['force']:.1f} % "
+                 f"({'-' if fc is None else f'{100 * fc:.0f} %'}) | {100 * g0['displacement']:.2f} % -> "
+                 f"{100 * g1['displacement']:.2f} % | {js['runtime_s']:.0f} s |")
+    L += ["", "(gap: rms(measured - simulated) / rms(measured), the model driven by the record's command alone; "
+          "closed: the share of the force gap above the noise floor the named effects close)", "", END]
+    return "\n".join(L)
+
+
 def main() -> None:
     import servohydraulics as sh
 
@@ -123,8 +156,21 @@ def main() -> None:
                    help="switch this effect of the nominal rig off first (repeatable), e.g. load_pressure")
     p.add_argument("--label", default="main", help="which section of the doc to write (its markers)")
     p.add_argument("--render", action="store_true", help="only re-write the doc section from OUT/utfsm_diagnose.json")
+    p.add_argument("--run", choices=[r[0] for r in RUNS],
+                   help="one run of issue 25's table: its rig (evaluation/utfsm_rigs/), record and label; OUT is "
+                        "then the folder of the table (OUT/<label>/) and the table is re-written after the run")
+    p.add_argument("--summary", action="store_true", help="only re-write the table of the runs found under OUT")
     a = p.parse_args()
     out = Path(a.out)
+    if a.summary:
+        write_section(Path(a.doc), SUMMARY, summary_section(out))
+        return
+    table = None
+    if a.run:
+        table = out
+        label, rig_from, a.record = next(r for r in RUNS if r[0] == a.run)
+        a.rig = a.rig or f"evaluation/utfsm_rigs/identified_from_{rig_from}.toml"
+        a.label, out = label, out / label
     out.mkdir(parents=True, exist_ok=True)
     if a.render:
         saved = json.loads((out / "utfsm_diagnose.json").read_text())
@@ -149,9 +195,10 @@ def main() -> None:
     for c in js["gap_before"]:
         print(f"  gap {c}: {100 * js['gap_before'][c]:.2f} % -> {100 * js['gap_after'][c]:.2f} % "
               f"(noise floor {100 * js['noise_floor'][c]:.2f} %)")
-    args = " ".join(f"--{k} {v}" for k, v in (("rig", a.rig), ("record", a.record), ("end", a.end),
-                                              ("max-effects", a.max_effects), ("out", a.out), ("label", a.label))
-                    if v)
+    given = [("run", a.run)] if a.run else [("rig", a.rig), ("record", a.record)]
+    given += [("end", a.end), ("max-effects", a.max_effects), ("out", table or a.out)]
+    given += [] if a.run else [("label", a.label)]
+    args = " ".join(f"--{k} {v}" for k, v in given if v)
     args += "".join(f" --effect-off {e}" for e in a.effect_off)
     cmd = f"PYTHONPATH=python python evaluation/utfsm_diagnose.py {args}"
     (out / "utfsm_diagnose.json").write_text(json.dumps({"command": cmd, "nominal": how, "identify_s": t_ident,
@@ -159,6 +206,8 @@ def main() -> None:
                                                         indent=1, default=str))
     if not a.no_doc:
         write_section(Path(a.doc), a.label, section(js, how, a.record, end, cmd, t_ident, a.label))
+        if table is not None:
+            write_section(Path(a.doc), SUMMARY, summary_section(table))
 
 
 def write_section(doc: Path, label: str, text_section: str) -> None:

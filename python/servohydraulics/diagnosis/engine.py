@@ -140,15 +140,26 @@ def simulate_case(rig: Rig, case: Case, tau: float, x0: float) -> Sim:
     return None
 
 
-def residuals(sims: list, cases: list[Case], which: str = "all") -> np.ndarray:
-    """Stacked normalised residuals (measured - simulated) / rms(measured)."""
+def residuals(sims: list, cases: list[Case], which: str = "all", weights: dict | None = None) -> np.ndarray:
+    """Stacked normalised residuals (measured - simulated) / rms(measured), each (record, channel)
+    series times its weight in ``weights`` (default 1)."""
     out = []
     for sim, case in zip(sims, cases):
         mask = {"all": slice(None), "train": case.train, "test": ~case.train}[which]
         for c, y in case.meas.items():
             e = (y - sim[c]) / case.scale[c] if sim is not None else np.full(y.size, 10.0)
-            out.append(e[mask])
+            out.append(e[mask] * (weights.get((case.name, c), 1.0) if weights else 1.0))
     return np.concatenate(out)
+
+
+def likelihood_weights(stats: dict) -> dict:
+    """Channel weights that make a least-squares fit follow the BIC's -2 log L,
+    sum_c n_eff,c log SSR_c, about the model of ``stats`` (its first-order expansion):
+    sqrt(n_eff,c / SSR_c) per (record, channel), scaled to a geometric mean of 1."""
+    ne = n_eff(stats)
+    w = {k: math.sqrt(ne[k] / max(s["ssr"], 1e-300)) for k, s in stats.items()}
+    g = math.exp(sum(math.log(v) for v in w.values()) / len(w))
+    return {k: v / g for k, v in w.items()}
 
 
 def channel_stats(sims: list, cases: list[Case], which: str = "all") -> dict:
@@ -431,14 +442,14 @@ def balance_screen(rig: Rig, cases: list[Case], signature) -> float:
 # --- fitting ----------------------------------------------------------------------------
 
 def fit(space: Space, cases: list[Case], z0: np.ndarray, base_tau: float, which: str, x0s,
-        max_nfev: int = 30) -> FitResult:
+        max_nfev: int = 30, weights: dict | None = None) -> FitResult:
     """Bounded least-squares fit of the candidate's parameters by simulation error,
     with each record's initial displacement co-fitted as a nuisance parameter
     (started from ``x0s``, within +-4 sd of its estimate from the record alone):
     an initial state refined against the model without the effect is biased
     towards hiding it (in a free decay a 40 um offset is a third of F_c / k).
     The result's ``jac`` and ``nuisance_scale`` include the x0 columns (for the
-    intervals)."""
+    intervals).  ``weights``: per (record, channel) factors of the residual (``residuals``)."""
     sd = np.array([max(c.x0_sd, 1e-8) for c in cases])
     cen = np.array([c.x0_data for c in cases])
     lo = np.concatenate([space.lo, cen - 4 * sd])
@@ -449,7 +460,7 @@ def fit(space: Space, cases: list[Case], z0: np.ndarray, base_tau: float, which:
 
     def fun(z):
         rig, tau = space.rig_and_tau(z[:p], base_tau)
-        return residuals(simulate_all(rig, cases, tau, z[p:]), cases, which)
+        return residuals(simulate_all(rig, cases, tau, z[p:]), cases, which, weights)
 
     res = least_squares(fun, zs, bounds=(lo, hi), x_scale=np.concatenate([space.scale, sd]), diff_step=1e-3,
                         max_nfev=max_nfev, method="trf", xtol=1e-6, ftol=1e-8)

@@ -231,16 +231,17 @@ STATUS_WORDS = {"identified": "identified", "at bound": "at bound / not identifi
 
 
 def bound_status(z: ArrayLike, lo: ArrayLike, hi: ArrayLike, identified: ArrayLike,
-                 tol: float = 1e-6) -> list[str]:
-    """Per parameter: "at bound" when its estimate z is within ``tol`` (relative to the range, or
-    absolutely for an unbounded side) of a bound of its fitting range [lo, hi] (a parameter that
-    collapsed to a limit of its range: its sandwich interval, from a one-sided Jacobian, would be
-    falsely precise), else "not identified" where ``identified`` is False (``Covariance``), else
+                 tol: float = 1e-6, scale: ArrayLike | None = None) -> list[str]:
+    """Per parameter: "at bound" when its estimate z is within ``tol`` times its ``scale`` (default:
+    the larger of 1 and |z|) of a bound of its fitting range [lo, hi] (a parameter that collapsed
+    to a limit of its range: its sandwich interval, from a one-sided Jacobian, would be falsely
+    precise), else "not identified" where ``identified`` is False (``Covariance``), else
     "identified"."""
     z, lo, hi = (np.asarray(a, dtype=float) for a in (z, lo, hi))
     ok = np.asarray(identified, dtype=bool)
-    span = np.where(np.isfinite(hi - lo), hi - lo, 1.0)
-    t = tol * np.maximum(span, np.where(np.isfinite(z), np.abs(z), 1.0))
+    size = np.maximum(1.0, np.where(np.isfinite(z), np.abs(z), 1.0)) if scale is None else np.abs(
+        np.asarray(scale, dtype=float))
+    t = tol * size
     at = (np.isfinite(lo) & (z - lo <= t)) | (np.isfinite(hi) & (hi - z <= t))
     return ["at bound" if a else ("identified" if o else "not identified") for a, o in zip(at, ok)]
 
