@@ -8,6 +8,10 @@ record, the mode and the nominal rig), then, and only then, reads the answer key
 and writes docs/diagnose_eval.md and docs/diagnose_eval.json: naming precision and
 recall, false-positive rate on no-effect records, confusion matrix, parameter
 error and interval coverage, fraction of the gap closed, runtime.
+
+``--only SUBSET`` diagnoses and reports the records of one subset (``SUBSETS``,
+chosen by the answer key's labels: e.g. ``issue25``) into its own ``--doc``;
+``--before JSON`` adds the same records diagnosed by earlier code.
 """
 
 from __future__ import annotations
@@ -64,7 +68,8 @@ SUBSETS = (("snr>=30", lambda k: k["snr"] >= 30), ("snr=55", lambda k: k["snr"] 
            ("issue13", lambda k: k.get("set") == "issue13"),
            ("issue13 snr>=30", lambda k: k.get("set") == "issue13" and k["snr"] >= 30),
            ("issue25", lambda k: k.get("set") == "issue25"),
-           ("issue25 snr>=30", lambda k: k.get("set") == "issue25" and k["snr"] >= 30))
+           ("issue25 snr>=30", lambda k: k.get("set") == "issue25" and k["snr"] >= 30),
+           ("issue25 pairs", lambda k: k.get("set") == "issue25" and k["kind"] == "pair"))
 
 
 def coverage_rows(results: list[dict], key: list[dict], snr_min: float = 30) -> list[dict]:
@@ -445,6 +450,10 @@ def main() -> None:
     p.add_argument("--before", help="the JSON of the same evaluation before issue 25 (its before/after section)")
     p.add_argument("--cache", help="a JSON-lines file of the diagnoses done so far: each result is appended as it "
                                    "comes, and records already in it are not diagnosed again (a long run resumes)")
+    p.add_argument("--only", choices=[label for label, _ in SUBSETS],
+                   help="diagnose and report only the records of this subset (write the doc elsewhere with --doc)")
+    p.add_argument("--cached-only", action="store_true",
+                   help="report only the records already in --cache (a run cut short; the doc says how many)")
     a = p.parse_args()
     from servohydraulics.workers import check_workers, process_pool
 
@@ -458,16 +467,23 @@ def main() -> None:
     if a.from_json:
         saved = json.loads(doc.with_suffix(".json").read_text())
         key = json.loads((data / "answer_key.json").read_text())
+        key = [k for k in key if k["id"] in {r["id"] for r in saved["records"]}]
         write_doc(metrics(saved["records"], key), saved["records"], key, doc, saved["command"], saved["wall_s"],
                   a.jobs, before)
         return
     manifest = json.loads((data / "manifest.json").read_text())
+    if a.only:  # the subset's rows are chosen by the answer key's labels (set, snr), not by any result
+        keep = dict(SUBSETS)[a.only]
+        ids = {k["id"] for k in json.loads((data / "answer_key.json").read_text()) if keep(k)}
+        manifest = [m for m in manifest if m["id"] in ids]
     done = {}
     if a.cache and Path(a.cache).exists():
         for line in Path(a.cache).read_text().splitlines():
             if line.strip():
                 r = json.loads(line)
                 done[r["id"]] = r
+    if a.cached_only:
+        manifest = [m for m in manifest if m["id"] in done]
     jobs = [(m["id"], str(data / m["record"]), str(data / m["rig"]), m["mode"]) for m in manifest
             if m["id"] not in done]
     t0 = time.time()
@@ -482,12 +498,15 @@ def main() -> None:
     results = [done[m["id"]] for m in manifest]
     wall = time.time() - t0 + sum(r["runtime"] for r in done.values() if r["id"] not in {j[0] for j in jobs})
     key = json.loads((data / "answer_key.json").read_text())  # read only now, after every diagnosis
+    key = [k for k in key if k["id"] in {r["id"] for r in results}]
     m = metrics(results, key)
     gen = data / "generate.json"
     gen_cmd = (json.loads(gen.read_text())["command"] if gen.exists()
                else f"python evaluation/diagnose_eval/generate.py --out {a.data}")
     cmd = (f"{gen_cmd} --jobs {a.jobs}\n"
-           f"python evaluation/diagnose_eval/evaluate.py --data {a.data} --jobs {a.jobs}")
+           f"python evaluation/diagnose_eval/evaluate.py --data {a.data} --jobs {a.jobs}"
+           + (f" --only '{a.only}' --doc {a.doc}" if a.only else "")
+           + (f" --cache {a.cache} --cached-only: {len(manifest)} records of the set" if a.cached_only else ""))
     write_doc(m, results, key, doc, cmd, wall, a.jobs, before)
     doc.with_suffix(".json").write_text(json.dumps({"metrics": m, "records": results, "command": cmd,
                                                     "wall_s": wall}, indent=1, default=str))

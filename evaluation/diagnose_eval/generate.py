@@ -47,8 +47,9 @@ as OUT/nominal_<rig>_<mode>.toml (the paper's as OUT/nominal_<mode>.toml).
 delays, load pressure + 400 N Coulomb, Bouc-Wen specimens, the other rigs in
 displacement and force control, their no-effect records); ``--cases issue25``
 only those added for issue 25, of the kinds of the two blind misses at other
-magnitudes, rigs and seeds (``plan_issue25``: heavy pistons on small rigs, the
-load-pressure term with a second effect on records of large forces and low noise).
+magnitudes, rigs and seeds (``plan_issue25``: heavy pistons on small rigs, behind
+the load cell and seen by it, the load-pressure term with a second effect on
+records of large forces and low noise).
 """
 
 from __future__ import annotations
@@ -142,8 +143,9 @@ def nominal_file(mode: str, rig: str = "paper") -> str:
 
 
 # effect key -> (Truth overrides at a strength value, answer name, answer parameter, modes)
-def hidden(key: str, val: float, peak_spool: float) -> tuple[dict, str, dict, str]:
-    """Truth overrides, the library name that should be found, the true parameter, the form."""
+def hidden(key: str, val: float, peak_spool: float, m: float = 0.0) -> tuple[dict, str, dict, str]:
+    """Truth overrides, the library name that should be found, the true parameter, the form
+    (``m``: the rig's structure mass [kg])."""
     if key == "coulomb":
         return {"friction": "coulomb", "F_c": val}, "coulomb_friction", {"F_c": val}, "Coulomb (tanh)"
     if key == "stribeck":
@@ -189,6 +191,9 @@ def hidden(key: str, val: float, peak_spool: float) -> tuple[dict, str, dict, st
         return {"C_l": val}, "leakage", {"C_l": val}, "laminar leakage"
     if key == "piston":
         return {"m_p": val}, "piston_mass", {"m_p": val}, "rigid mass"
+    if key == "mass":  # val kg more mass on the load cell's structure side (the load cell measures its inertia)
+        return ({"m": m + val}, "moving_mass", {"m": m + val},
+                f"{val:g} kg the load cell sees (a piston on its actuator side)")
     if key == "spool":
         return {"x_v_max": val * peak_spool}, "spool_saturation", {"x_v_max": val * peak_spool}, "hard stop"
     raise ValueError(key)
@@ -242,6 +247,13 @@ def plan_issue25(snrs_pairs=(55, 40), snrs_singles=(40, 30)) -> list[dict]:
         ("piston", "displacement", 120.0, "rigD"),
         ("piston", "force", 60.0, "rigD"),
         ("piston", "displacement", 40.0, "rigC"),
+        # the blind miss itself: a piston whose inertia the load cell measures (F = p A), i.e. mass on the load
+        # cell's structure side; the look-alikes (a piston behind the load cell, a softer oil column, the valve)
+        # lower the oil-column frequency alike but leave the force's m a out
+        ("mass", "displacement", 60.0, "rigD"),
+        ("mass", "displacement", 25.0, "rigD"),
+        ("mass", "force", 60.0, "rigD"),
+        ("mass", "displacement", 40.0, "rigC"),
     ]
     pairs = [
         # (effects, rig, cmd_scale)
@@ -321,7 +333,7 @@ def plan(size: str, cases: str = "all") -> list[dict]:
 
 
 IN_LIBRARY = {"coulomb", "viscous", "spring", "load_pressure", "flow", "delay", "valve", "leakage", "piston",
-              "spool", "bouc_wen", "bouc_wen_soft"}
+              "spool", "bouc_wen", "bouc_wen_soft", "mass"}
 #: (IN_LIBRARY: forms the library has exactly; the others are out-of-library forms)
 
 
@@ -340,7 +352,7 @@ def make_record(args: tuple) -> tuple[dict, dict, dict]:
         if any(k == "spool" for k, _ in it["effects"]) else 0.0
     answers, forms, over = [], [], {}
     for k, v in it["effects"]:
-        o, name, par, form = hidden(k, v, peak)
+        o, name, par, form = hidden(k, v, peak, tr.m)
         over.update(o)
         answers.append({"name": name, "parameters": par, "form": k, "in_library": k in IN_LIBRARY})
         forms.append(f"{k}: {form}")

@@ -6,6 +6,10 @@ workflow now passes, the hidden truth as the oracle.
 * A piston mass that is a large share of a small rig's moving mass (the blind test's 60 kg on a
   150 kg structure, 6 cm^2 piston, 50 Hz valve) was beyond the candidate's range (0.3 m): its fit
   stopped at the bound and the valve took the rest.
+* A mass the load cell sees (the blind miss: a 60 kg piston on the actuator's side of the load
+  cell, F = p A = (m + 60 kg) a + ..., named compressibility plus valve dynamics) adds m a to the
+  measured force: the moving_mass candidate, screened by the structure's balance residual against
+  the acceleration.
 * A wrong load-pressure term in the nominal model (the UTFSM rig identified at 0 A) made every
   force candidate cost displacement, so none passed: the force candidates now re-fit the model's
   load-pressure term with them over its whole range ("off" included).
@@ -74,6 +78,22 @@ def test_a_heavy_piston_on_a_small_rig_is_named_piston_mass(monkeypatch) -> None
     old = sh.diagnose(rec, nominal, mode="displacement", progress=False, candidates=PISTON_LOOK_ALIKES,
                       max_effects=1)
     assert _names(old) != ["piston_mass"] or _param(old, "piston_mass", "m_p")["status"] == "at bound", old.summary
+
+
+def test_a_mass_the_load_cell_sees_is_named_moving_mass() -> None:
+    """rigD (150 kg structure, 6 cm^2, 50 Hz valve) with 60 kg more moving mass on the load cell's
+    structure side (the independent simulator's structure mass 210 kg: the load cell measures its
+    inertia, force residual 60 kg x acceleration).  Named moving_mass, m within 3 % of 210 kg with a
+    95 % interval that covers it, ahead of the look-alikes that only lower the oil-column frequency
+    (piston mass behind the load cell, a softer oil column, the valve)."""
+    rec = _record("rigD", 2.0, 13, 40.0, m=210.0)
+    nominal = gen.nominal_rig("displacement", "rigD")
+    d = sh.diagnose(rec, nominal, mode="displacement", progress=False,
+                    candidates=PISTON_LOOK_ALIKES + ["moving_mass"], max_effects=1)
+    assert _names(d) == ["moving_mass"], d.summary
+    p = _param(d, "moving_mass", "m")
+    assert abs(p["value"] - 210.0) < 0.03 * 210.0 and p["status"] == "identified", p
+    assert p["interval_95"][0] <= 210.0 <= p["interval_95"][1], p
 
 
 def test_a_wrong_load_pressure_term_no_longer_blocks_the_force_candidate() -> None:

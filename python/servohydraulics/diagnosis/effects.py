@@ -449,7 +449,9 @@ def _max_stable(rig: Rig, mode: str, key: str, upper: float) -> float:
         return upper
     if not stable(cur):
         return cur
-    lo, hi = cur, upper
+    lo, hi = max(cur, 1e-6 * upper), upper  # a current value of 0 (no piston) would pin the log bisection at 0
+    if not stable(lo):
+        return cur
     for _ in range(30):
         mid = math.sqrt(lo * hi)
         lo, hi = (mid, hi) if stable(mid) else (lo, mid)
@@ -467,6 +469,23 @@ def _compressibility_bounds(ctx: Context) -> tuple[np.ndarray, np.ndarray]:
 #: piston and fixtures can weigh as much as its specimen (the blind test's 60 kg on a 150 kg structure, beyond the
 #: former bound of 0.3 m = 45 kg: the fit stopped there and the valve and compressibility took the rest)
 PISTON_MAX_RATIO = 2.0
+
+
+def _mass_bounds(ctx: Context) -> tuple[np.ndarray, np.ndarray]:
+    # from a third of the model's structure mass up to the structure's and the piston's mass added again
+    # (PISTON_MAX_RATIO times), but not beyond 0.9 of the heaviest structure whose closed loop is stable at rest
+    m_p = _piston_absent(ctx)[0]
+    upper = ctx.rig.m + PISTON_MAX_RATIO * (ctx.rig.m + m_p)
+    upper = 0.9 * _max_stable(ctx.rig, ctx.mode, "m", upper / 0.9)
+    return _a(0.3 * ctx.rig.m), _a(max(upper, 1.05 * ctx.rig.m))
+
+
+def _apply_mass(rig: Rig, th: np.ndarray) -> Rig:
+    return _with(rig, m=th[0])
+
+
+def _sig_mass(rig: Rig, s: dict) -> np.ndarray:
+    return s["acceleration"]
 
 
 def _piston_bounds(ctx: Context) -> tuple[np.ndarray, np.ndarray]:
@@ -760,12 +779,13 @@ CANDIDATES: tuple[Candidate, ...] = (
     ),
     Candidate(
         "piston_mass", (Param("m_p", "structure.m_p (effects.piston_mass on)"),),
-        "mass moving between the load cell and the structure (piston, fixtures)",
+        "piston mass on the oil's side of the load cell: it moves with the structure, the load cell does not "
+        "measure its inertia (F = p A - m_p a; a mass it does measure is moving_mass)",
         absent=_piston_absent,
         bounds=_piston_bounds,
         probe=lambda ctx: _piston_absent(ctx) + max(100.0, 0.02 * ctx.rig.m),
         apply=_apply_piston_mass, modes=("displacement", "force"), loads_actuator=True,
-        structural_signature=None, look_alikes=("compressibility",),
+        structural_signature=None, look_alikes=("compressibility", "moving_mass"),
         separate="record the load pressure as well (or test with the specimen detached): the load cell then "
                  "differs from p A by m_p a; a softer oil column (compressibility) lowers the oil-column "
                  "frequency as the extra mass does, but leaves F = p A",
@@ -798,10 +818,23 @@ CANDIDATES: tuple[Candidate, ...] = (
         bounds=_compressibility_bounds,
         probe=lambda ctx: _a(1.6 * ctx.rig.K_a),
         apply=_apply_compressibility, interacts=(("C_l", "m^3/(s Pa)"),), modes=("displacement", "force"),
-        look_alikes=("piston_mass",),
+        look_alikes=("piston_mass", "moving_mass"),
         separate="a sweep through the oil-column resonance: compressibility moves it, leakage damps it; "
                  "a piston mass moves it too (both set A^2 / (K_a M)) but shows as F = p A - m_p a "
                  "when the load pressure is recorded",
+    ),
+    Candidate(
+        "moving_mass", (Param("m", "structure.m"),),
+        "mass the load cell sees moving with the structure, Eq (5)'s m (added, issue 25: fixtures, a specimen's "
+        "own mass, or a piston on the actuator's side of the load cell whose inertia it measures)",
+        absent=lambda ctx: _a(ctx.rig.m),
+        bounds=_mass_bounds,
+        probe=lambda ctx: _a(ctx.rig.m + max(0.1 * (ctx.rig.m + _piston_absent(ctx)[0]), 1.0)),
+        apply=_apply_mass, modes=("displacement", "force"), loads_actuator=True,
+        structural_signature=_sig_mass, look_alikes=("piston_mass", "compressibility"),
+        separate="the force-acceleration relation: a mass the load cell sees adds m a to the measured force "
+                 "(the structure's balance residual is proportional to the acceleration); a piston mass behind "
+                 "the load cell or a softer oil column lower the oil-column frequency alike but leave it out",
     ),
 )
 
