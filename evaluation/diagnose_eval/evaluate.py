@@ -224,6 +224,8 @@ CASE_SETS = {
     "issue25": ("The cases added for issue 25 (the kinds of the two blind misses)",
                 "A piston mass that is a large share of a small rig's moving mass (rigD: 150 kg, 50 kN/m, 6 cm^2, "
                 "50 Hz valve; m_p 30, 60 and 120 kg in displacement control, 60 kg in force control; rigC, 40 kg), "
+                "a mass the load cell sees (the blind miss itself: 25 and 60 kg on rigD in displacement control, "
+                "60 kg in force control, 40 kg on rigC; truth: moving_mass), at 40 and 30 dB, "
                 "and the load-pressure term with a second effect (Coulomb friction 250-600 N, viscous damping "
                 "4 kN s/m) on records of large forces (the standard command enlarged 1.3-1.7 times: forces to "
                 "65-95 kN on the paper's rig, load pressures to 0.8-1.2 of the supply) at 55 and 40 dB, on the "
