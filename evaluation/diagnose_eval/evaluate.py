@@ -69,7 +69,9 @@ SUBSETS = (("snr>=30", lambda k: k["snr"] >= 30), ("snr=55", lambda k: k["snr"] 
            ("issue13 snr>=30", lambda k: k.get("set") == "issue13" and k["snr"] >= 30),
            ("issue25", lambda k: k.get("set") == "issue25"),
            ("issue25 snr>=30", lambda k: k.get("set") == "issue25" and k["snr"] >= 30),
-           ("issue25 pairs", lambda k: k.get("set") == "issue25" and k["kind"] == "pair"))
+           ("issue25 pairs", lambda k: k.get("set") == "issue25" and k["kind"] == "pair"),
+           ("issue25 moving mass", lambda k: k.get("set") == "issue25"
+            and any(a["name"] == "moving_mass" for a in k["answers"])))
 
 
 def coverage_rows(results: list[dict], key: list[dict], snr_min: float = 30) -> list[dict]:
