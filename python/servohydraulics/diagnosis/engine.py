@@ -49,8 +49,9 @@ def noise_sigma(y: np.ndarray) -> float:
     return float(1.4826 * np.median(np.abs(d3 - np.median(d3))) / math.sqrt(20.0))
 
 
-def make_case(rec: Any, mode: str, name: str) -> Case:
-    """A record (``read_record``'s result: ``.channels``, ``.dt``) prepared for the diagnosis."""
+def make_case(rec: Any, mode: str, name: str, controller_dt: float | None = None) -> Case:
+    """A record (``read_record``'s result: ``.channels``, ``.dt``) prepared for the diagnosis,
+    simulated with the controller sample ``controller_dt`` [s] (None: the record's)."""
     ch = rec.channels
     t = ch["time"] - ch["time"][0]
     dt = rec.dt
@@ -86,7 +87,7 @@ def make_case(rec: Any, mode: str, name: str) -> Case:
     derived["rms_v"] = float(np.sqrt(np.mean(derived["velocity"] ** 2)))
     x0, x0_sd = initial_displacement(t, x, sigma["displacement"])
     return Case(name, mode, dt, t, np.asarray(ch["command"], float), meas, scale, sigma, train, derived,
-                x0, x0_sd, float(np.max(np.abs(derived["velocity"]))))
+                x0, x0_sd, float(np.max(np.abs(derived["velocity"]))), controller_dt)
 
 
 def initial_displacement(t: np.ndarray, x: np.ndarray, sigma: float) -> tuple[float, float]:
@@ -134,7 +135,7 @@ def simulate_case(rig: Rig, case: Case, tau: float, x0: float) -> Sim:
     that run fails."""
     for opts in (solver_options(), solver_options(method="cvode")):
         try:
-            r = simulate_command(rig, case.mode, case.u, case.dt, float(x0), opts, delay=tau)
+            r = simulate_command(rig, case.mode, case.u, case.dt, float(x0), opts, dt=case.controller_dt, delay=tau)
         except (SimulationError, ValueError):
             continue
         return {c: r.channels[c] for c in SIM_CHANNELS}

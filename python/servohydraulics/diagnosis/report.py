@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import FileSet, WriteError
+from ..identification.report import checks_markdown
 from ..rig import save_rig
 
 
@@ -142,6 +143,7 @@ def _markdown(d, figs: dict) -> str:
     L = ["# Diagnosis", "", f"**Verdict: {d.verdict}.** {d.summary}", "",
          f"Mode: {d.mode}. Records: " + ", ".join(f"`{r}`" for r in d.records) + f". Runtime {d.runtime_s:.1f} s.",
          ""]
+    L += checks_markdown(getattr(d, "checks", []))
     L += ["## Gap per channel (normalised RMS error, %)", "",
           "| channel | before | after | noise floor | gap closed (of the part above the floor) |",
           "|---|---|---|---|---|"]
