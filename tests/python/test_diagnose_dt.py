@@ -6,7 +6,9 @@ command twice as long (a zero-order hold of 1 ms lags 0.25 ms more than one of 0
 so without the controller's sample the diagnosis names a ``command_delay`` (negative:
 the record leads the model) that is not in the rig; with ``dt=5e-4`` (the command
 interpolated onto the controller's grid, the same helper as ``compare`` and
-``identify``) it names nothing.  The oracle: the record is the nominal rig's."""
+``identify``) it names nothing.  The oracle: the record is the nominal rig's.  Sensor noise
+as on the UTFSM frame's quieter campaign (2 um, 20 N): the linear interpolation of the 1 kHz
+command misses the 2 kHz one by about 1 um at the chirp's top (8.5 Hz), below that noise."""
 
 from __future__ import annotations
 
@@ -30,8 +32,8 @@ def decimated():
     rng = np.random.default_rng(3)
     keep = slice(None, None, 2)
     rec = sh.Response({"time": t[keep], "command": u[keep],
-                       "displacement": np.asarray(res.displacement)[keep] + 2e-7 * rng.standard_normal(t[keep].size),
-                       "force": np.asarray(res.force)[keep] + 5.0 * rng.standard_normal(t[keep].size)},
+                       "displacement": np.asarray(res.displacement)[keep] + 2e-6 * rng.standard_normal(t[keep].size),
+                       "force": np.asarray(res.force)[keep] + 20.0 * rng.standard_normal(t[keep].size)},
                       kind="record")
     return rig, rec
 
@@ -52,7 +54,8 @@ def test_a_1khz_record_of_a_2khz_rig_has_no_delay_with_dt(decimated):
     fixed = sh.diagnose([rec], rig, mode="displacement", progress=False, candidates=DELAYS, dt=5e-4)
     assert fixed.verdict == "no_effect", fixed.summary
     assert fixed.to_dict()["controller_dt_s"] == 5e-4
-    assert fixed.gap_before["displacement"] < 0.2 * without.gap_before["displacement"]
+    # the model at the right controller rate: its gap a quarter of the other (0.17 % against 0.64 %, the rest noise)
+    assert fixed.gap_before["displacement"] < 0.5 * without.gap_before["displacement"]
 
 
 def test_diagnose_refuses_a_dt_that_does_not_fit_the_record(decimated, tmp_path):

@@ -87,7 +87,7 @@ def test_columns_mapping_and_a_file_without_names(tmp_path):
 @pytest.mark.parametrize("kwargs, words", [
     ({"columns": {"force": "F"}}, ["bad.csv", "force='F' names no column", "header ['t', 'cmd', 'x', 'load']",
                                   "the mapping tried"]),
-    ({"columns": {"forse": "load"}}, ["invalid columns channel 'forse'", "not a record channel"]),
+    ({"columns": {"forse": "load"}}, ["invalid columns channel = 'forse'", "not a record channel"]),
     ({}, ["bad.csv", "missing column(s) ['time', 'command', 'displacement', 'force']", "header ['t', 'cmd'",
           "--columns time=NAME"]),
     ({"columns": {"time": "t", "command": "cmd", "displacement": "x", "force": "load"},
@@ -294,7 +294,7 @@ def test_raw_daq_errors(tmp_path, case, words):
 @pytest.mark.parametrize("text, words", [
     ("bogus = 1\n", ["lay.toml", "unknown key(s) ['bogus']"]),
     ("header_lines = -1\n", ["lay.toml", "invalid header_lines = -1"]),
-    ("[columns]\nforse = 'F'\n", ["lay.toml", "invalid columns channel 'forse'"]),
+    ("[columns]\nforse = 'F'\n", ["lay.toml", "invalid columns channel = 'forse'"]),
     ("[scale]\nforce = 'big'\n", ["lay.toml", "invalid scale force = 'big'"]),
     ("offset_first_s = -1\n", ["lay.toml", "invalid offset_first_s = -1"]),
     ("delimiter = '|'\n", ["lay.toml", "invalid delimiter = '|'"]),

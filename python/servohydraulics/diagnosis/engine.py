@@ -22,7 +22,7 @@ from scipy.signal import savgol_filter
 from .. import _core
 from ..identification.coordinates import Coordinates
 from ..identification.run import simulate_command
-from ..identification.stats import LEVEL, ar1_coefficient, ar1_effective_n, quantile
+from ..identification.stats import LEVEL, ar1_coefficient, ar1_effective_n, noise_sigma, quantile
 from ..identification.stats import covariance as hac_covariance
 from ..rig import Rig
 from ..simulate import MODES, SimulationError, solver_options
@@ -40,13 +40,6 @@ SIM_CHANNELS = tuple(c for c, _ in _core.PLANT_CHANNELS if c not in NOT_COMPARED
 CHANNELS = {mode: tuple(c for c in SIM_CHANNELS if not (mode == "free" and c in ACTUATOR_CHANNELS))
             for mode in MODES}
 N_SEGMENTS = 6  #: held-out split: contiguous segments, even ones train, odd ones test
-
-
-def noise_sigma(y: np.ndarray) -> float:
-    """Noise standard deviation of a record channel from its third differences
-    (robust MAD; smooth signal content sampled well above its bandwidth cancels)."""
-    d3 = np.diff(y, 3)
-    return float(1.4826 * np.median(np.abs(d3 - np.median(d3))) / math.sqrt(20.0))
 
 
 def make_case(rec: Any, mode: str, name: str, controller_dt: float | None = None) -> Case:

@@ -35,6 +35,7 @@ import numpy as np
 
 from ..response import Response
 from ..rig import Rig
+from .stats import noise_sigma
 
 ERROR, WARNING = "error", "warning"
 
@@ -108,8 +109,8 @@ class CheckError(ValueError):
 
     def __init__(self, checks: Sequence[Check]):
         self.checks = list(checks)
-        more = f" (and {len(checks) - 1} more: " + "; ".join(c.line() for c in checks[1:]) + ")" if len(checks) > 1 \
-            else ""
+        more = (f" (and {len(checks) - 1} more: " + ", ".join(f"[{c.code}] {c.channel}" for c in checks[1:]) + ")"
+                if len(checks) > 1 else "")
         super().__init__(checks[0].line() + more)
 
 
@@ -174,8 +175,6 @@ def _runs(mask: np.ndarray) -> tuple[int, int]:
 
 
 def _noise(y: np.ndarray) -> float:
-    from ..diagnosis.engine import noise_sigma
-
     return noise_sigma(y) if y.size > 3 else 0.0
 
 
@@ -200,8 +199,8 @@ def _limits(rec: Response, rig: Rig | None, mode: str, where: str) -> list[Check
             vals = {"peak": peak, "limit": lim, "ratio": ratio}
             name = ("command" if ch == "command" else "displacement") if kind != "force" else "force"
             if ratio > LIMIT_FACTOR:
-                hint = (f"--units {ch}=mm (or in, cm)" if kind != "force" else
-                        f"--units {ch}=... or --scale {ch}=FACTOR")
+                hint = (f"--units {ch}=mm, or in, cm" if kind != "force" else
+                        f"--units {ch}=..., or --scale {ch}=FACTOR")
                 out.append(Check(f"{name}_outside_{limit}", where, ch, (
                     f"invalid {ch} = {scale * peak:.4g} {unit} (max |{ch}|): {ratio:.3g} times the rig's {limit} "
                     f"{scale * lim:.4g} {unit}: no test on this rig reaches that; a unit slip ({hint}) or the wrong "

@@ -50,8 +50,8 @@ def zoom_windows(time: np.ndarray, measured: Mapping[str, np.ndarray], simulated
                  command: np.ndarray | None = None, count: int = 3, cycles: float = 4.0) -> list[tuple[int, int]]:
     """Up to ``count`` windows (start, stop sample) where the simulated and measured records part
     most: the largest moving mean of the squared difference (each channel over its measured
-    std), each about ``cycles`` periods of the command there (0.5 % to 25 % of the record), not
-    overlapping; in time order."""
+    std), each about ``cycles`` periods of the command there (0.5 % to 25 % of the record), at
+    least a tenth of the record (or a window) apart; in time order."""
     n = time.size
     dt = float(time[1] - time[0]) if n > 1 else 1.0
     e2 = np.zeros(n)
@@ -77,7 +77,8 @@ def zoom_windows(time: np.ndarray, measured: Mapping[str, np.ndarray], simulated
         a = int(np.clip(k - length // 2, 0, max(n - length, 0)))
         b = min(n, a + length)
         out.append((a, b))
-        taken[max(0, a - length // 2):min(n, b + length // 2)] = True
+        gap = max(length, n // 10)  # the next window elsewhere in the record, not next door
+        taken[max(0, a - gap):min(n, b + gap)] = True
     return sorted(out)
 
 
@@ -101,9 +102,9 @@ def overlay_figure(time: np.ndarray, measured: Mapping[str, np.ndarray], simulat
         m, s = f * np.asarray(measured[ch]), f * np.asarray(simulated[ch])
         r = (2 * i) if wins else i
         ax = fig.add_subplot(gs[r, :])
-        ax.plot(t, m, lw=0.6, color=MEASURED, label=labels[0])
-        ax.plot(t, s, lw=0.6, color=SIMULATED, label=labels[1])
-        ax.plot(t, s - m, lw=0.5, color=DIFFERENCE, label="difference")
+        ax.plot(t, s - m, lw=0.5, color=DIFFERENCE, label="difference", alpha=0.6, zorder=1)
+        ax.plot(t, m, lw=0.6, color=MEASURED, label=labels[0], zorder=2)
+        ax.plot(t, s, lw=0.6, color=SIMULATED, label=labels[1], zorder=3)
         for j, (a, b) in enumerate(wins):
             ax.axvspan(t[a], t[b - 1], color=SHADE, alpha=0.12, lw=0)
             ax.text(0.5 * (t[a] + t[b - 1]), 1.0, letters[j], transform=ax.get_xaxis_transform(), ha="center",

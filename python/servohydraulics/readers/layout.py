@@ -130,7 +130,7 @@ def check_layout(lay: Layout) -> Layout:
             raise ValueError(lay.where(f"invalid {what} = {mapping!r}: expected a table of channel = value"))
         for ch, v in mapping.items():
             if ch not in allowed:
-                raise ValueError(lay.where(f"invalid {what} channel {ch!r}: not a record channel; channels: "
+                raise ValueError(lay.where(f"invalid {what} channel = {ch!r}: not a record channel; channels: "
                                            f"{', '.join(allowed)}"))
             if what != "scale" and (not isinstance(v, str) or not v.strip()):
                 raise ValueError(lay.where(f"invalid {what} {ch} = {v!r}: expected a name"))

@@ -28,7 +28,7 @@ DESIRED, MEASURED, ERROR, REFERENCE = "C0", "C1", "C3", "0.5"
 
 def run_title(meta: Mapping[str, Any], what: str) -> str:
     """``RTHS benchmark: <what>: <record> x <intensity>, controller <name>`` (+ the embedded default's label)."""
-    title = (f"RTHS benchmark (Silva et al. 2020): {what}: {meta.get('record', '?')} x "
+    title = (f"RTHS benchmark (Silva et al. 2020): {what}\n{meta.get('record', '?')} x "
              f"{meta.get('eq_intensity', '?')}, controller {meta.get('controller', '?')}")
     if meta.get("synthetic"):
         title += "\nEMBEDDED DEFAULT with a SYNTHETIC ground motion: not the benchmark's records or results"
@@ -45,8 +45,8 @@ def tracking_figure(trials: Mapping[int, Any], meta: Mapping[str, Any]) -> Figur
         t, xd, xm = s["time"], 1e3 * s["numerical"][:, 0], 1e3 * s["measured"]
         err = xm - xd
         top = fig.add_subplot(gs[2 * i, :2])
-        top.plot(t, xd, lw=0.6, color=DESIRED, label="desired y_n(1)")
-        top.plot(t, xm, lw=0.6, color=MEASURED, label="measured x_m")
+        top.plot(t, xm, lw=1.0, color=MEASURED, label="measured x_m")
+        top.plot(t, xd, lw=0.5, color=DESIRED, label="desired y_n(1)")
         top.set_ylabel(f"case {case}\ndisplacement [mm]")
         top.set_title(f"case {case}: J1 {trial.J[0]:.2f} ms, J2 {trial.J[1]:.2f} %, J3 {trial.J[2]:.2f} %",
                       fontsize=9)
@@ -59,8 +59,8 @@ def tracking_figure(trials: Mapping[int, Any], meta: Mapping[str, Any]) -> Figur
         k = int(np.argmax(np.abs(xd)))
         win = (t > t[k] - 1.0) & (t < t[k] + 1.0)
         zoom = fig.add_subplot(gs[2 * i:2 * i + 2, 2])
-        zoom.plot(t[win], xd[win], color=DESIRED, lw=1.0, label="desired y_n(1)")
-        zoom.plot(t[win], xm[win], color=MEASURED, lw=1.0, label="measured x_m")
+        zoom.plot(t[win], xm[win], color=MEASURED, lw=1.8, label="measured x_m")
+        zoom.plot(t[win], xd[win], color=DESIRED, lw=0.9, label="desired y_n(1)")
         zoom.plot(t[win], 1e3 * s["reference"][win, 0], "--", color=REFERENCE, lw=0.8, label="reference floor 1")
         zoom.set_title(f"zoom at the peak, t = {t[k]:.2f} s", fontsize=9)
         zoom.set_xlabel("time [s]")
@@ -110,8 +110,11 @@ def criteria_figure(results: Mapping[str, Any]) -> Figure:
         std = np.array(e["perturbed"]["J_std"], dtype=float) if per else None
         label = f"case {n}" + (f" ({e['perturbed']['runs']} perturbed)" if per else " (nominal)")
         off = (j - (len(cases) - 1) / 2) * width
-        a1.bar(off, mean[0], width, yerr=None if std is None else std[0], label=label)
-        a2.barh(y + off, mean[1:], width, xerr=None if std is None else std[1:], label=label)
+        bars = a1.bar(off, mean[0], width, yerr=None if std is None else std[0], label=label)
+        a1.bar_label(bars, fmt="%.2f", fontsize=7)
+        bars = a2.barh(y + off, mean[1:], width, xerr=None if std is None else std[1:], label=label)
+        a2.bar_label(bars, fmt="%.2f", fontsize=7, padding=2)
+    a1.set_xlim(-0.7, 0.7)
     a1.set_xticks([0.0])
     a1.set_xticklabels([J_LABELS[0]], fontsize=8)
     a1.set_ylabel("[ms]")
