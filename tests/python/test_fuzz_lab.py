@@ -474,7 +474,7 @@ def read_case(tmp_path, mode, fmt, length, force, named_units, defect, flags):
         _require(not (correct and (truly_si or fmt == "daq")), "right reading refused", argv, err)
 
 
-@settings(max_examples=12, deadline=None, derandomize=True,
+@settings(max_examples=8, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(**READ_DRAW)
 @example(mode="displacement", fmt="csv", length="mm", force="N", named_units=False, defect="none", flags="none")

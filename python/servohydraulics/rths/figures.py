@@ -76,7 +76,7 @@ def tracking_figure(trials: Mapping[int, Any], meta: Mapping[str, Any]) -> Figur
 def synchronization_figure(trials: Mapping[int, Any], meta: Mapping[str, Any]) -> Figure:
     """Per case: measured x_m against desired y_n(1), with the diagonal (perfect tracking)."""
     n = len(trials)
-    fig = Figure(figsize=(3.6 * n + 0.6, 4.2))
+    fig = Figure(figsize=(3.8 * n + 0.6, 4.8))
     axes = fig.subplots(1, n, squeeze=False)[0]
     for ax, (case, trial) in zip(axes, trials.items()):
         s = trial.signals
