@@ -455,7 +455,7 @@ def read_case(tmp_path, mode, fmt, length, force, named_units, defect, flags):
     elif flags == "column_unknown":
         argv += ["--columns", "forse=force"]
     elif flags.startswith("accept_"):
-        argv += ["--accept", {"accept_error": "command_outside_stroke", "accept_bogus": "bogus"}[flags]]
+        argv += ["--accept", {"accept_error": "displacement_outside_stroke", "accept_bogus": "bogus"}[flags]]
     if flags == "accept_warning":
         argv += ["--accept", "flat_at_limit,run_spool"]
     outcome, code, err = _run(argv)

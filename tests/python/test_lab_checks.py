@@ -48,16 +48,16 @@ def files(tmp_path_factory):
 
 
 def test_a_millimetre_record_read_as_metres_is_refused_and_read_right_with_units(files, tmp_path):
-    """Before: ``compare`` of this record exited 0 with a 278 % displacement NRMSE and no word
-    (docs/lab-records.md, 'Checks').  Now: exit 2 naming the file, the channel, the value, the
-    rig's stroke and the flag that reads it right; with ``--units`` it compares at ~0."""
+    """Before, ``compare`` of such a record exited 0 with a number and no word (the shared sweep in
+    mm: 142.67 %, docs/lab-records.md, 'Checks').  Now: exit 2 naming the file, the channel, the
+    value, the rig's stroke and the flag that reads it right; with ``--units`` it compares at ~0."""
     out = tmp_path / "cmp"
     outcome, code, err = run_case(["compare", str(files["mm"]), "--rig", str(files["rig"]), "--mode", "displacement",
                                    "--out", str(out)])
     assert code == 2, err
     line = err.strip().splitlines()[-1]
-    for w in ("error:", "rec_mm.csv", "[command_outside_stroke]", "invalid command = 2", "times the rig's stroke",
-              "--units command=mm"):
+    for w in ("error:", "rec_mm.csv", "[displacement_outside_stroke]", "invalid displacement = 1.496 m",
+              "times the rig's stroke", "--units command=mm,displacement=mm"):
         assert w in line, line
     assert not out.exists() or not any(out.iterdir())
     outcome, code, err = run_case(["compare", str(files["mm"]), "--rig", str(files["rig"]), "--mode", "displacement",
@@ -77,7 +77,8 @@ def test_identify_and_diagnose_refuse_the_millimetre_record_too(files, tmp_path)
                  ["diagnose", str(files["mm"]), "--rig", str(files["rig"]), "--mode", "displacement", "--quiet"]):
         outcome, code, err = run_case(argv + ["--out", str(tmp_path / argv[0])])
         assert code == 2, err
-        assert "rec_mm.csv" in err and ("[displacement_implausible]" in err or "[command_outside_stroke]" in err), err
+        assert "rec_mm.csv" in err, err
+        assert "[displacement_implausible]" in err or "[displacement_outside_stroke]" in err, err
         assert not (tmp_path / argv[0]).exists() or not any((tmp_path / argv[0]).iterdir())
 
 
@@ -145,7 +146,7 @@ def test_the_simulated_runs_limits_are_checks(files, tmp_path):
 
 @pytest.mark.parametrize("accept, words", [
     ("bogus", ["invalid accept = 'bogus'", "not a check"]),
-    ("command_outside_stroke", ["invalid accept = 'command_outside_stroke'", "cannot be acknowledged"]),
+    ("displacement_outside_stroke", ["invalid accept = 'displacement_outside_stroke'", "cannot be acknowledged"]),
 ])
 def test_accept_refuses_unknown_and_error_codes(files, tmp_path, accept, words):
     outcome, code, err = run_case(["compare", str(files["m"]), "--rig", str(files["rig"]), "--mode", "displacement",
@@ -156,7 +157,7 @@ def test_accept_refuses_unknown_and_error_codes(files, tmp_path, accept, words):
 
 
 def test_every_code_has_a_level_and_a_meaning():
-    assert set(CODES) >= {"time_step", "command_outside_stroke", "flat_at_limit", "run_spool", "run_drive",
+    assert set(CODES) >= {"time_step", "displacement_outside_stroke", "flat_at_limit", "run_spool", "run_drive",
                           "run_stroke"}
     for code, (level, why) in CODES.items():
         assert level in ("error", "warning") and why, code
