@@ -74,6 +74,10 @@ def zoom_windows(time: np.ndarray, measured: Mapping[str, np.ndarray], simulated
             if np.isfinite(period):
                 length = int(round(cycles * period / dt))
         length = int(np.clip(length, lo_len, hi_len))
+        # the region found on the coarse score, the window's centre on a score of its own length
+        lo, hi = max(0, k - base), min(n, k + base + 1)
+        fine = np.where(taken[lo:hi], -np.inf, _moving_mean(e2, length)[lo:hi])
+        k = lo + int(np.argmax(fine))
         a = int(np.clip(k - length // 2, 0, max(n - length, 0)))
         b = min(n, a + length)
         out.append((a, b))
