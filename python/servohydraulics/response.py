@@ -141,30 +141,40 @@ def solver_warnings(work: Any) -> list[str]:
     return out
 
 
-def limit_warnings(flags: np.ndarray, time: np.ndarray, peak_force: float, rig: Rig | None = None) -> list[str]:
-    """Notes on the physical limits a run hit, from its per-row OutputFlag bits
-    (``rig`` adds the limit values)."""
+def limit_notes(flags: np.ndarray, time: np.ndarray, peak_force: float, rig: Rig | None = None
+                ) -> list[tuple[str, str, float]]:
+    """(code, note, first time [s]) of each physical limit a run hit, from its per-row
+    OutputFlag bits (``rig`` adds the limit values to the notes).  Codes: ``run_capacity``,
+    ``run_supply``, ``run_stroke``, ``run_spool``, ``run_drive``."""
     out = []
     if np.any(flags & _core.FLAG_CAPACITY_EXCEEDED):
         cap = f" > {rig.F_cap / 1e3:.0f} kN" if rig is not None else ""
-        out.append(f"actuator capacity exceeded: peak force {peak_force / 1e3:.1f} kN{cap}, "
-                   f"first at t = {_first_time(time, flags, _core.FLAG_CAPACITY_EXCEEDED):.3f} s")
+        t = _first_time(time, flags, _core.FLAG_CAPACITY_EXCEEDED)
+        out.append(("run_capacity", f"actuator capacity exceeded: peak force {peak_force / 1e3:.1f} kN{cap}, "
+                                    f"first at t = {t:.3f} s", t))
     if np.any(flags & _core.FLAG_SUPPLY_LIMITED):
         lim = f" (p_s A = {rig.p_s * rig.A / 1e3:.1f} kN)" if rig is not None else ""
-        out.append(f"load pressure reached the supply pressure{lim}, force limited, "
-                   f"first at t = {_first_time(time, flags, _core.FLAG_SUPPLY_LIMITED):.3f} s")
+        t = _first_time(time, flags, _core.FLAG_SUPPLY_LIMITED)
+        out.append(("run_supply", f"load pressure reached the supply pressure{lim}, force limited, "
+                                  f"first at t = {t:.3f} s", t))
     if np.any(flags & _core.FLAG_STROKE_EXCEEDED):
         lim = f" (+-{rig.stroke * 1e3:.0f} mm)" if rig is not None else ""
-        out.append(f"displacement beyond the actuator stroke{lim} first at t = "
-                   f"{_first_time(time, flags, _core.FLAG_STROKE_EXCEEDED):.3f} s: a real actuator would hit "
-                   "its end stop")
+        t = _first_time(time, flags, _core.FLAG_STROKE_EXCEEDED)
+        out.append(("run_stroke", f"displacement beyond the actuator stroke{lim} first at t = {t:.3f} s: a real "
+                                  "actuator would hit its end stop", t))
     if np.any(flags & _core.FLAG_SPOOL_SATURATED):
-        out.append("servovalve spool saturated (fully open) first at t = "
-                   f"{_first_time(time, flags, _core.FLAG_SPOOL_SATURATED):.3f} s")
+        t = _first_time(time, flags, _core.FLAG_SPOOL_SATURATED)
+        out.append(("run_spool", f"servovalve spool saturated (fully open) first at t = {t:.3f} s", t))
     if np.any(flags & _core.FLAG_DRIVE_SATURATED):
-        out.append(f"servovalve drive saturated first at t = "
-                   f"{_first_time(time, flags, _core.FLAG_DRIVE_SATURATED):.3f} s")
+        t = _first_time(time, flags, _core.FLAG_DRIVE_SATURATED)
+        out.append(("run_drive", f"servovalve drive saturated first at t = {t:.3f} s", t))
     return out
+
+
+def limit_warnings(flags: np.ndarray, time: np.ndarray, peak_force: float, rig: Rig | None = None) -> list[str]:
+    """Notes on the physical limits a run hit, from its per-row OutputFlag bits
+    (``rig`` adds the limit values): the notes of :func:`limit_notes`."""
+    return [note for _, note, _ in limit_notes(flags, time, peak_force, rig)]
 
 
 class Channels(Mapping):
@@ -220,11 +230,14 @@ class Response:
             ``RunSummary``: rows, internal steps, rhs evaluations, restarts,
             peak force, displacement and velocity, failure time, status); None for a record.
         path: the file of a record, else None.
+        metadata: how a record was read (``read_record``: columns, units, scales, offsets, the
+            file's header block); empty for a run.
     """
 
     def __init__(self, channels: Mapping[str, ArrayLike], *, kind: str = "record", mode: str | None = None,
                  dt: float | None = None, rig: Rig | None = None, work: _core.RunSummary | Work | None = None,
-                 units: Mapping[str, str] | None = None, path: str | Path | None = None):
+                 units: Mapping[str, str] | None = None, path: str | Path | None = None,
+                 metadata: Mapping[str, Any] | None = None):
         if kind not in KINDS:
             raise ValueError(f"invalid kind = {kind!r}: expected one of {list(KINDS)}")
         if "time" not in channels:
@@ -237,6 +250,7 @@ class Response:
             work = Work.from_core(work)
         self.kind, self.mode, self.rig, self.work = kind, mode, rig, work
         self.path = None if path is None else Path(path)
+        self.metadata = dict(metadata or {})
         t = data["time"]
         self.dt = float(dt) if dt is not None else (float((t[-1] - t[0]) / (t.size - 1)) if t.size > 1 else math.nan)
         status = None if work is None else work.status
@@ -295,14 +309,20 @@ class Response:
         return self._warning_list(rig)
 
     def _warning_list(self, rig: Rig | None) -> list[str]:
+        return [text for _, text in self.notes(rig)]
+
+    def notes(self, rig: Rig | None = None) -> list[tuple[str, str]]:
+        """(code, note) of every warning (:meth:`warnings`): the limits the run hit
+        (``limit_notes``' codes), ``run_solver`` for the integrator's notes and ``run_failed``
+        for a failure."""
         rig = self.rig if rig is None else rig
         peak = getattr(self.work, "peak_force", None)
         if peak is None:
             peak = float(np.max(np.abs(self.channels.get("force", np.zeros(0))), initial=0.0))
-        out = limit_warnings(self.flags, self.time, peak, rig)
-        out += solver_warnings(self.work)
+        out = [(code, text) for code, text, _ in limit_notes(self.flags, self.time, peak, rig)]
+        out += [("run_solver", text) for text in solver_warnings(self.work)]
         if not self.success:
-            out.append(self.message)
+            out.append(("run_failed", self.message))
         return out
 
     # ---- export ----------------------------------------------------------------------
@@ -366,5 +386,5 @@ def finish(res: Response, raise_on_failure: bool) -> Response:
     return res
 
 
-__all__ = ["Channels", "Response", "Work", "SimulationError", "channel_units", "limit_warnings", "solver_warnings",
-           "uniform_dt"]
+__all__ = ["Channels", "Response", "Work", "SimulationError", "channel_units", "limit_notes", "limit_warnings",
+           "solver_warnings", "uniform_dt"]

@@ -35,6 +35,7 @@ from ..atomic import FileSet, check_folder
 from ..records import read_record
 from ..response import Response
 from ..rig import Rig, load_rig, save_rig
+from .checks import check_accept, gate
 from .compare import Comparison, channels_of, compare, save_figures, write_json
 from .coordinates import FORCE_KEYS, LOOP_KEYS, Coordinates, check_keys, specimen_keys, use_specimen
 from .fit import (
@@ -82,6 +83,7 @@ class Identification:
     status: dict = field(default_factory=dict)  #: key -> "identified", "not identified" or "at bound"
     costs: dict = field(default_factory=dict)  #: time-domain cost of the start and of each stage
     kept: str = "time"  #: which of "start", "frequency", "time" the result is
+    checks: list = field(default_factory=list)  #: ``checks.Check``: the records' plausibility, the runs' limits
 
     def to_dict(self) -> dict[str, Any]:
         units = _units()
@@ -95,6 +97,7 @@ class Identification:
             "derived": derived(self.rig, self.mode), "flags": self.flags, "channel_weights": self.weights,
             "integrator": self.integrator, "n_eff": self.n_eff, "rho1": self.rho1, "nfev": self.nfev,
             "runtime_s": self.runtime_s, "costs": self.costs, "kept": self.kept,
+            "checks": [c.to_dict() for c in self.checks],
             "records": [{"record": b.name, "before": {c: b.channels[c]["nrmse_pct"] for c in b.channels},
                          "after": {c: a.channels[c]["nrmse_pct"] for c in a.channels}, "warnings": a.warnings}
                         for b, a in zip(self.before, self.after)],
@@ -134,12 +137,13 @@ def _units() -> dict[str, str]:
     return {p.key: p.unit for p in PARAMETERS}
 
 
-def as_records(records) -> list:
+def as_records(records, layout=None) -> list:
     """Records from records (anything with ``channels``: a Response) or record paths (a single
-    one is accepted); the paths read by ``read_record``."""
+    one is accepted); the paths read by ``read_record`` with ``layout`` (a ``readers.Layout``,
+    a layout file or a dict of its fields: columns, units, scale...)."""
     if isinstance(records, (str, Path)) or hasattr(records, "channels"):
         records = [records]
-    out = [r if hasattr(r, "channels") else read_record(r) for r in records]
+    out = [r if hasattr(r, "channels") else read_record(r, layout) for r in records]
     if not out:
         raise ValueError("invalid records = []: give at least one record")
     return out
@@ -289,7 +293,7 @@ def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options,
 def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | None = None,
              mode: str = "displacement", specimen: str = "linear", channels: Sequence[str] | None = None,
              dt: float | None = None, frequency_stage: bool = True, max_nfev: int = 60,
-             progress: bool = True, workers: int | None = None) -> Identification:
+             progress: bool = True, workers: int | None = None, layout=None, accept=None) -> Identification:
     """Identifies rig keys from lab records (see the module docstring).
 
     Args:
@@ -305,11 +309,18 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         max_nfev: the time-domain stage's budget of residual evaluations (Jacobians not counted).
         progress: a tqdm bar over the simulations.
         workers: threads for the Jacobian's columns (default: up to 2).
+        layout: how record paths are read (``read_record``'s ``layout``: a ``readers.Layout``, a
+            layout file or a dict of its fields, e.g. ``{"units": {"displacement": "mm"}}``).
+        accept: codes of warning-level checks acknowledged (``checks.CODES``).  The records are
+            checked against the start rig (a generic start: the rig-free checks only) before any
+            fit; an error-level check raises ``checks.CheckError`` (a ValueError).
     """
     if isinstance(max_nfev, bool) or not isinstance(max_nfev, (int, np.integer)) or max_nfev < 1:
         raise ValueError(f"invalid max_nfev = {max_nfev!r}: must be an integer >= 1")
     t_start = time.perf_counter()
-    recs, start, generic, keys, chans = _setup(records, rig, fit, mode, specimen, channels, dt)
+    check_accept(accept)
+    recs, start, generic, keys, chans = _setup(as_records(records, layout), rig, fit, mode, specimen, channels, dt)
+    found = gate(recs, None if generic else start, mode, dt, accept)
     coords = Coordinates.about(start, keys)
     runtime: dict[str, float] = {}
     z1, stage1_keys, nfev = np.zeros(len(keys)), [], {}
@@ -328,10 +339,10 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
     s1_vals = coords.values(z1)
     out_rig = coords.apply(start, final.z)
     t0 = time.perf_counter()
-    before = [compare(r, start, mode, simulated=simulate_record(start, r, mode, dt=dt, options=options))
+    before = [compare(r, start, mode, simulated=simulate_record(start, r, mode, dt=dt, options=options), check=False)
               for r in recs]
-    after = [compare(r, out_rig, mode, simulated=simulate_record(out_rig, r, mode, dt=dt, options=options))
-             for r in recs]
+    after = [compare(r, out_rig, mode, simulated=simulate_record(out_rig, r, mode, dt=dt, options=options),
+                     accept=accept, check=False) for r in recs]
     runtime["compare"] = time.perf_counter() - t0
     runtime["total"] = time.perf_counter() - t_start
     return Identification(
@@ -343,7 +354,7 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
                                                                    u["status"]),
         before=before, after=after, generic_start=generic, weights=weights, integrator=options.method.name.lower(),
         n_eff=float(u["n_eff"]), rho1=float(u["rho1"]), nfev=nfev, runtime_s=runtime, status=u["status"],
-        costs=costs, kept=kept)
+        costs=costs, kept=kept, checks=found + [c for a in after for c in a.checks])
 
 
 __all__ = ["Comparison", "Identification", "as_records", "identify", "key_status", "separability_flags",

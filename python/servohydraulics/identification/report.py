@@ -9,6 +9,18 @@ def _v(x) -> str:
     return "-" if x is None else f"{x:.5g}"
 
 
+def checks_markdown(checks) -> list[str]:
+    """The plausibility checks as a markdown section (nothing without checks)."""
+    if not checks:
+        return []
+    out = ["## Checks of the records and runs (docs/lab-records.md, 'Checks')", "",
+           "| level | code | file | channel | finding |", "|---|---|---|---|---|"]
+    for c in checks:
+        level = f"{c.level} (acknowledged)" if c.acknowledged else c.level
+        out.append(f"| {level} | `{c.code}` | {c.file} | {c.channel or '-'} | {c.message} |")
+    return out + [""]
+
+
 def identification_markdown(ident) -> str:
     d = ident.to_dict()
     start = "the generic rig scaled from the first record (docs/lab-records.md)" if ident.generic_start \
@@ -38,10 +50,8 @@ def identification_markdown(ident) -> str:
     for b, a in zip(ident.before, ident.after):
         for c in a.channels:
             lines.append(f"| {a.name} | {c} | {b.nrmse(c):.2f} | {a.nrmse(c):.2f} | "
-                         f"[overlay](overlay_{a.name}.png), [FRF](frf_{a.name}.png) |")
-    notes = [f"- {a.name}: {w}" for a in ident.after for w in a.warnings]
-    if notes:
-        lines += ["", "## Warnings of the identified rig's runs", "", *notes]
+                         + ", ".join(f"[{n}]({n}_{a.name}.png)" for n in a.figure_names()) + " |")
+    lines += [""] + checks_markdown(ident.checks)
     rt = ", ".join(f"{k} {v:.1f} s" for k, v in ident.runtime_s.items())
     lines += ["", f"Run time: {rt}; evaluations: {ident.nfev}.", ""]
     return "\n".join(lines)
