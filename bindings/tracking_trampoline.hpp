@@ -24,10 +24,12 @@
 #include <Python.h>
 
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <string>
 #include <utility>
 
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include "servohydraulics/rths/tracking.hpp"
@@ -153,8 +155,31 @@ class PythonControllerCalls {
     ++samples_;
     return failed_ ? std::numeric_limits<double>::quiet_NaN() : u;
   }
+  //! A multi-actuator command() through f, which returns the Python result: n floats written to u; NaN in
+  //! every u[i] once anything failed (multi_trampoline.hpp).
+  template <class F>
+  void command_into(F&& f, double* u, std::size_t n) noexcept {
+    for (std::size_t i = 0; i < n; ++i) u[i] = std::numeric_limits<double>::quiet_NaN();
+    if (failed_) return;
+    py::gil_scoped_acquire gil;
+    guarded("command", [&] { to_commands(f(), u, n); });
+    ++samples_;
+    if (failed_)
+      for (std::size_t i = 0; i < n; ++i) u[i] = std::numeric_limits<double>::quiet_NaN();
+  }
 
  private:
+  static void to_commands(const py::handle& r, double* u, std::size_t n) {
+    using Arr = py::array_t<double, py::array::c_style | py::array::forcecast>;
+    const bool numeric = py::isinstance<py::sequence>(r) || py::isinstance<py::array>(r);
+    Arr a = numeric ? Arr::ensure(r) : Arr();
+    if (!a || a.ndim() != 1 || static_cast<std::size_t>(a.size()) != n) {
+      PyErr_Clear();
+      throw py::type_error("command() returned " + py::repr(r).cast<std::string>().substr(0, 200) + ": expected " +
+                           std::to_string(n) + " floats, the actuator commands [m]");
+    }
+    for (std::size_t i = 0; i < n; ++i) u[i] = a.data()[i];
+  }
   static double to_command(const py::handle& r) {
     const double u = PyFloat_AsDouble(r.ptr());
     if (u == -1.0 && PyErr_Occurred()) {
