@@ -314,9 +314,13 @@ void expose_marths(py::module_& m) {
   py::class_<PassThrough, MultiTrackingController>(r, "PassThrough")
       .def(py::init<std::size_t>(), py::arg("actuators") = 2);
   py::class_<DecentralizedController, MultiTrackingController>(r, "DecentralizedController")
-      .def(py::init([](const std::vector<TrackingController*>& ch) { return new DecentralizedController(ch); }),
-           py::arg("channels"), py::keep_alive<1, 2>(),
-           "one single-actuator TrackingController per actuator (the list is kept alive with this object)");
+      .def(py::init([](const std::vector<TrackingController*>& ch, double dt) {
+             return new DecentralizedController(ch, dt);
+           }),
+           py::arg("channels"), py::arg("dt") = 0.0, py::keep_alive<1, 2>(),
+           "one single-actuator TrackingController per actuator (the list is kept alive with this object); dt > 0: "
+           "the targets' rates by backward differences at dt, 0: the loop's")
+      .def_property_readonly("dt", &DecentralizedController::dt);
   py::class_<MimoFeedforwardConfig>(r, "MimoFeedforwardConfig").def(py::init<>())
       .def_readwrite("dt", &MimoFeedforwardConfig::dt)
       .def_readwrite("coefficients", &MimoFeedforwardConfig::coefficients)

@@ -101,8 +101,15 @@ PassThrough::PassThrough(std::size_t actuators) : n_(actuators) {
   require(actuators >= 1 && actuators <= 8, "actuators", static_cast<double>(actuators), "1 to 8");
 }
 
-DecentralizedController::DecentralizedController(std::vector<TrackingController*> channels) : ch_(std::move(channels)) {
+DecentralizedController::DecentralizedController(std::vector<TrackingController*> channels, double dt)
+    : ch_(std::move(channels)), dt_(dt) {
   require(!ch_.empty() && ch_.size() <= 8, "decentralized.channels", static_cast<double>(ch_.size()), "1 to 8");
+  require(std::isfinite(dt) && dt >= 0.0, "decentralized.dt", dt, "finite and >= 0 [s] (0: the loop's rates)");
+  const double h = dt > 0.0 ? dt : 1.0;
+  for (std::size_t i = 0; i < ch_.size(); ++i) {
+    dv_.emplace_back(h);
+    da_.emplace_back(h);
+  }
   for (std::size_t i = 0; i < ch_.size(); ++i) {
     const std::string f = "decentralized.channels[" + std::to_string(i) + "]";
     require(ch_[i] != nullptr, f.c_str(), 0.0, "a tracking controller (not null)");
@@ -111,14 +118,23 @@ DecentralizedController::DecentralizedController(std::vector<TrackingController*
 
 void DecentralizedController::reset() noexcept {
   for (TrackingController* c : ch_) c->reset();
+  for (std::size_t i = 0; i < ch_.size(); ++i) {
+    dv_[i].reset();
+    da_[i].reset();
+  }
 }
 
 void DecentralizedController::command(const MultiTrackingInput& in, double* u) noexcept {
   for (std::size_t i = 0; i < ch_.size(); ++i) {
     TrackingInput t;
     t.desired = in.desired[i];
-    t.desired_velocity = in.desired_velocity ? in.desired_velocity[i] : 0.0;
-    t.desired_acceleration = in.desired_acceleration ? in.desired_acceleration[i] : 0.0;
+    if (dt_ > 0.0) {
+      t.desired_velocity = dv_[i](in.desired[i]);
+      t.desired_acceleration = da_[i](t.desired_velocity);
+    } else {
+      t.desired_velocity = in.desired_velocity ? in.desired_velocity[i] : 0.0;
+      t.desired_acceleration = in.desired_acceleration ? in.desired_acceleration[i] : 0.0;
+    }
     t.measured = in.measured[i];
     u[i] = ch_[i]->command(t);
   }
@@ -187,11 +203,9 @@ void MimoFeedforward::command(const MultiTrackingInput& in, double* u) noexcept 
   const std::size_t n = actuators();
   for (std::size_t i = 0; i < n; ++i) {
     const auto r = static_cast<Eigen::Index>(i);
-    const double v = dr_[i](in.desired[i]);  // the fallbacks, kept current either way
-    const double a = ddr_[i](v);
     deriv_(r, 0) = in.desired[i];
-    deriv_(r, 1) = in.desired_velocity ? in.desired_velocity[i] : v;
-    deriv_(r, 2) = in.desired_acceleration ? in.desired_acceleration[i] : a;
+    deriv_(r, 1) = dr_[i](deriv_(r, 0));
+    deriv_(r, 2) = ddr_[i](deriv_(r, 1));
     deriv_(r, 3) = dddr_[i](deriv_(r, 2));
   }
   out_.setZero();

@@ -108,7 +108,7 @@ def _inverse_series(data: MarthsData, i: int, order: int) -> list[float]:
 
 
 def _decentralized(data: MarthsData, make_one: Callable[[MarthsData, int], Any]) -> Any:
-    return R.DecentralizedController([make_one(data, i) for i in range(2)])
+    return R.DecentralizedController([make_one(data, i) for i in range(2)], DT)
 
 
 def _channel_sample(data: MarthsData, i: int) -> Any:
@@ -132,7 +132,7 @@ def _channel_polynomial(data: MarthsData, i: int) -> Any:
 def _channel_model(data: MarthsData, i: int) -> Any:
     cfg = TC.ModelBasedConfig()
     cfg.dt = DT
-    cfg.coefficients = _inverse_series(data, i, 3)
+    cfg.coefficients = _inverse_series(data, i, 2) + [0.0]  # the jerk term destabilises the loop
     cfg.pi = TC.PiGains(0.0, 0.0)
     _ideal_converters(cfg)
     return TC.ModelBasedCompensator(cfg)
@@ -165,9 +165,9 @@ CONTROLLERS: dict[str, tuple[Callable[[MarthsData], Any], str]] = {
                      "RoDeAC with P0 = 0: the fixed FIR compensator of Initial_parameters.mat (non-adaptive)"),
     "none": (lambda d: R.PassThrough(2), "no compensation: the command is the target"),
     "decentralized": (lambda d: _decentralized(d, _channel_model),
-                      "decentralized model-based feedforward: per actuator, the 3rd-order series of 1/H_ii(s)"),
+                      "decentralized model-based feedforward: per actuator, the 2nd-order series of 1/H_ii(s)"),
     "decentralized-model": (lambda d: _decentralized(d, _channel_model),
-                            "decentralized model-based feedforward: per actuator, the 3rd-order series of 1/H_ii(s)"),
+                            "decentralized model-based feedforward: per actuator, the 2nd-order series of 1/H_ii(s)"),
     "decentralized-polynomial": (lambda d: _decentralized(d, _channel_polynomial),
                                  "decentralized polynomial extrapolation (Horiuchi et al. 1999) over H_ii's delay"),
     "decentralized-ats": (lambda d: _decentralized(d, _channel_ats),

@@ -89,22 +89,29 @@ class PassThrough final : public MultiTrackingController {
 };
 
 //! One single-actuator compensator per actuator (not owned: they must outlive this object).  Each reads its
-//! target, the target's rates (0 when the loop gives none) and its measurement; no force is measured.
+//! target, the target's rates and its measurement; no force is measured.  The rates: with dt > 0 the backward
+//! differences of the target (first and second) at dt; with dt = 0 the loop's (0 when it gives none).
+//! In the maRTHS loop the numerical substructure's own acceleration responds within the sample to the measured
+//! noise (the feedback force's mass term is the second difference of the measurement), so a compensator that
+//! multiplies it closes a loop of gain ~1/dt^2 and diverges; the differences of the target do not.
 class DecentralizedController final : public MultiTrackingController {
  public:
-  explicit DecentralizedController(std::vector<TrackingController*> channels);
+  explicit DecentralizedController(std::vector<TrackingController*> channels, double dt = 0.0);
   std::size_t actuators() const noexcept override { return ch_.size(); }
   void reset() noexcept override;
   void command(const MultiTrackingInput& in, double* u) noexcept override;
   TrackingController& channel(std::size_t i) const noexcept { return *ch_[i]; }
+  double dt() const noexcept { return dt_; }
 
  private:
   std::vector<TrackingController*> ch_;
+  double dt_;
+  std::vector<BackwardDifference> dv_, da_;
 };
 
 struct MimoFeedforwardConfig {
   double dt = 1.0 / 1024.0;  //!< [s]
-  //! E_0 .. E_order (N x N): u = E_0 r + E_1 r' + E_2 r'' + E_3 r''' [s^m]
+  //! E_0 .. E_order (N x N): u = E_0 r + E_1 r' + E_2 r'' + E_3 r''' [s^m], the rates by backward differences
   std::vector<Eigen::MatrixXd> coefficients;
   PiGains pi{0.0, 0.0};  //!< feedback on each actuator's tracking error (0, 0: feedforward only)
   void validate() const;
@@ -113,8 +120,10 @@ struct MimoFeedforwardConfig {
   static MimoFeedforwardConfig from_plant(const StateSpace& plant, int order = 2, double dt = 1.0 / 1024.0);
 };
 
-//! u = sum_m E_m r^(m) + PI(r - x_m).  r' and r'' are the loop's target rates (backward differences of the
-//! target when the loop gives none); r''' the backward difference of r''.
+//! u = sum_m E_m D^m r + PI(r - x_m), D the backward difference at dt: an FIR on the target's last taps (as
+//! RoDeAC's), coupled across the actuators.  Not the loop's target rates: the numerical substructure's
+//! acceleration carries the measured noise of the same sample with a gain ~1/dt^2 (DecentralizedController).
+//! Order 2 is the default: order 3 (the jerk) destabilises the benchmark's loop (docs/marths-benchmark.md).
 class MimoFeedforward final : public MultiTrackingController {
  public:
   explicit MimoFeedforward(const MimoFeedforwardConfig& config);
