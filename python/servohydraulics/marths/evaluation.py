@@ -38,25 +38,29 @@ SATURATION_LIMIT = 3.8
 
 
 def finddelay(x: np.ndarray, y: np.ndarray) -> int:
-    """MATLAB's ``finddelay(x, y)`` for two vectors of one length: the lag L (samples, positive when y lags
-    x) maximising |sum_n y(n + L) x(n)| / sqrt(sum x^2 sum y^2) over all lags, the smallest |L| among equal
-    maxima (the positive one on a tie of |L|); 0 when a signal is zero or the largest normalised correlation
-    is below 1e-8 (finddelay's threshold for FFT round-off)."""
+    """MATLAB's ``finddelay(x, y)`` for two vectors: the lag L (samples, positive when y lags x) maximising
+    |sum_n y(n + L) x(n)| / sqrt(sum x^2 sum y^2) over all lags (the shorter vector padded with zeros, as
+    ``xcorr``), the smallest |L| among equal maxima (equal to 1e-12, the FFT's round-off), the positive one on a
+    tie of |L|; 0 when a signal is zero or the largest normalised correlation is below 1e-8 (finddelay's
+    threshold for FFT round-off)."""
     x = np.asarray(x, dtype=float).ravel()
     y = np.asarray(y, dtype=float).ravel()
-    if x.size != y.size or x.size == 0:
-        raise ValueError(f"invalid signals: lengths {x.size} and {y.size}, expected one nonzero length")
+    if x.size == 0 or y.size == 0:
+        raise ValueError(f"invalid signals: lengths {x.size} and {y.size}, expected nonzero lengths")
+    n = max(x.size, y.size)
+    x = np.concatenate([x, np.zeros(n - x.size)])
+    y = np.concatenate([y, np.zeros(n - y.size)])
     nx, ny = float(np.dot(x, x)), float(np.dot(y, y))
     if nx == 0.0 or ny == 0.0:
         return 0
     from scipy import signal
 
     c = np.abs(signal.correlate(y, x, mode="full", method="fft")) / math.sqrt(nx * ny)
-    lags = np.arange(-(x.size - 1), x.size)
+    lags = np.arange(-(n - 1), n)
     best = float(np.max(c))
     if best < 1e-8:
         return 0
-    cand = lags[c == best]
+    cand = lags[c >= best * (1.0 - 1e-12)]
     order = np.lexsort((-cand, np.abs(cand)))  # smallest |L|, then the positive one
     return int(cand[order[0]])
 
