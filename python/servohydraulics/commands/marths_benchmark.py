@@ -5,7 +5,8 @@ from __future__ import annotations
 
 
 def _run(args) -> int:
-    from ..marths.report import check_perturbed, j_table, run_benchmark, write_outputs
+    from ..atomic import check_folder
+    from ..marths.report import check_perturbed, execute, j_table, prepare, write_outputs
     from ..workers import check_workers
 
     if args.workers is not None:
@@ -13,9 +14,11 @@ def _run(args) -> int:
     perturbed = check_perturbed(args.perturbed, "--perturbed")
     if args.seed < 0:
         raise ValueError(f"invalid --seed = {args.seed}: expected a whole number >= 0")
-    run = run_benchmark(args.data, args.record, args.controller, perturbed, args.seed, workers=args.workers,
-                        progress=not args.quiet, daq_quantizer=args.daq_quantizer, daq_saturation=args.daq_saturation,
-                        exact_kinematics=args.exact_kinematics)
+    setup = prepare(args.data, args.record, args.controller, perturbed, args.seed, workers=args.workers,
+                    daq_quantizer=args.daq_quantizer, daq_saturation=args.daq_saturation,
+                    exact_kinematics=args.exact_kinematics)  # every input validated: nothing written yet
+    check_folder(args.out)  # a folder that cannot hold the results fails before the runs
+    run = execute(setup, progress=not args.quiet)
     out = write_outputs(run, args.out)
     print(j_table(run["results"]))
     nom = run["results"]["runs"]["nominal"]

@@ -36,7 +36,7 @@ from .benchmark import (
 )
 from .data import DT, EQ_INTENSITY, FILES, FS, RECORDS, MarthsData, load_data, load_record
 from .evaluation import J_COMPONENTS, J_TITLES, J_UNITS, SATURATION_LIMIT, evaluate, finddelay, realizable
-from .report import check_perturbed, j_table, run_benchmark, write_outputs
+from .report import Setup, check_perturbed, execute, j_table, prepare, run_benchmark, write_outputs
 
 core = _core.marths
 #: The multi-actuator controller interface: subclass it in Python (super().__init__(2)), or give any object
@@ -51,6 +51,7 @@ __all__ = [
     "mimo_feedforward_config", "nominal_plant", "noise_seed", "perturbed_model", "perturbed_plant", "plant_model",
     "rodeac_config", "run_trial", "samples", "structures", "DT", "EQ_INTENSITY", "FILES", "FS", "RECORDS",
     "MarthsData", "load_data", "load_record", "J_COMPONENTS", "J_TITLES", "J_UNITS", "SATURATION_LIMIT", "evaluate",
-    "finddelay", "realizable", "check_perturbed", "j_table", "run_benchmark", "write_outputs", "core",
+    "finddelay", "realizable", "check_perturbed", "j_table", "run_benchmark", "write_outputs", "core", "Setup",
+    "prepare", "execute",
     "MultiTrackingController", "MultiActuatorSystem",
 ]

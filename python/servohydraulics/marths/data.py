@@ -52,6 +52,8 @@ FILES = {
     "dofs": FE / "Joint_DOF.xlsx",
 }
 
+#: The FE model's least size: the benchmark reads and loads DOFs up to 29 (MarthsDofs).
+MIN_DOFS = 29
 #: Relative asymmetry a structural matrix may have (the SAP2000 export is symmetric to the last bit).
 SYMMETRY_RTOL = 1e-9
 
@@ -123,8 +125,8 @@ def _plant(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         raise ValueError(f"{path}: D must be 2 x 2, got shape {D.shape}")
     if np.any(D != 0):
         i, j = np.argwhere(D != 0)[0]
-        raise ValueError(f"{path}: D[{i + 1},{j + 1}] = {D[i, j]!r}: must be 0 (the identified plant is strictly "
-                         "proper)")
+        raise ValueError(f"{path}: D[{i + 1},{j + 1}] = {float(D[i, j])!r}: must be 0 (the identified plant is "
+                         "strictly proper)")
     eig = np.linalg.eigvals(A)
     worst = eig[np.argmax(eig.real)]
     if not worst.real < 0:
@@ -192,6 +194,9 @@ def _structure(path: Path, name: str, size: int | None) -> np.ndarray:
         raise ValueError(f"{path}: {name} must be square, got shape {a.shape}")
     if size is not None and a.shape[0] != size:
         raise ValueError(f"{path}: {name} must be {size} x {size} (the size of K), got shape {a.shape}")
+    if a.shape[0] < MIN_DOFS:
+        raise ValueError(f"{path}: {name} must be at least {MIN_DOFS} x {MIN_DOFS} (the benchmark reads and loads "
+                         f"DOFs up to {MIN_DOFS}), got shape {a.shape}")
     _symmetric(a, f"{path}: {name}")
     low = float(np.min(np.linalg.eigvalsh(a)))
     tol = 1e-12 * float(np.max(np.abs(a)))

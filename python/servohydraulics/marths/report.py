@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -27,7 +28,7 @@ from .benchmark import (
 from .data import EQ_INTENSITY, FS, RECORDS, MarthsData, load_data, load_record
 from .evaluation import J_COMPONENTS, J_TITLES, J_UNITS, SATURATION_LIMIT
 
-__all__ = ["run_benchmark", "write_outputs", "j_table", "check_perturbed"]
+__all__ = ["Setup", "prepare", "execute", "run_benchmark", "write_outputs", "j_table", "check_perturbed"]
 
 
 def check_perturbed(value: Any, name: str = "perturbed") -> int:
@@ -62,6 +63,46 @@ def _round(J: dict[str, list[float]]) -> dict[str, list[float]]:
     return {j: [matlab_round(10.0 * v) / 10.0 if math.isfinite(v) else v for v in vals] for j, vals in J.items()}
 
 
+@dataclass
+class Setup:
+    """A validated benchmark run, before any trial (:func:`prepare`)."""
+    data: MarthsData
+    record: Any
+    controller: Any        #: the name / "module:Class" as given, or the controller object
+    built: Any             #: the nominal trial's controller object
+    name: str
+    description: str
+    perturbed: int
+    seed: int
+    scale: float
+    workers: int
+    options: dict[str, bool]
+    folder: Path
+
+
+def prepare(data: str | Path, record: str = "elcentro", controller: Any = "rodeac", perturbed: Any = 0,
+            seed: int = NOMINAL_SEED, scale: float = EQ_INTENSITY, workers: int | None = None,
+            daq_quantizer: bool = False, daq_saturation: bool = False, exact_kinematics: bool = False) -> Setup:
+    """Validates every argument and input file (ValueError naming the field or the file and the value) and
+    builds the nominal controller, before anything runs or is written."""
+    n_pert = check_perturbed(perturbed)
+    if record not in RECORDS:
+        raise ValueError(f"invalid record = {record!r}: expected one of {sorted(RECORDS)}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"invalid seed = {seed!r}: expected a whole number >= 0")
+    if not (isinstance(scale, (int, float)) and math.isfinite(scale)):
+        raise ValueError(f"invalid scale = {scale!r}: expected a finite number")
+    workers = default_workers() if workers is None else check_workers(workers, "workers")
+    d = load_data(data)
+    rec = load_record(data, record)
+    name, description = controller_label(controller)
+    built = make_controller(controller, d) if isinstance(controller, str) else controller
+    options = {"daq_quantizer": bool(daq_quantizer), "daq_saturation": bool(daq_saturation),
+               "exact_kinematics": bool(exact_kinematics)}
+    return Setup(d, rec, controller, built, name, description, n_pert, int(seed), float(scale), workers, options,
+                 Path(data))
+
+
 def run_benchmark(data: str | Path, record: str = "elcentro", controller: Any = "rodeac", perturbed: Any = 0,
                   seed: int = NOMINAL_SEED, scale: float = EQ_INTENSITY, workers: int | None = None,
                   progress: bool = True, daq_quantizer: bool = False, daq_saturation: bool = False,
@@ -70,56 +111,51 @@ def run_benchmark(data: str | Path, record: str = "elcentro", controller: Any = 
     (plants and noise seeded from ``seed`` and the trial number) of one record and controller.
 
     ``controller``: a built-in name, ``"module:Class"`` or a controller object (its perturbed trials then run
-    here, one after another).  Everything is validated before the first run.  Returns ``{"results": <the
-    results.json content>, "trial": the nominal Trial (signals kept), "table": DataFrame of the perturbed
-    trials or None}``.
+    here, one after another).  Everything is validated before the first run (:func:`prepare`).  Returns
+    ``{"results": <the results.json content>, "trial": the nominal Trial (signals kept), "table": DataFrame of
+    the perturbed trials or None}``.
     """
-    n_pert = check_perturbed(perturbed)
-    if record not in RECORDS:
-        raise ValueError(f"invalid record = {record!r}: expected one of {sorted(RECORDS)}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ValueError(f"invalid seed = {seed!r}: expected a whole number >= 0")
-    workers = default_workers() if workers is None else check_workers(workers, "workers")
-    d = load_data(data)
-    rec = load_record(data, record)
-    name, description = controller_label(controller)
-    ctrl = make_controller(controller, d) if isinstance(controller, str) else controller  # a bad name fails here
-    options = {"daq_quantizer": bool(daq_quantizer), "daq_saturation": bool(daq_saturation),
-               "exact_kinematics": bool(exact_kinematics)}
-    st = structures(d)
-    nom = run_trial(d, rec, ctrl, seed=seed, scale=scale, config=loop_config(**options), structures_=st,
-                    keep_signals=True)
+    return execute(prepare(data, record, controller, perturbed, seed, scale, workers, daq_quantizer, daq_saturation,
+                           exact_kinematics), progress)
+
+
+def execute(setup: Setup, progress: bool = True) -> dict[str, Any]:
+    """Runs a prepared benchmark (:func:`prepare`)."""
+    s = setup
+    st = structures(s.data)
+    nom = run_trial(s.data, s.record, s.built, seed=s.seed, scale=s.scale, config=loop_config(**s.options),
+                    structures_=st, keep_signals=True)
     runs: dict[str, Any] = {"nominal": {
         "J": nom.J, "J_rounded": _round(nom.J), "realizable": nom.realizable, "peak_voltage_V": nom.peak_voltage,
-        "ok": nom.ok, "failure_time": nom.failure_time, "noise_seed": int(seed), "wall_time_s": nom.wall_time}}
+        "ok": nom.ok, "failure_time": nom.failure_time, "noise_seed": s.seed, "wall_time_s": nom.wall_time}}
     table = None
-    if n_pert > 0:
+    if s.perturbed > 0:
         from ..parameter_sweep import sweep
 
-        parallel = isinstance(controller, str)
-        own = None
+        parallel = isinstance(s.controller, str)
         if parallel:
-            executor = own = process_pool(min(workers, n_pert), "workers")
-        else:
+            executor = process_pool(min(s.workers, s.perturbed), "workers")
+        else:  # a controller object cannot go to worker processes: its trials run here, one after another
             from concurrent.futures import ThreadPoolExecutor
-            executor = own = ThreadPoolExecutor(max_workers=1)
+            executor = ThreadPoolExecutor(max_workers=1)
         try:
-            table = sweep(grid={"trial": list(range(1, n_pert + 1))}, run=_perturbed_job,
-                          fixed={"data": d, "record": rec, "controller": controller if parallel else ctrl,
-                                 "seed": int(seed), "scale": scale, "config": options},
+            ctrl = s.controller if parallel else s.built
+            table = sweep(grid={"trial": list(range(1, s.perturbed + 1))}, run=_perturbed_job,
+                          fixed={"data": s.data, "record": s.record, "controller": ctrl, "seed": s.seed,
+                                 "scale": s.scale, "config": s.options},
                           executor=executor, progress=progress)
         finally:
-            if own is not None:
-                own.shutdown(wait=True)
+            executor.shutdown(wait=True)
         table = table.drop(columns=["data", "record", "controller", "config"])
         if "error" in table.columns and table["error"].notna().any():
             raise RuntimeError(f"perturbed trial failed: {table['error'].dropna().iloc[0]}")
-        runs["perturbed"] = _statistics(table, n_pert)
+        runs["perturbed"] = _statistics(table, s.perturbed)
     meta = {"benchmark": "virtual multi-axial RTHS (maRTHS), Condori Uribe et al. 2023; RoDeAC: Quiroz et al. 2024",
-            "data": str(Path(data)), "record": rec.name, "record_source": rec.source, "eq_intensity": scale,
-            "fs_Hz": FS, "samples": int(rec.samples(FS)), "controller": name, "controller_description": description,
-            "seed": int(seed), "noise": "Simulink Random Number block algorithm, one sequence on both channels",
-            "perturbed_runs": n_pert, **options, "saturation_limit_V": SATURATION_LIMIT,
+            "data": str(s.folder), "record": s.record.name, "record_source": s.record.source,
+            "eq_intensity": s.scale, "fs_Hz": FS, "samples": int(s.record.samples(FS)), "controller": s.name,
+            "controller_description": s.description, "seed": s.seed,
+            "noise": "Simulink Random Number block algorithm, one sequence on both channels",
+            "perturbed_runs": s.perturbed, **s.options, "saturation_limit_V": SATURATION_LIMIT,
             "J_components": {j: list(c) for j, c in J_COMPONENTS.items()}, "J_units": J_UNITS, "J_titles": J_TITLES}
     return {"results": {"meta": meta, "runs": runs}, "trial": nom, "table": table}
 
