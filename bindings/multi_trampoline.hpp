@@ -99,10 +99,7 @@ class PythonMultiController final : public MultiTrackingController, public Pytho
   PythonMultiController(py::object obj, std::size_t actuators) : obj_(std::move(obj)), n_(actuators) {
     if (actuators < 1 || actuators > 8)
       throw py::value_error("invalid actuators = " + std::to_string(actuators) + ": 1 to 8");
-    std::string missing;
-    for (const char* name : {"reset", "command"})
-      if (!py::hasattr(obj_, name) || !PyCallable_Check(obj_.attr(name).ptr()))
-        missing += std::string(missing.empty() ? "" : ", ") + name + "()";
+    const std::string missing = missing_members(obj_, {"reset", "command"});
     if (!missing.empty())
       throw py::type_error("invalid controller = " + py::repr(obj_).cast<std::string>() +
                            ": not a multi-actuator controller, it lacks " + missing +
@@ -142,12 +139,7 @@ inline void raise_multi_controller_error(const MultiTrackingController& c, doubl
 class PythonMultiActuatorSystem final : public MultiActuatorSystem {
  public:
   explicit PythonMultiActuatorSystem(py::object obj) : obj_(std::move(obj)) {
-    std::string missing;
-    for (const char* name : {"reset", "displacements", "step"})
-      if (!py::hasattr(obj_, name) || !PyCallable_Check(obj_.attr(name).ptr()))
-        missing += std::string(missing.empty() ? "" : ", ") + name + "()";
-    for (const char* name : {"actuators", "dt"})
-      if (!py::hasattr(obj_, name)) missing += std::string(missing.empty() ? "" : ", ") + name;
+    const std::string missing = missing_members(obj_, {"reset", "displacements", "step"}, {"actuators", "dt"});
     if (!missing.empty())
       throw py::type_error("invalid plant = " + py::repr(obj_).cast<std::string>() +
                            ": not a multi-actuator system, it lacks " + missing);

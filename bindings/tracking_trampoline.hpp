@@ -25,6 +25,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <initializer_list>
 #include <limits>
 #include <string>
 #include <utility>
@@ -99,6 +100,19 @@ struct CommandSignature {
     return py::reinterpret_steal<py::object>(r);
   }
 };
+
+//! The names of the callable methods (written "name()") and the attributes (written "name") that obj lacks,
+//! comma-separated ("" when it has them all): the check of every Python object that stands in for a C++ one.
+inline std::string missing_members(const py::handle& obj, std::initializer_list<const char*> methods,
+                                   std::initializer_list<const char*> attributes = {}) {
+  std::string missing;
+  for (const char* name : methods)
+    if (!py::hasattr(obj, name) || !PyCallable_Check(obj.attr(name).ptr()))
+      missing += std::string(missing.empty() ? "" : ", ") + name + "()";
+  for (const char* name : attributes)
+    if (!py::hasattr(obj, name)) missing += std::string(missing.empty() ? "" : ", ") + name;
+  return missing;
+}
 
 //! The call discipline shared by the two Python controllers: GIL, error capture, sample count.
 class PythonControllerCalls {
@@ -268,10 +282,7 @@ class PyTrackingController : public rths::TrackingController, public PythonContr
 class PythonTrackingController final : public rths::TrackingController, public PythonControllerCalls {
  public:
   explicit PythonTrackingController(py::object obj) : obj_(std::move(obj)) {
-    std::string missing;
-    for (const char* name : {"reset", "command"})
-      if (!py::hasattr(obj_, name) || !PyCallable_Check(obj_.attr(name).ptr()))
-        missing += std::string(missing.empty() ? "" : ", ") + name + "()";
+    const std::string missing = missing_members(obj_, {"reset", "command"});
     if (!missing.empty())
       throw py::type_error("invalid controller = " + py::repr(obj_).cast<std::string>() +
                            ": not a tracking controller, it lacks " + missing +

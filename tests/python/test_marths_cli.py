@@ -53,6 +53,7 @@ def test_the_command_writes_results_report_and_plots(folder, tmp_path, capsys):
     assert nom["J_rounded"]["J2"][0] == round(nom["J"]["J2"][0], 1)
     p = res["runs"]["perturbed"]
     assert p["runs"] == 2 and len(p["trials"]) == 2 and set(p["J_mean"]) == set(nom["J"])
+    assert nom["stable"] is True and p["stable"] == 2 and p["ran_to_end"] == 2
     assert res["meta"]["record"] == "morgan" and res["meta"]["seed"] == 123
     report = (out / "report.md").read_text()
     assert report.startswith("# Multi-axial RTHS benchmark (maRTHS): morgan")

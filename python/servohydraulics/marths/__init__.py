@@ -18,6 +18,7 @@ from .. import _core
 from .benchmark import (
     CONTROLLERS,
     NOMINAL_SEED,
+    STABLE_J2_PCT,
     Trial,
     as_controller,
     controller_label,
@@ -47,7 +48,8 @@ MultiTrackingController = _core.MultiTrackingController
 MultiActuatorSystem = _core.MultiActuatorSystem
 
 __all__ = [
-    "CONTROLLERS", "NOMINAL_SEED", "Trial", "as_controller", "controller_label", "loop_config", "make_controller",
+    "CONTROLLERS", "NOMINAL_SEED", "STABLE_J2_PCT", "Trial", "as_controller", "controller_label", "loop_config",
+    "make_controller",
     "mimo_feedforward_config", "nominal_plant", "noise_seed", "perturbed_model", "perturbed_plant", "plant_model",
     "rodeac_config", "run_trial", "samples", "structures", "DT", "EQ_INTENSITY", "FILES", "FS", "RECORDS",
     "MarthsData", "load_data", "load_record", "J_COMPONENTS", "J_TITLES", "J_UNITS", "SATURATION_LIMIT", "evaluate",

@@ -26,6 +26,8 @@ __all__ = ["CONTROLLERS", "NOMINAL_SEED", "Trial", "structures", "plant_model", 
 
 #: The noise seed of the nominal trial (S1_Input_Data.m: rng(123)).
 NOMINAL_SEED = 123
+#: A trial is stable when it ran to the end with J2 below this on both actuators [%] (Trial.stable).
+STABLE_J2_PCT = 100.0
 
 
 # ----------------------------------------------------------------------------- the model
@@ -249,6 +251,12 @@ class Trial:
     def realizable(self) -> bool:
         """S5's rule on this trial's peak voltages."""
         return realizable(self.peak_voltage)
+
+    @property
+    def stable(self) -> bool:
+        """Ran to the end with both actuators' tracking errors smaller than their targets (J2 < 100 %): a loop that
+        diverges can still run to the end in floating point (the 3rd-order MIMO feedforward did, at 1e4 %)."""
+        return self.ok and all(math.isfinite(v) and v < STABLE_J2_PCT for v in self.J["J2"])
 
 
 def samples(record: Record) -> int:

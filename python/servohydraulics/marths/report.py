@@ -55,7 +55,8 @@ def _perturbed_job(rig, trial: int, data: MarthsData, record, controller: str, s
     """One perturbed trial in a sweep worker (the rig argument of sh.sweep is unused)."""
     t = run_trial(data, record, controller, plant=perturbed_plant(seed, trial), seed=noise_seed(seed, trial),
                   scale=scale, config=loop_config(**config))
-    return {**_flat(t.J), "ok": t.ok, "failure_time": t.failure_time, "peak_voltage_1": t.peak_voltage[0],
+    return {**_flat(t.J), "ok": t.ok, "stable": t.stable, "failure_time": t.failure_time,
+            "peak_voltage_1": t.peak_voltage[0],
             "peak_voltage_2": t.peak_voltage[1], "realizable": t.realizable, "wall_time": t.wall_time}
 
 
@@ -127,7 +128,8 @@ def execute(setup: Setup, progress: bool = True) -> dict[str, Any]:
                     structures_=st, keep_signals=True)
     runs: dict[str, Any] = {"nominal": {
         "J": nom.J, "J_rounded": _round(nom.J), "realizable": nom.realizable, "peak_voltage_V": nom.peak_voltage,
-        "ok": nom.ok, "failure_time": nom.failure_time, "noise_seed": s.seed, "wall_time_s": nom.wall_time}}
+        "ok": nom.ok, "stable": nom.stable, "failure_time": nom.failure_time, "noise_seed": s.seed,
+        "wall_time_s": nom.wall_time}}
     table = None
     if s.perturbed > 0:
         from ..parameter_sweep import sweep
@@ -171,7 +173,7 @@ def _statistics(table, n: int) -> dict[str, Any]:
             "J_mean": mean, "J_mean_rounded": _round(mean),
             "J_std": per_j(lambda v: np.std(v, ddof=1) if v.size > 1 else 0.0),
             "J_min": per_j(np.min), "J_max": per_j(np.max),
-            "ran_to_end": int(table["ok"].sum()),
+            "ran_to_end": int(table["ok"].sum()), "stable": int(table["stable"].sum()),
             # S5: only the last trial decides the final message, as coded; all trials are listed too
             "realizable": real[-1], "realizable_all": all(real),
             "not_realizable_trials": [int(t) for t, ok in zip(table["trial"], real) if not ok],
@@ -294,13 +296,16 @@ def _report(res: dict[str, Any], plots: list[str]) -> str:
              j_table(res), ""]
     if not nom["ok"]:
         lines += [f"**The nominal trial failed at t = {nom['failure_time']:.4f} s.**", ""]
+    elif not nom["stable"]:
+        lines += ["**The nominal trial is not stable: a tracking error (J2) is 100 % of its target or more.**", ""]
     v1, v2 = nom["peak_voltage_V"]
     lines += [f"Peak command voltages (nominal): {v1:.3f} V, {v2:.3f} V; the controller is "
               f"{'realizable' if nom['realizable'] else 'NOT realizable'} (not realizable when both exceed "
               f"{meta['saturation_limit_V']} V)."]
     if "perturbed" in runs:
         p = runs["perturbed"]
-        lines += [f"Perturbed trials: {p['ran_to_end']} of {p['runs']} ran to the end; realizable as S5 decides "
+        lines += [f"Perturbed trials: {p['ran_to_end']} of {p['runs']} ran to the end, {p['stable']} stable "
+                  "(J2 < 100 %); realizable as S5 decides "
                   f"(the last trial): {'yes' if p['realizable'] else 'no'}; trials not realizable: "
                   f"{p['not_realizable_trials'] or 'none'}."]
     lines += [""] + [f"![{Path(n).stem}]({n})" for n in plots] + [""]
