@@ -13,6 +13,7 @@ void expose_linearize(py::module_& m);
 void expose_compensators(py::module_& m);
 void expose_loops(py::module_& m);
 void expose_rths(py::module_& m);
+void expose_marths(py::module_& m);
 void expose_fmu(py::module_& m);
 void expose_realtime(py::module_& m);
 
@@ -29,6 +30,7 @@ PYBIND11_MODULE(_core, m) {
   expose_compensators(m);
   expose_loops(m);
   expose_rths(m);
+  expose_marths(m);
   expose_fmu(m);
   expose_realtime(m);
 }

@@ -34,7 +34,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from .rig import Rig
 
-KINDS = ("plant", "eft", "rpsd", "tracking", "record", "rths")
+KINDS = ("plant", "eft", "rpsd", "tracking", "record", "rths", "marths")
 
 #: Columns a record file must have (the diagnosis needs them).
 REQUIRED = ("time", "command", "displacement", "force")
@@ -64,12 +64,15 @@ def channel_units(kind: str = "record", mode: str | None = None) -> dict[str, st
     channels, the flags and the method's channels.  ``"record"``: the union of
     all of them (what a record file may hold).  ``"rths"``: the RTHS loop's
     channels (``_core.rths.RTHS_CHANNELS``) and its optional ``step_seconds``
-    (the per-DOF channels of a trial carry their units with them: ``rths.Trial``).
+    (the per-DOF channels of a trial carry their units with them: ``rths.Trial``); ``"marths"``:
+    the maRTHS loop's (``_core.marths.MARTHS_CHANNELS``) and ``step_seconds``.
     """
     if kind not in KINDS:
         raise ValueError(f"invalid kind = {kind!r}: expected one of {list(KINDS)}")
     if kind == "rths":
         return {**dict(map(tuple, _core.rths.RTHS_CHANNELS)), "step_seconds": "s"}
+    if kind == "marths":
+        return {**dict(map(tuple, _core.marths.MARTHS_CHANNELS)), "step_seconds": "s"}
     plant, eft, rpsd = _core_tables()
     out = dict(plant)
     if kind in ("plant", "tracking", "record"):
@@ -357,7 +360,7 @@ class Response:
 
 
 _LABELS = {"plant": "simulation", "eft": "EFT", "rpsd": "RPsD", "tracking": "tracking", "record": "record",
-           "rths": "RTHS"}
+           "rths": "RTHS", "marths": "maRTHS"}
 
 
 def _failure_message(kind: str, status: SimpleNamespace) -> str:
