@@ -15,6 +15,7 @@ void expose_loops(py::module_& m);
 void expose_rths(py::module_& m);
 void expose_fmu(py::module_& m);
 void expose_realtime(py::module_& m);
+void expose_multi_rig(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "C++ core of servohydraulics (SUNDIALS CVODE, Eigen)";
@@ -31,4 +32,5 @@ PYBIND11_MODULE(_core, m) {
   expose_rths(m);
   expose_fmu(m);
   expose_realtime(m);
+  expose_multi_rig(m);
 }
