@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike
 from . import _core
 from .atomic import FileSet
 from .response import Response, finish, limit_warnings, solver_warnings
-from .rig import Rig, load_rig, rig_from_dict, rig_to_dict, zhao2003
+from .rig import Rig, copy_rig, load_rig, rig_from_dict, rig_to_dict, zhao2003
 from .simulate import _check_dt, solver_options
 
 if sys.version_info >= (3, 11):
@@ -48,6 +48,9 @@ NODE_CHANNELS = dict(map(tuple, _core.NODE_CHANNELS))
 #: The maRTHS benchmark's coupler (BENCHMARK.md section 6): arm length [m] and angles [rad].
 MARTHS_ARM = math.hypot(0.2667, 0.127)
 MARTHS_ANGLES = (-math.radians(25.4633), math.radians(25.4633))
+
+#: The frames a rig file or MultiActuatorRig names: name -> marths_frame's reduction.
+FRAMES = {"marths": "guyan", "marths_static": "static"}
 
 #: The committed rig files (the calibrated two-actuator maRTHS rig, docs/multi-actuator.md).
 RIG_FILES = Path(__file__).parent / "rig_files"
@@ -163,14 +166,22 @@ class MultiActuatorRig:
         arms: arm lengths d_i [m] from the node to actuator i's attachment.
         angles: arm angles alpha_i [rad] from the actuator axis (stroke
             ``s_i = x + d_i (cos(theta + alpha_i) - cos(alpha_i))``).
-        specimen: a :func:`node_specimen` (or the dict of :func:`marths_frame` with ``M``, ``C``, ``K``).
+        specimen: a :func:`node_specimen`, a dict with ``M``, ``C``, ``K`` (as :func:`marths_frame` returns),
+            or a frame's name: ``"marths"`` (``marths_frame()``) or ``"marths_static"``
+            (``marths_frame("static")``), which a rig file keeps by name.
 
     ``core`` is the validated ``_core.MultiRig``; construction raises ValueError naming a bad field
     (``actuators[1].K_v``, ``specimen.K[0][1]``, ...).
     """
 
     def __init__(self, rigs: Sequence[Rig], arms: Sequence[float], angles: Sequence[float],
-                 specimen: _core.NodeSpecimen | dict[str, ArrayLike]):
+                 specimen: _core.NodeSpecimen | dict[str, ArrayLike] | str):
+        self.frame = None
+        if isinstance(specimen, str):
+            if specimen not in FRAMES:
+                raise ValueError(f"invalid specimen = {specimen!r}: expected a frame name {list(FRAMES)}, a "
+                                 "NodeSpecimen or a dict of M, C, K")
+            self.frame, specimen = specimen, marths_frame(FRAMES[specimen])
         if isinstance(specimen, dict):
             specimen = node_specimen(**specimen)
         self.rigs = [r for r in rigs]
@@ -188,6 +199,12 @@ class MultiActuatorRig:
         return (f"MultiActuatorRig(actuators={self.actuators}, arms={self.arms}, angles={self.angles}, "
                 f"rotation={self.specimen.rotation}, states={self.core.num_states})")
 
+    def specimen_matrix(self, name: str) -> np.ndarray:
+        """The specimen's ``"M"``, ``"C"`` or ``"K"`` as a 2 x 2 array (the fixture's mass not included)."""
+        if name not in ("M", "C", "K"):
+            raise ValueError(f"invalid name = {name!r}: expected 'M', 'C' or 'K'")
+        return np.reshape(getattr(self.specimen, name), (2, 2))
+
     def make_plant(self, dt: float, options: _core.SolverOptions | None = None) -> _core.MultiRigPlant:
         """The rig stepped at the loop's sample time ``dt`` [s] (a ``MultiActuatorSystem``: ``reset()``,
         ``displacements()`` [m], ``step(u)`` with the N commands [m], ``observe()``); ``options`` from
@@ -200,10 +217,23 @@ class MultiActuatorRig:
         u = np.zeros(self.actuators) if u0 is None else np.asarray(u0, dtype=float)
         return self.core.linearize(self.core.rest(), u)
 
-    def frequency_response(self, frequencies: ArrayLike, u0: ArrayLike | None = None) -> np.ndarray:
+    def frequency_response(self, frequencies: ArrayLike, u0: ArrayLike | None = None,
+                           friction: bool = False) -> np.ndarray:
         """The linearised rig's command -> stroke frequency response at ``frequencies`` [Hz]:
-        complex array (n_f, N, N), entry [k, i, j] from command j to stroke i [m/m]."""
-        A, B, C = self.linearize(u0)
+        complex array (n_f, N, N), entry [k, i, j] from command j to stroke i [m/m].  The pistons'
+        friction is left out unless ``friction``: linearised at rest it is the regularisation's slope
+        F_c / v_stick, a stiff damper that a sliding piston never feels.  States without dynamics here
+        (a zero row and column of A and a zero row of B: the bristle without LuGre, the spool without
+        valve dynamics) are dropped, so that 0 Hz is defined."""
+        rig = self
+        if not friction and any(r.effects.coulomb_friction for r in self.rigs):
+            rigs = [copy_rig(r) for r in self.rigs]
+            for r in rigs:
+                r.effects.coulomb_friction = False
+            rig = MultiActuatorRig(rigs, self.arms, self.angles, self.specimen)
+        A, B, C = rig.linearize(u0)
+        keep = np.any(A != 0, axis=1) | np.any(A != 0, axis=0) | np.any(B != 0, axis=1)
+        A, B, C = A[np.ix_(keep, keep)], B[keep], C[:, keep]
         f = np.atleast_1d(np.asarray(frequencies, dtype=float))
         eye = np.eye(A.shape[0])
         return np.stack([C @ np.linalg.solve(2j * np.pi * fk * eye - A, B) for fk in f])
@@ -212,10 +242,11 @@ class MultiActuatorRig:
         """The layout of a multi-actuator rig file (``rig_files``: the actuators' file names to refer to;
         else their parameters inline)."""
         sp = self.specimen
+        matrices: dict[str, Any] = ({"frame": self.frame} if self.frame is not None else
+                                    {k: self.specimen_matrix(k).tolist() for k in ("M", "C", "K")})
         out: dict[str, Any] = {
             "fixture": {"arms": list(self.arms), "angles": list(self.angles), "rotation": bool(sp.rotation)},
-            "specimen": {"M": np.reshape(sp.M, (2, 2)).tolist(), "C": np.reshape(sp.C, (2, 2)).tolist(),
-                         "K": np.reshape(sp.K, (2, 2)).tolist(), "fixture_mass": float(sp.fixture_mass),
+            "specimen": {**matrices, "fixture_mass": float(sp.fixture_mass),
                          "fixture_inertia": float(sp.fixture_inertia)},
         }
         out["actuators"] = ([{"rig": name} for name in rig_files] if rig_files is not None
@@ -270,11 +301,11 @@ def multi_rig_from_dict(data: dict[str, Any], folder: Path | None = None) -> Mul
         raise ValueError(f"invalid fixture.rotation = {rotation!r}: expected true or false")
     frame = specimen.get("frame")
     if frame is not None:
-        if frame not in ("marths", "marths_static"):
-            raise ValueError(f"invalid specimen.frame = {frame!r}: expected 'marths' or 'marths_static'")
+        if frame not in FRAMES:
+            raise ValueError(f"invalid specimen.frame = {frame!r}: expected one of {list(FRAMES)}")
         if any(k in specimen for k in ("M", "C", "K")):
             raise ValueError("give specimen.frame or specimen.M, C, K, not both")
-        matrices = marths_frame("guyan" if frame == "marths" else "static")
+        matrices = marths_frame(FRAMES[frame])
     else:
         if "M" not in specimen:
             raise ValueError("missing specimen.M (or specimen.frame)")
@@ -283,6 +314,9 @@ def multi_rig_from_dict(data: dict[str, Any], folder: Path | None = None) -> Mul
                        fixture_mass=_number("specimen.fixture_mass", specimen.get("fixture_mass", 0.0)),
                        fixture_inertia=_number("specimen.fixture_inertia", specimen.get("fixture_inertia", 0.0)))
     rigs = []
+    if len(actuators) != len(arms):
+        raise ValueError(f"invalid [[actuators]] (count) = {len(actuators)}: one per arm of fixture.arms "
+                         f"({len(arms)})")
     for i, table in enumerate(actuators):
         table = dict(table)
         base = zhao2003()
@@ -298,7 +332,9 @@ def multi_rig_from_dict(data: dict[str, Any], folder: Path | None = None) -> Mul
             msg = str(e)
             raise ValueError(f"invalid actuators[{i}].{msg[8:]}" if msg.startswith("invalid ")
                              else f"actuators[{i}]: {msg}") from None
-    return MultiActuatorRig(rigs, arms, angles, sp)
+    out = MultiActuatorRig(rigs, arms, angles, sp)
+    out.frame = frame
+    return out
 
 
 def _number(where: str, value: Any) -> float:

@@ -235,7 +235,7 @@ def test_warnings_name_the_actuator():
     ('[fixture]\narms = [0.3, 0.3]\nangles = [0.1, -0.1]\n[specimen]\nframe = "marths"\n'
      '[[actuators]]\n[[actuators]]\n[actuators.servovalve]\nK_v = -1.0\n', "invalid actuators[1].K_v = -1"),
     ('[fixture]\narms = [0.3, 0.3]\nangles = [0.1, -0.1]\n[specimen]\nframe = "marths"\n[[actuators]]\n',
-     "invalid actuators = 1"),
+     "invalid [[actuators]] (count) = 1"),
     ('[fixture]\narms = [0.3, "a"]\nangles = [0.1, -0.1]\n[specimen]\nframe = "marths"\n[[actuators]]\n'
      '[[actuators]]\n', "invalid fixture.arms[1] = 'a'"),
     ('[fixture]\narms = [0.3, 0.3]\nangles = [0.1, -0.1]\n[specimen]\nframe = "nope"\n[[actuators]]\n'
