@@ -268,3 +268,24 @@ def test_bad_commands_and_plant_calls():
     assert plant.step([0.001, 0.0]).ok()
     np.testing.assert_allclose(plant.displacements(), [plant.observe()["actuator1.stroke"],
                                                        plant.observe()["actuator2.stroke"]])
+
+
+def test_calibrated_marths_rig_follows_the_identified_plant():
+    """The committed rig files (studies/marths_rig_calibration.py) against the benchmark's identified
+    plant: the band errors docs/multi-actuator.md states, recomputed from the files."""
+    import json
+
+    from shared_data import shared_path
+
+    ss = json.loads(shared_path("marths-data/ID_Control_plant_100Hz_plantFRAME_SS.json").read_text())
+    A, B, C, D = (np.asarray(ss[k], dtype=float) for k in "ABCD")
+    f = np.logspace(-1, np.log10(50.0), 80)
+    H_id = np.stack([C @ np.linalg.solve(2j * np.pi * fk * np.eye(A.shape[0]) - A, B) + D for fk in f])
+    rig = sh.marths_rig()
+    assert rig.actuators == 2 and rig.frame == "marths" and all(r.effects.coulomb_friction for r in rig.rigs)
+    H = rig.frequency_response(f)
+    rms = np.sqrt(np.mean((np.abs(H - H_id) / np.abs(H_id)) ** 2, axis=0))
+    assert rms[0, 0] < 0.03 and rms[1, 0] < 0.02  # column 1 followed closely
+    assert rms[0, 1] < 0.1 and rms[1, 1] < 0.1    # column 2: the compromise the docs explain
+    dc = rig.frequency_response([0.0])[0].real
+    np.testing.assert_allclose(dc, [[0.835, 0.127], [0.139, 0.877]], atol=2e-3)
