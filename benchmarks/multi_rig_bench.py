@@ -25,7 +25,6 @@ import json
 import math
 import os
 import platform
-import re
 import sys
 import time
 from pathlib import Path
@@ -39,7 +38,7 @@ from ground_motion import ground_acceleration, sdof_displacement  # noqa: E402
 
 import servohydraulics as sh  # noqa: E402
 from servohydraulics import _core  # noqa: E402
-from servohydraulics.atomic import write_text  # noqa: E402
+from servohydraulics.atomic import replace_marked, write_text  # noqa: E402
 
 FS = 1024.0
 N = 42169  # the benchmark's nominal El Centro run (BENCHMARK.md section 1)
@@ -125,12 +124,7 @@ def main() -> None:
     print(table)
     if args.write:
         write_text(ROOT / "benchmarks" / "multi_rig_bench.json", json.dumps(results, indent=2) + "\n")
-        doc = ROOT / "docs" / "multi-actuator.md"
-        pat = re.compile(r"(<!-- multi_rig_bench -->\n)(.*?)(<!-- /multi_rig_bench -->)", re.S)
-        old = doc.read_text()
-        if not pat.search(old):
-            raise SystemExit(f"error: marker <!-- multi_rig_bench --> not found in {doc}")
-        write_text(doc, pat.sub(lambda m: m.group(1) + table + "\n" + m.group(3), old))
+        replace_marked(ROOT / "docs" / "multi-actuator.md", "multi_rig_bench", table)
 
 
 if __name__ == "__main__":

@@ -183,9 +183,17 @@ void expose_multi_rig(py::module_& m) {
         py::arg("rig"), py::arg("dt"), py::arg("options") = SolverOptions{},
         "RK4 substeps per sample of dt [s] the coupled rig's automatic rule chooses");
 
-  py::class_<MultiRigPlant>(m, "MultiRigPlant",
-                            "The coupled rig stepped at the loop's rate, the N commands [m] held over each sample "
-                            "(a MultiActuatorSystem)")
+  // The seam (multi_actuator.hpp), so that a loop bound elsewhere takes this plant as its
+  // MultiActuatorSystem; registered here unless another module of the core did it first.
+  if (py::detail::get_type_info(typeid(MultiActuatorSystem)) == nullptr) {
+    py::class_<MultiActuatorSystem>(m, "MultiActuatorSystem",
+                                    "N displacement-commanded actuators on one specimen (multi_actuator.hpp)")
+        .def_property_readonly("actuators", &MultiActuatorSystem::actuators)
+        .def_property_readonly("dt", &MultiActuatorSystem::dt);
+  }
+  py::class_<MultiRigPlant, MultiActuatorSystem>(m, "MultiRigPlant",
+                                                 "The coupled rig stepped at the loop's rate, the N commands [m] "
+                                                 "held over each sample (a MultiActuatorSystem)")
       .def(py::init<const MultiRig&, double, const SolverOptions&>(), py::arg("rig"), py::arg("dt"),
            py::arg("options") = SolverOptions{})
       .def_property_readonly("actuators", &MultiRigPlant::actuators)

@@ -32,14 +32,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import re
 from pathlib import Path
 
 import numpy as np
 from scipy.optimize import least_squares
 
 import servohydraulics as sh
-from servohydraulics.atomic import write_text, write_with
+from servohydraulics.atomic import replace_marked, write_with
 from servohydraulics.multi_rig import MARTHS_ANGLES, MARTHS_ARM, RIG_FILES, MultiActuatorRig
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -256,12 +255,7 @@ def main() -> None:
     sh.save_multi_rig(rig, RIG_FILES / "marths_2act.toml", header=header)
     write_with(ROOT / "docs" / "figures" / "marths_rig_frf.png",
                lambda path: figure(H_id, H_lin, f_nl, H_nl).savefig(path, dpi=110, format="png"))
-    doc = ROOT / "docs" / "multi-actuator.md"
-    pat = re.compile(r"(<!-- marths_rig_calibration -->\n)(.*?)(<!-- /marths_rig_calibration -->)", re.S)
-    old = doc.read_text()
-    if not pat.search(old):
-        raise SystemExit(f"error: marker <!-- marths_rig_calibration --> not found in {doc}")
-    write_text(doc, pat.sub(lambda m: m.group(1) + text + "\n" + m.group(3), old))
+    replace_marked(ROOT / "docs" / "multi-actuator.md", "marths_rig_calibration", text)
 
 
 if __name__ == "__main__":

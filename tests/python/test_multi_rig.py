@@ -289,3 +289,14 @@ def test_calibrated_marths_rig_follows_the_identified_plant():
     assert rms[0, 1] < 0.1 and rms[1, 1] < 0.1    # column 2: the compromise the docs explain
     dc = rig.frequency_response([0.0])[0].real
     np.testing.assert_allclose(dc, [[0.835, 0.127], [0.139, 0.877]], atol=2e-3)
+
+
+def test_replace_marked_keeps_the_rest(tmp_path):
+    from servohydraulics.atomic import replace_marked
+
+    page = tmp_path / "page.md"
+    page.write_text("head\n<!-- t -->\nold\n<!-- /t -->\ntail\n")
+    replace_marked(page, "t", "new\n")
+    assert page.read_text() == "head\n<!-- t -->\nnew\n<!-- /t -->\ntail\n"
+    with pytest.raises(ValueError, match="marker <!-- u -->"):
+        replace_marked(page, "u", "x")
