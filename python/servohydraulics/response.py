@@ -34,7 +34,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from .rig import Rig
 
-KINDS = ("plant", "eft", "rpsd", "tracking", "record", "rths", "marths")
+KINDS = ("plant", "eft", "rpsd", "tracking", "record", "rths", "marths", "multi")
 
 #: Columns a record file must have (the diagnosis needs them).
 REQUIRED = ("time", "command", "displacement", "force")
@@ -66,6 +66,8 @@ def channel_units(kind: str = "record", mode: str | None = None) -> dict[str, st
     channels (``_core.rths.RTHS_CHANNELS``) and its optional ``step_seconds``
     (the per-DOF channels of a trial carry their units with them: ``rths.Trial``); ``"marths"``:
     the maRTHS loop's (``_core.marths.MARTHS_CHANNELS``) and ``step_seconds``.
+    ``"multi"``: the coupled multi-actuator rig's node channels (``node.<name>``) and the counts (the
+    actuators' ``actuator<i>.<name>`` carry their units with the response: ``multi_rig.MultiResponse``).
     """
     if kind not in KINDS:
         raise ValueError(f"invalid kind = {kind!r}: expected one of {list(KINDS)}")
@@ -73,6 +75,8 @@ def channel_units(kind: str = "record", mode: str | None = None) -> dict[str, st
         return {**dict(map(tuple, _core.rths.RTHS_CHANNELS)), "step_seconds": "s"}
     if kind == "marths":
         return {**dict(map(tuple, _core.marths.MARTHS_CHANNELS)), "step_seconds": "s"}
+    if kind == "multi":  # the node's; the actuators' (actuator<i>.<name>) come with the response (multi_rig.py)
+        return {"time": "s", **{f"node.{n}": u for n, u in _core.NODE_CHANNELS}, **_COUNTS}
     plant, eft, rpsd = _core_tables()
     out = dict(plant)
     if kind in ("plant", "tracking", "record"):
@@ -221,8 +225,9 @@ class Response:
         channels: read-only mapping name -> array (also attributes:
             ``res.displacement``); it includes ``time``.
         units: name -> SI unit of each channel.
-        kind: ``"plant"`` (simulate), ``"eft"``, ``"rpsd"``, ``"tracking"``, ``"record"`` or
-            ``"rths"`` (``rths.run_trial``: the RTHS benchmark loop).
+        kind: ``"plant"`` (simulate), ``"eft"``, ``"rpsd"``, ``"tracking"``, ``"record"``,
+            ``"rths"`` (``rths.run_trial``: the RTHS benchmark loop) or ``"multi"``
+            (``simulate_multi``: the coupled multi-actuator rig, a ``MultiResponse``).
         mode: control mode (``"displacement"``, ``"force"``, ``"free"``), None if unknown.
         dt: controller sample time [s].
         rig: the rig the run used (RPsD: the physical rig), None for a record.
@@ -245,7 +250,8 @@ class Response:
             raise ValueError(f"invalid kind = {kind!r}: expected one of {list(KINDS)}")
         if "time" not in channels:
             raise ValueError(f"invalid channels {list(channels)}: a response needs a 'time' channel")
-        data = {n: (np.asarray(v) if n in _INTEGER else np.asarray(v, dtype=float)) for n, v in channels.items()}
+        data = {n: (np.asarray(v) if n in _INTEGER or n.endswith(".flags") else np.asarray(v, dtype=float))
+                for n, v in channels.items()}
         table = channel_units(kind, mode)
         self.channels = Channels(data)
         self.units = {n: (units or {}).get(n, table.get(n, "?")) for n in data}
@@ -360,7 +366,7 @@ class Response:
 
 
 _LABELS = {"plant": "simulation", "eft": "EFT", "rpsd": "RPsD", "tracking": "tracking", "record": "record",
-           "rths": "RTHS", "marths": "maRTHS"}
+           "rths": "RTHS", "marths": "maRTHS", "multi": "multi-actuator run"}
 
 
 def _failure_message(kind: str, status: SimpleNamespace) -> str:

@@ -3,16 +3,24 @@
 // declared in plant.hpp) and an embedded error estimate that flags a sample.
 #pragma once
 
+#include "detail/ode_system.hpp"
 #include "servohydraulics/dynamics.hpp"
 #include "servohydraulics/solver_options.hpp"
 #include "servohydraulics/status.hpp"
 
 namespace servohydraulics::detail {
 
-class Rk4Integrator {
+//! RK4 over a system of the OdeSystem interface (ode_system.hpp): the single-actuator plant
+//! (Rk4Integrator) or the coupled multi-actuator rig.
+template <class System>
+class BasicRk4Integrator {
  public:
+  using Sys = OdeSystem<System>;
+  using State = typename Sys::State;
+  using Input = typename Sys::Input;
+
   //! options.rk4_substeps per sample of dt [s], or the automatic rule if 0 (may throw Error).
-  Rk4Integrator(const Dynamics& dyn, double dt, const SolverOptions& options);
+  BasicRk4Integrator(const System& sys, double dt, const SolverOptions& options);
 
   void reset(const State& y0, double) noexcept;
   //! The classical RK4 over substeps() equal substeps, and the estimate of its error: the classical
@@ -26,7 +34,7 @@ class Rk4Integrator {
   //! rk4_max_refinements times (the flag stays: a local estimate does not bound the error carried on).
   //! `substeps` > 0 replaces the configured count (the plant passes a share of it for each part of a
   //! sample split by a command delay).
-  Status advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t, double t_next,
+  Status advance(const System& sys, const Input& in, State& y, double& t, double t_next,
                  int substeps = 0) noexcept;
 
   int substeps() const noexcept { return substeps_; }
@@ -37,16 +45,19 @@ class Rk4Integrator {
 
  private:
   //! n substeps of size h from y (updated); returns the weighted norm of the error estimate.
-  double sweep(const Dynamics& dyn, const Dynamics::Input& in, State& y, int n, double h) const noexcept;
+  double sweep(const System& sys, const Input& in, State& y, int n, double h) const noexcept;
   void track_peak(const State& y) noexcept;
 
   int n_;
   int substeps_;
   int max_refinements_;
   double rtol_;
-  double atol_[kMaxStates];
-  double peak_[kMaxStates] = {};  //!< max |y_i| over the samples since the last reset
+  double atol_[Sys::kCapacity];
+  double peak_[Sys::kCapacity] = {};  //!< max |y_i| over the samples since the last reset
   long steps_done_ = 0, rhs_done_ = 0, flagged_ = 0;
 };
+
+//! The single-actuator plant's fixed-step integrator.
+using Rk4Integrator = BasicRk4Integrator<Dynamics>;
 
 }  // namespace servohydraulics::detail
