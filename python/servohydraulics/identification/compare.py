@@ -31,6 +31,7 @@ from .run import (
     nrmse_demeaned_pct,
     nrmse_pct,
     record_name,
+    record_rig,
     simulate_record,
 )
 
@@ -131,7 +132,8 @@ def frf_points(measured: FrequencyResponse, simulated: FrequencyResponse, freque
 
 
 def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, options=None,
-            frequencies=None, simulated: Response | None = None) -> Comparison:
+            frequencies=None, simulated: Response | None = None, current: float | None = None,
+            voltage: float | None = None) -> Comparison:
     """Simulates the record's command through the rig and compares (see the module docstring).
 
     Args:
@@ -141,7 +143,14 @@ def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, opti
         options: solver options (default: CVODE BDF).
         frequencies: FRF points [Hz] (default ``FREQUENCIES`` up to the command's band).
         simulated: the record already simulated (``run.simulate_record``; skips the run).
+        current, voltage: the MR damper's coil current [A] or voltage [V] the record was made at (its
+            law predicts the damper there, ``law.predict_at``; a value outside the range the law was
+            identified on is reported in ``warnings``); ValueError naming the flag when the rig has
+            no MR damper, its law reads the other input, or the value is not a finite number >= 0.
     """
+    from .law import predict_at
+
+    rig = predict_at(rig, current, voltage)
     if mode not in ("displacement", "force"):
         raise ValueError(f"invalid mode = {mode!r}: a record compares in 'displacement' or 'force' control")
     check_record(record)
@@ -153,7 +162,8 @@ def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, opti
     freq = np.asarray(frequencies if frequencies is not None else [f for f in FREQUENCIES if f <= 1.05 * f_max],
                       dtype=float)
     out = Comparison(name=record_name(record), mode=mode, time=np.asarray(record.time), measured={}, simulated={},
-                     frf_measured={}, frf_simulated={}, frequencies=freq, f_max=f_max, warnings=sim.warnings(rig))
+                     frf_measured={}, frf_simulated={}, frequencies=freq, f_max=f_max,
+                     warnings=sim.warnings(record_rig(rig, record)))
     for ch in chans:
         m, s = np.asarray(record.channels[ch], dtype=float), np.asarray(sim.channels[ch], dtype=float)
         out.measured[ch], out.simulated[ch] = m, s
