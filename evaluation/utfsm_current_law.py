@@ -104,17 +104,17 @@ def campaign_evidence(sh, records: dict) -> dict:
     return out
 
 
-def law_summary(ident) -> list[str]:
-    """The fitted law's keys with their 95 % intervals, one line each."""
-    from servohydraulics.identification.coordinates import units
+def law_summary(parameters: dict) -> list[str]:
+    """The fitted law's keys with their 95 % intervals, one line each, from the identification's
+    JSON ``parameters`` (key -> value, unit, status, interval)."""
+    def unit(text: str) -> str:  # the law's units per unit of the field input: here amperes
+        return "" if text == "-" else text.replace("(m u)", "(m A)").replace("u^2", "A^2").replace("1/u", "1/A")
 
-    u = units()
     lines = []
-    for k in ident.keys:
-        lo, hi = ident.intervals[k]
-        status = ident.status.get(k, "identified")
-        iv = f"[{lo:.4g}, {hi:.4g}]" if status == "identified" else f"{status}"
-        lines.append(f"`{k}` = {ident.values[k]:.4g} {u.get(k, '')} {iv}")
+    for k, p in parameters.items():
+        lo, hi = p["interval"]
+        iv = f"[{lo:.4g}, {hi:.4g}]" if p["status"] == "identified" else f"({p['status']})"
+        lines.append(f"`{k}` = {p['value']:.4g} {unit(p['unit'])} {iv}".replace("  ", " "))
     return lines
 
 
@@ -209,7 +209,8 @@ def main(argv=None) -> int:
     p.add_argument("--data", default=str(DATA))
     p.add_argument("--out", default="utfsm_law_out")
     p.add_argument("--laws", default=",".join(LAWS), help="comma-separated laws (default: both)")
-    p.add_argument("--sets", default="may,june", help="training sets: may (a), june (b)")
+    p.add_argument("--sets", default="may,june",
+                   help="training sets: may (a), june (b); \"\": only the tables, from an earlier run into --out")
     p.add_argument("--no-docs", action="store_true", help="do not rewrite docs/lab-records.md or the figure")
     args = p.parse_args(argv)
     sys.path.insert(0, str(ROOT / "python"))
@@ -224,14 +225,16 @@ def main(argv=None) -> int:
     records = {n: sh.read_record(data / f"{n}.csv") for n in CURRENT}
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    saved = out / "utfsm_current_law.json"
+    # the sets and laws of an earlier run into the same --out are kept (one table from both runs)
+    earlier = json.loads(saved.read_text()) if saved.exists() else {}
     t_all = time.perf_counter()
     base = thesis_baselines(records)
-    results: dict = {}
-    times: dict = {}
-    preds_05: dict = {}
+    results: dict = earlier.get("results", {})
+    times: dict = earlier.get("identify_s", {})
     for s in sets:
         train, tests = SETS[s]
-        results[s] = {}
+        results.setdefault(s, {})
         for law in laws:
             ident, wall, cpu = identify_set(sh, records, train, law, out)
             times[f"{s} {law}"] = {"wall_s": wall, "cpu_s": cpu}
@@ -239,34 +242,37 @@ def main(argv=None) -> int:
             RIGS.mkdir(exist_ok=True)
             sh.save_rig(ident.rig, RIGS / f"law_{s}_{law}.toml")
             r = {"fit": {a.name: {c: a.channels[c]["nrmse_pct"] for c in a.channels} for a in ident.after},
-                 "predicted": {}, "law": law_summary(ident), "flags": ident.flags}
+                 "predicted": {}, "flags": ident.flags}
             for name in tests:
                 c = predict(records, ident.rig, name)
                 c.write(out / f"{name}_from_{s}_{law}")
                 m, q = np.asarray(records[name].force), np.asarray(c.simulated["force"])
                 r["predicted"][name] = {"displacement": c.nrmse("displacement"), "force": c.nrmse("force"),
                                         "gain": float(m @ q / (q @ q)), "warnings": c.warnings}
-                if s == "may" and name == "sweep15Hz_0p5A":
-                    preds_05[law] = c
             results[s][law] = r
             print(f"{s} {law}: identified in {wall:.0f} s wall ({cpu:.0f} s CPU); "
                   + "; ".join(f"{n}: displacement {v['displacement']:.2f} %, force {v['force']:.2f} %"
                               for n, v in r["predicted"].items()), flush=True)
-            for line in r["law"]:
-                print("   ", line)
             for f in ident.flags:
                 print("    flag:", f)
-    evidence = campaign_evidence(sh, records) if "june" in sets else None
+    for s, per in results.items():  # the laws with their intervals, from each identification's JSON
+        for law, r in per.items():
+            r["law"] = law_summary(json.loads((out / f"identified_{s}_{law}" / "identification.json").read_text())
+                                   ["parameters"])
+            print(f"{s} {law}:", "; ".join(r["law"]))
+    evidence = campaign_evidence(sh, records) if "june" in results else None
     text = tables(results, base, evidence, times)
-    (out / "utfsm_current_law.json").write_text(json.dumps(
+    saved.write_text(json.dumps(
         {"baselines": {k: {c: v[c] for c in ("displacement", "force")} for k, v in base.items()},
          "results": results, "identify_s": times,
          "evidence": None if evidence is None else {k: {q: np.asarray(w).tolist() for q, w in v.items()}
                                                     for k, v in evidence.items()}}, indent=2) + "\n")
     print(text)
     if not args.no_docs:
-        if preds_05:
-            figure(records, preds_05, base, FIGURE)
+        if "may" in results:  # the 0.5 A predictions of the May rigs (one simulation each)
+            preds = {law: predict(records, sh.load_rig(RIGS / f"law_may_{law}.toml"), "sweep15Hz_0p5A")
+                     for law in results["may"]}
+            figure(records, preds, base, FIGURE)
             print(f"wrote {FIGURE}")
         doc = ROOT / "docs" / "lab-records.md"
         s = doc.read_text()

@@ -172,6 +172,10 @@ def test_identifies_a_known_current_law_and_predicts_a_third_current():
     ident = sh.identify(recs, rig=start, fit=fit, mode="displacement", currents=[0.0, 1.0], progress=False)
     assert ident.field_input.values == (0.0, 1.0) and ident.law == "spencer"
     assert ident.rig.mr_law_min == 0.0 and ident.rig.mr_law_max == 1.0
+    d = ident.to_dict()
+    assert d["field"] == {"input": "current", "unit": "A", "values": [0.0, 1.0], "range": [0.0, 1.0], "law": "spencer"}
+    assert [r["current"] for r in d["records"]] == [0.0, 1.0]
+    assert "fitted across the records at currents 0, 1 A" in ident.markdown()
     for k in ("mr_alpha_a", "mr_alpha_b", "mr_c0_a", "mr_c0_b"):
         lo, hi = ident.intervals[k]
         v = TRUTH[k]
