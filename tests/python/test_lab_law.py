@@ -308,11 +308,18 @@ def _thesis_on_half_amp(rec):
     return nrmse_pct(x, rec.displacement), nrmse_pct(f, rec.force)
 
 
-@pytest.mark.parametrize("law_name", ["spencer", "quiroz2022"])
+@pytest.mark.parametrize("law_name", [
+    "spencer",
+    pytest.param("quiroz2022", marks=pytest.mark.xfail(strict=True, reason=(
+        "known loss on the force (docs/lab-records.md): from two currents the thesis' law makes the yield force "
+        "alpha(i) sqrt(A / gamma(i)) convex in i (linear alpha, exponential gamma; alpha's curvature needs a "
+        "third current), 1.6 times too weak at 0.5 A"))),
+])
 def test_utfsm_half_amp_predicted_no_worse_than_the_thesis(law_name):
     """The committed rig identified on the May 0 A and 1 A sweeps (evaluation/utfsm_current_law.py)
     predicts the held-out 0.5 A sweep from its command alone no worse than the thesis' models on
-    that record (its G(s) from the command, its Bouc-Wen from the measured displacement)."""
+    that record (its G(s) from the command, its Bouc-Wen from the measured displacement).  The
+    thesis' law loses on the force (a strict xfail: a win fails until the table is updated)."""
     from servohydraulics.identification import compare, simulate_record
     from servohydraulics.identification.fit import fit_options
 
@@ -321,7 +328,7 @@ def test_utfsm_half_amp_predicted_no_worse_than_the_thesis(law_name):
     c = compare(rec, rig, "displacement",
                 simulated=simulate_record(rig, rec, "displacement", options=fit_options(rig, [rec], "displacement")))
     thesis_x, thesis_f = _thesis_on_half_amp(rec)
-    assert not c.warnings
+    assert (rig.mr_law_min, rig.mr_law_max) == (0.0, 1.0) and not c.warnings  # 0.5 A: inside the fitted range
     assert c.nrmse("displacement") <= thesis_x, (c.nrmse("displacement"), thesis_x)
     assert c.nrmse("force") <= thesis_f, (c.nrmse("force"), thesis_f)
 
