@@ -152,13 +152,41 @@ def figure(records: dict, preds: dict, base: dict, path: Path) -> None:
     fig.savefig(path, dpi=110)
 
 
+def law_at_currents(results: dict) -> list[str]:
+    """The identified laws (the committed rigs) and the thesis' at 0, 0.5 and 1 A: alpha, c0, c1,
+    beta + gamma, the Bouc-Wen saturation z_u = (A / (beta + gamma))^(1/n) and the force level
+    alpha z_u it gives (the damper's yield force, about)."""
+    import servohydraulics as sh
+    from servohydraulics import _core
+    from servohydraulics.identification.baselines import thesis_law_keys
+    from servohydraulics.identification.law import predict_at
+
+    rigs = {f"{s}, {law}": sh.load_rig(RIGS / f"law_{s}_{law}.toml") for s, per in results.items() for law in per}
+    thesis = sh.rig_from_dict({"specimen": thesis_law_keys()})
+    thesis.effects.mr_damper = True
+    rigs["the thesis' law (May sinusoids, 0-1 A)"] = thesis
+    lines = ["The laws at 0 / 0.5 / 1 A (the damper's yield force is about alpha z_u, z_u = (A / (beta + "
+             "gamma))^(1/n) the Bouc-Wen saturation):", "",
+             "| law | alpha [kN/m] | c0 [kN s/m] | c1 [kN s/m] | z_u [mm] | alpha z_u [N] |",
+             "|---|---|---|---|---|---|"]
+    for name, rig in rigs.items():
+        v = [_core.mr_damper_law(predict_at(rig, current=i)) for i in (0.0, 0.5, 1.0)]
+        z_u = [(rig.mr_A / (w["beta"] + w["gamma"])) ** (1.0 / rig.mr_n) for w in v]
+        j = lambda a, f: " / ".join(format(x, f) for x in a)  # noqa: E731
+        lines.append(f"| {name} | {j([w['alpha'] / 1e3 for w in v], '.1f')} | {j([w['c0'] / 1e3 for w in v], '.2f')} | "
+                     f"{j([w['c1'] / 1e3 for w in v], '.0f')} | {j([1e3 * z for z in z_u], '.1f')} | "
+                     f"{j([w['alpha'] * z for w, z in zip(v, z_u)], '.0f')} |")
+    return lines + [""]
+
+
 def tables(results: dict, base: dict, evidence: dict | None, times: dict) -> str:
     lines = []
     if "may" in results:
         lines += ["**(a) May sweeps 0 A + 1 A -> the held-out 0.5 A sweep, from its command alone** (NRMSE %; the "
                   "thesis' G(s) from the command, its Bouc-Wen from the measured displacement):", "",
                   "| law | displacement: ours | thesis G(s) | force: ours | thesis Bouc-Wen | ours <= thesis | "
-                  "fit: 0 A disp / force | fit: 1 A disp / force |", "|---|---|---|---|---|---|---|---|"]
+                  "gain g of measured ~ g ours | fit: 0 A disp / force | fit: 1 A disp / force |",
+                  "|---|---|---|---|---|---|---|---|---|"]
         for law, r in results["may"].items():
             p = r["predicted"]["sweep15Hz_0p5A"]
             b = base["sweep15Hz_0p5A"]
@@ -166,8 +194,8 @@ def tables(results: dict, base: dict, evidence: dict | None, times: dict) -> str
             verdict = "both" if len(wins) == 2 else (f"{wins[0]} only" if wins else "neither")
             f0, f1 = (r["fit"][n] for n in SETS["may"][0])
             lines.append(f"| {law} | {p['displacement']:.2f} | {b['displacement']:.2f} | {p['force']:.2f} | "
-                         f"{b['force']:.2f} | {verdict} | {f0['displacement']:.2f} / {f0['force']:.2f} | "
-                         f"{f1['displacement']:.2f} / {f1['force']:.2f} |")
+                         f"{b['force']:.2f} | {verdict} | {p['gain']:.2f} | {f0['displacement']:.2f} / "
+                         f"{f0['force']:.2f} | {f1['displacement']:.2f} / {f1['force']:.2f} |")
         lines.append("")
     if "june" in results:
         lines += ["**(b) June chirps 0 A + 1 A -> each May sweep** (NRMSE %; the thesis' models as in (a), fitted "
@@ -193,6 +221,7 @@ def tables(results: dict, base: dict, evidence: dict | None, times: dict) -> str
                          f"{j(e['ratio'], '.2f')} | {j(e['phase_deg'], '.1f')} | {j(e['model_ratio'], '.2f')} | "
                          f"{j(e['model_phase_deg'], '.1f')} |")
         lines.append("")
+    lines += law_at_currents(results)
     for s, per in results.items():
         for law, r in per.items():
             lines.append(f"Law identified on the {s} records, `{law}` (95 % intervals; SI units, per A): "
