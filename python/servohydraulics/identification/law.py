@@ -32,8 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _core
-from ..response import Response, mr_law_warnings
+from ..response import Response
 from ..rig import CHOICES, Rig, choice_name
 
 #: the field input's kind -> (the rig key of its value, its unit)
@@ -153,17 +152,15 @@ def law_keys(law: str, levels: int) -> tuple[tuple[str, ...], list[str]]:
     return keys, notes
 
 
-def set_field(rig: Rig, kind: str, value: float, law: str | None = None) -> Rig:
-    """A copy of ``rig`` driven by the field ``kind`` at ``value`` (the other input at 0), with
-    ``law`` when given."""
+def set_field(rig: Rig, kind: str, value: float) -> Rig:
+    """A copy of ``rig`` driven by the field ``kind`` ("current" or "voltage") at ``value`` (the
+    other input at 0)."""
     key = FIELD_INPUTS[kind][0]
     out = copy.copy(rig)
     out.mr_input = MR_INPUTS[kind]
     for other, _ in FIELD_INPUTS.values():
         setattr(out, other, 0.0)
     setattr(out, key, float(value))
-    if law is not None:
-        out.mr_law = MR_LAWS[check_law(law)]
     return out
 
 
@@ -171,10 +168,6 @@ def rig_field(rig: Rig) -> tuple[str, float]:
     """(the rig's field input kind, its value)."""
     kind = choice_name(rig, "mr_input")
     return kind, float(getattr(rig, FIELD_INPUTS[kind][0]))
-
-
-def rig_law(rig: Rig) -> str:
-    return choice_name(rig, "mr_law")
 
 
 def predict_at(rig: Rig, current=None, voltage=None) -> Rig:
@@ -194,12 +187,6 @@ def predict_at(rig: Rig, current=None, voltage=None) -> Rig:
         raise ValueError(f"invalid --{kind} = {value!r}: the rig's MR damper law reads a {have} "
                          f"([specimen] mr_input = \"{have}\"); give --{have}")
     return set_field(rig, kind, value)
-
-
-def law_values(rig: Rig) -> dict[str, float]:
-    """The damper's parameters at the rig's field value (the core's law, ``_core.mr_damper_law``):
-    alpha [N/m], c0, c1 [N s/m], beta, gamma [1/m^n] and u [A or V]."""
-    return dict(_core.mr_damper_law(rig))
 
 
 def law_start(rig: Rig, records: Sequence[Response], field: FieldInput, law: str) -> None:
@@ -263,6 +250,5 @@ def with_fields(records: Sequence[Response], field: FieldInput) -> list[Response
 
 
 __all__ = ["FIELD_FREE_KEYS", "FIELD_INPUTS", "FieldInput", "LINEAR_TERMS", "MR_INPUTS", "MR_LAWS", "QUIROZ_TERMS",
-           "check_law", "coordinate_scales", "field_input", "field_value", "law_keys", "law_start", "law_values",
-           "mr_law_warnings", "parse_values", "predict_at", "rig_field", "rig_law", "set_field", "start_range",
-           "with_fields"]
+           "check_law", "coordinate_scales", "field_input", "field_value", "law_keys", "law_start", "parse_values",
+           "predict_at", "rig_field", "set_field", "start_range", "with_fields"]
