@@ -118,36 +118,41 @@ def law_summary(parameters: dict) -> list[str]:
     return lines
 
 
-def figure(records: dict, preds: dict, base: dict, path: Path) -> None:
-    """Measured and predicted force at 0.5 A: the force-velocity loop and a time window."""
+def figure(records: dict, preds: dict, base: dict, path: Path, window=(30.0, 31.0)) -> None:
+    """Measured and predicted force at 0.5 A over a time window: the force-velocity loop (velocity
+    from the displacement low-passed at 200 Hz, measured or simulated) and the time history."""
     from matplotlib.figure import Figure
 
     from servohydraulics.identification.baselines import smoothed_motion
 
     rec = records["sweep15Hz_0p5A"]
-    _, v = smoothed_motion(rec.displacement, rec.dt)
     t = np.asarray(rec.time)
+    w = (t >= window[0]) & (t <= window[1])
+    _, v = smoothed_motion(rec.displacement, rec.dt)
+    x = np.asarray(rec.displacement)[w]
+    f_hz = np.count_nonzero(np.diff(np.sign(x - x.mean())) > 0) / (window[1] - window[0])
     fig = Figure(figsize=(11, 4.6), layout="constrained")
     ax1, ax2 = fig.subplots(1, 2, width_ratios=(1, 1.6))
-    ax1.plot(1e3 * v, rec.force / 1e3, color="0.2", lw=0.6, label="measured")
-    w = (t >= 30.0) & (t <= 31.0)
-    ax2.plot(t[w], rec.force[w] / 1e3, color="0.2", lw=1.4, label="measured")
     styles = {"spencer": ("tab:blue", "-"), "quiroz2022": ("tab:orange", "--")}
     for law, c in preds.items():
-        sim = c.simulated["force"]
+        sim = np.asarray(c.simulated["force"])
         _, vs = smoothed_motion(c.simulated["displacement"], rec.dt)
         col, ls = styles[law]
-        ax1.plot(1e3 * vs, sim / 1e3, color=col, ls=ls, lw=0.6, label=f"ours, {law} law (from the command)")
+        ax1.plot(1e3 * vs[w], sim[w] / 1e3, color=col, ls=ls, lw=1.0, label=f"ours, {law} law (from the command)")
         ax2.plot(t[w], sim[w] / 1e3, color=col, ls=ls, lw=1.2, label=f"ours, {law} law")
-    ax2.plot(t[w], base["sweep15Hz_0p5A"]["F"][w] / 1e3, color="tab:green", ls=":", lw=1.2,
-             label="thesis Bouc-Wen (measured x)")
-    ax1.set(xlabel="velocity [mm/s]", ylabel="force [kN]", title="0.5 A sweep: force-velocity")
-    ax2.set(xlabel="time [s]", ylabel="force [kN]", title="0.5 A sweep, 30-31 s (about 11 Hz)")
+    thesis = base["sweep15Hz_0p5A"]["F"]
+    ax1.plot(1e3 * v[w], thesis[w] / 1e3, color="tab:green", ls=":", lw=1.0, label="thesis Bouc-Wen (measured x)")
+    ax2.plot(t[w], thesis[w] / 1e3, color="tab:green", ls=":", lw=1.2, label="thesis Bouc-Wen (measured x)")
+    ax1.plot(1e3 * v[w], rec.force[w] / 1e3, color="k", lw=0.8, label="measured")
+    ax2.plot(t[w], rec.force[w] / 1e3, color="k", lw=1.0, label="measured")
+    span = f"{window[0]:g}-{window[1]:g} s (about {f_hz:.0f} Hz)"
+    ax1.set(xlabel="velocity [mm/s]", ylabel="force [kN]", title=f"force-velocity, {span}")
+    ax2.set(xlabel="time [s]", ylabel="force [kN]", title=f"force, {span}")
     for ax in (ax1, ax2):
         ax.grid(alpha=0.3)
     ax1.legend(fontsize=7, loc="upper left")
     ax2.legend(fontsize=7, loc="upper right")
-    fig.suptitle("Held-out 0.5 A (May): identified on the 0 A and 1 A sweeps, predicted from the command alone")
+    fig.suptitle("Held-out 0.5 A sweep (May): identified on the 0 A and 1 A sweeps, predicted from the command alone")
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
 
@@ -179,7 +184,19 @@ def law_at_currents(results: dict) -> list[str]:
     return lines + [""]
 
 
-def tables(results: dict, base: dict, evidence: dict | None, times: dict) -> str:
+def force_levels(records: dict, base: dict) -> list[str]:
+    """How far the measured 0.5 A force lies between 0 A and 1 A (std of the measured force of the
+    May sweeps), and the gain g of measured ~ g (the thesis' Bouc-Wen) on each sweep."""
+    sd = {n: float(np.std(records[n].force)) for n in SWEEPS}
+    gain = {n: float(np.asarray(records[n].force) @ base[n]["F"] / (base[n]["F"] @ base[n]["F"])) for n in SWEEPS}
+    frac = (sd["sweep15Hz_0p5A"] - sd["sweep15Hz_0A"]) / (sd["sweep15Hz_1A"] - sd["sweep15Hz_0A"])
+    return [f"The May sweeps' measured force (std) at 0 / 0.5 / 1 A: {' / '.join(f'{v:.0f}' for v in sd.values())} N: "
+            f"0.5 A lies {100 * frac:.0f} % of the way from 0 A to 1 A (a law linear in the current: 50 %).  The "
+            "gain g of measured ~ g x the thesis' Bouc-Wen (measured x) on them: "
+            f"{' / '.join(f'{v:.2f}' for v in gain.values())}.", ""]
+
+
+def tables(results: dict, base: dict, evidence: dict | None, times: dict, levels: list[str] = ()) -> str:
     lines = []
     if "may" in results:
         lines += ["**(a) May sweeps 0 A + 1 A -> the held-out 0.5 A sweep, from its command alone** (NRMSE %; the "
@@ -197,6 +214,7 @@ def tables(results: dict, base: dict, evidence: dict | None, times: dict) -> str
                          f"{b['force']:.2f} | {verdict} | {p['gain']:.2f} | {f0['displacement']:.2f} / "
                          f"{f0['force']:.2f} | {f1['displacement']:.2f} / {f1['force']:.2f} |")
         lines.append("")
+        lines += list(levels)
     if "june" in results:
         lines += ["**(b) June chirps 0 A + 1 A -> each May sweep** (NRMSE %; the thesis' models as in (a), fitted "
                   "to May tests):", "",
@@ -213,7 +231,7 @@ def tables(results: dict, base: dict, evidence: dict | None, times: dict) -> str
         lines += [f"Measured against measured (H1 of the measured force over the measured displacement, at {f} Hz, "
                   "June chirp / May sweep; the control: the thesis' one model driven by each record's measured "
                   "displacement):", "",
-                  "| current | June |F/x| [N/mm] | May |F/x| [N/mm] | ratio June/May | phase June - May [deg] | "
+                  "| current | June abs(F/x) [N/mm] | May abs(F/x) [N/mm] | ratio June/May | phase June - May [deg] | "
                   "control: ratio | control: phase [deg] |", "|---|---|---|---|---|---|---|"]
         for cur, e in evidence.items():
             j = lambda a, s: " ".join(format(float(x), s) for x in a)  # noqa: E731
@@ -227,9 +245,10 @@ def tables(results: dict, base: dict, evidence: dict | None, times: dict) -> str
             lines.append(f"Law identified on the {s} records, `{law}` (95 % intervals; SI units, per A): "
                          + "; ".join(r["law"]) + ".")
             lines.append("")
+    load = lambda v: f" (load average {v['load']:.1f} at its end)" if "load" in v else ""  # noqa: E731
     lines.append(f"Identification run times (wall clock / CPU over all threads, generic start, {os.cpu_count()} "
-                 f"cores shared with other jobs, load average {os.getloadavg()[0]:.1f} at the end): "
-                 + ", ".join(f"{k} {v['wall_s']:.0f} s / {v['cpu_s']:.0f} s" for k, v in times.items()) + ".")
+                 "cores shared with other jobs): "
+                 + ", ".join(f"{k} {v['wall_s']:.0f} s / {v['cpu_s']:.0f} s{load(v)}" for k, v in times.items()) + ".")
     return "\n".join(lines)
 
 
@@ -266,7 +285,7 @@ def main(argv=None) -> int:
         results.setdefault(s, {})
         for law in laws:
             ident, wall, cpu = identify_set(sh, records, train, law, out)
-            times[f"{s} {law}"] = {"wall_s": wall, "cpu_s": cpu}
+            times[f"{s} {law}"] = {"wall_s": wall, "cpu_s": cpu, "load": os.getloadavg()[0]}
             ident.write(out / f"identified_{s}_{law}")
             RIGS.mkdir(exist_ok=True)
             sh.save_rig(ident.rig, RIGS / f"law_{s}_{law}.toml")
@@ -290,7 +309,7 @@ def main(argv=None) -> int:
                                    ["parameters"])
             print(f"{s} {law}:", "; ".join(r["law"]))
     evidence = campaign_evidence(sh, records) if "june" in results else None
-    text = tables(results, base, evidence, times)
+    text = tables(results, base, evidence, times, force_levels(records, base))
     saved.write_text(json.dumps(
         {"baselines": {k: {c: v[c] for c in ("displacement", "force")} for k, v in base.items()},
          "results": results, "identify_s": times,
