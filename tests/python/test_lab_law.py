@@ -195,6 +195,28 @@ def test_identifies_a_known_current_law_and_predicts_a_third_current():
     assert any("extrapolates" in w for w in far.warnings)
 
 
+def test_voltage_driven_records_run_at_their_own_voltage():
+    """``voltages=``: the rig's field input becomes the voltage, each record runs at its own (the
+    truth as the start reproduces both records to the noise, one short fit step), and the law's
+    range is the records'."""
+    truth = truth_rig()
+    truth.mr_input, truth.mr_current = law.MR_INPUTS["voltage"], 0.0
+    recs = []
+    for volts in (0.0, 2.0):
+        r = copy.copy(truth)
+        r.mr_voltage = volts
+        t, u = chirp(duration=2.0)
+        sim = sh.simulate(r, "displacement", command=u, dt=DT, options=sh.solver_options(method="cvode", rtol=1e-8))
+        recs.append(sh.Response({"time": t, "command": u, "displacement": sim.displacement, "force": sim.force}))
+    ident = sh.identify(recs, rig=truth, fit=["mr_alpha_b"], mode="displacement", voltages=[0, 2], max_nfev=1,
+                        frequency_stage=False, progress=False)
+    assert law.rig_field(ident.rig)[0] == "voltage" and (ident.rig.mr_law_min, ident.rig.mr_law_max) == (0.0, 2.0)
+    assert [a.nrmse("force") for a in ident.before] == pytest.approx([0.0, 0.0], abs=0.05)
+    # the same records at the wrong voltage are far off: the field per record is what runs
+    wrong = sh.identification.compare(recs[1], truth, "displacement", voltage=0.0)
+    assert wrong.nrmse("force") > 20.0
+
+
 def test_law_keys_follow_the_field_levels():
     keys, notes = law.law_keys("spencer", 2)
     assert keys == ("mr_alpha_a", "mr_alpha_b", "mr_c0_a", "mr_c0_b", "mr_c1_a", "mr_c1_b", *law.FIELD_FREE_KEYS)
