@@ -195,19 +195,31 @@ def test_identifies_a_known_current_law_and_predicts_a_third_current():
     assert any("extrapolates" in w for w in far.warnings)
 
 
-def test_voltage_driven_records_run_at_their_own_voltage():
-    """``voltages=``: the rig's field input becomes the voltage, each record runs at its own (the
-    truth as the start reproduces both records to the noise, one short fit step), and the law's
-    range is the records'."""
+def voltage_truth() -> sh.Rig:
+    """The truth rig with its law in the coil voltage [V] (the same coefficients, per volt)."""
     truth = truth_rig()
     truth.mr_input, truth.mr_current = law.MR_INPUTS["voltage"], 0.0
-    recs = []
+    return truth
+
+
+@pytest.fixture(scope="module")
+def voltage_records():
+    """The voltage truth simulated (CVODE, rtol 1e-8, no noise) at 0 V and 2 V, the 5 s chirps."""
+    truth, recs = voltage_truth(), []
     for volts in (0.0, 2.0):
         r = copy.copy(truth)
         r.mr_voltage = volts
-        t, u = chirp(duration=2.0)
+        t, u = chirp()
         sim = sh.simulate(r, "displacement", command=u, dt=DT, options=sh.solver_options(method="cvode", rtol=1e-8))
         recs.append(sh.Response({"time": t, "command": u, "displacement": sim.displacement, "force": sim.force}))
+    return recs
+
+
+def test_voltage_driven_records_run_at_their_own_voltage(voltage_records):
+    """``voltages=``: the rig's field input becomes the voltage, each record runs at its own (the
+    truth as the start reproduces both records to the noise, one short fit step), and the law's
+    range is the records'."""
+    truth, recs = voltage_truth(), voltage_records
     ident = sh.identify(recs, rig=truth, fit=["mr_alpha_b"], mode="displacement", voltages=[0, 2], max_nfev=1,
                         frequency_stage=False, progress=False)
     assert law.rig_field(ident.rig)[0] == "voltage" and (ident.rig.mr_law_min, ident.rig.mr_law_max) == (0.0, 2.0)
@@ -242,6 +254,9 @@ def two_records():
     (dict(currents=[0.0, -1.0]), r"invalid current of record 2 = -1.0: must be finite and >= 0"),
     (dict(currents=[0.0, "one"]), r"invalid current of record 2 = 'one': expected a number"),
     (dict(currents=[0.0, math.inf]), r"invalid current of record 2 = inf"),
+    (dict(currents=[math.nan, 1.0]), r"invalid current of record 1 = nan: must be finite and >= 0"),
+    (dict(voltages=[0.0]), r"invalid voltages = \[0.0\]: 1 value\(s\) for 2 record\(s\)"),
+    (dict(voltages=[0.0, -2.0]), r"invalid voltage of record 2 = -2.0: must be finite and >= 0"),
     (dict(currents=[0, 1], voltages=[0, 1]), r"currents and voltages both given"),
     (dict(currents=[0, 1], specimen="bouc_wen"), r"invalid specimen = 'bouc_wen' with currents"),
     (dict(law="quiroz2022"), r"invalid law = 'quiroz2022': a field law needs the records' field values"),
@@ -281,6 +296,10 @@ def _cli(capsys, *argv) -> tuple[int, str, str]:
     (("--current", "0,x"), r"error: invalid --current value 2 = 'x': expected a number"),
     (("--current", "0,,1"), r"error: invalid --current = '0,,1': expected comma-separated numbers"),
     (("--current", "0,1", "--voltage", "0,1"), r"error: invalid --current and --voltage together"),
+    (("--current", "0,nan"), r"error: invalid --current value 2 = 'nan': must be finite and >= 0"),
+    (("--voltage", "0,1,2"), r"error: invalid voltages = \[0.0, 1.0, 2.0\]: 3 value\(s\) for 2 record\(s\)"),
+    (("--voltage", "0,-2"), r"error: invalid --voltage value 2 = '-2': must be finite and >= 0"),
+    (("--voltage", "one,2"), r"error: invalid --voltage value 1 = 'one': expected a number"),
 ])
 def test_cli_identify_bad_field_input(tmp_path, capsys, two_records, flags, message):
     paths = [r.to_csv(tmp_path / f"r{i}.csv") for i, r in enumerate(two_records)]
@@ -315,6 +334,43 @@ def test_cli_compare_field_input(tmp_path, capsys, two_records):
         code, _, err = _cli(capsys, "compare", rec, "--rig", rig_file, "--mode", "displacement", *flags, "--out", bad)
         assert code == 2 and message in err and "Traceback" not in err, err
         assert not bad.exists()
+
+
+def test_cli_identify_and_compare_by_voltage(tmp_path, capsys, voltage_records):
+    """``identify --voltage 0,2`` then ``compare --voltage 1``: the identified rig reads a voltage
+    over 0 ... 2 V, and predicts a third voltage's record (the truth simulated at 1 V) to the
+    truth's own accuracy; ``--current`` against that rig is refused (exit 2, nothing written)."""
+    truth = voltage_truth()
+    start = sh.save_rig(truth, tmp_path / "start.toml")
+    paths = [r.to_csv(tmp_path / f"v{i}.csv") for i, r in enumerate(voltage_records)]
+    out = tmp_path / "law"
+    code, _, err = _cli(capsys, "identify", *paths, "--mode", "displacement", "--voltage", "0,2", "--rig", start,
+                        "--fit", "mr_alpha_b", "--max-nfev", "1", "--out", out, "--quiet")
+    assert code == 0, err
+    rig = sh.load_rig(out / "rig_identified.toml")
+    assert law.rig_field(rig)[0] == "voltage" and (rig.mr_law_min, rig.mr_law_max) == (0.0, 2.0)
+    assert json.loads((out / "identification.json").read_text())["field"]["values"] == [0.0, 2.0]
+    at_one = copy.copy(truth)
+    at_one.mr_voltage = 1.0
+    t, u = chirp()
+    sim = sh.simulate(at_one, "displacement", command=u, dt=DT, options=sh.solver_options(method="cvode", rtol=1e-8))
+    rec = sh.Response({"time": t, "command": u, "displacement": sim.displacement, "force": sim.force})
+    rec_path = rec.to_csv(tmp_path / "v_half.csv")
+    code, _, err = _cli(capsys, "compare", rec_path, "--rig", out / "rig_identified.toml", "--mode", "displacement",
+                        "--voltage", "1", "--out", tmp_path / "cmp")
+    assert code == 0, err
+    c = json.loads((tmp_path / "cmp" / "comparison.json").read_text())
+    assert c["channels"]["force"]["nrmse_pct"] < 2.0 and not any("extrapolates" in w for w in c["warnings"]), c
+    assert c["field"] == {"input": "voltage", "value": 1.0, "unit": "V", "law": "spencer", "given": True}
+    # the same record at 0 V (what a forgotten --voltage would give) is far off: the flag is what runs
+    code, _, err = _cli(capsys, "compare", rec_path, "--rig", out / "rig_identified.toml", "--mode", "displacement",
+                        "--voltage", "0", "--out", tmp_path / "cmp0")
+    zero = json.loads((tmp_path / "cmp0" / "comparison.json").read_text())
+    assert code == 0 and zero["channels"]["force"]["nrmse_pct"] > 20.0, err
+    code, _, err = _cli(capsys, "compare", rec_path, "--rig", out / "rig_identified.toml", "--mode", "displacement",
+                        "--current", "1", "--out", tmp_path / "bad")
+    assert code == 2 and "the rig's MR damper law reads a voltage" in err and "Traceback" not in err, err
+    assert not (tmp_path / "bad").exists()
 
 
 # ---- the UTFSM records: 0 A + 1 A -> the held-out 0.5 A sweep --------------------------------------

@@ -63,6 +63,7 @@ class Comparison:
     f_max: float = 0.0
     channels: dict = field(default_factory=dict)  #: channel -> metrics (the JSON's "channels")
     warnings: list = field(default_factory=list)  #: the simulated run's limits and solver notes (``Response.warnings``)
+    field: dict | None = None  #: the MR damper's field input the record ran at (input, value, unit, law), else None
 
     def nrmse(self, channel: str) -> float:
         return self.channels[channel]["nrmse_pct"]
@@ -72,7 +73,7 @@ class Comparison:
                 "dt_s": float(self.time[1] - self.time[0]), "command_band_hz": self.f_max,
                 "definition": "nrmse_pct = 100 rms(sim - measured) / std(measured); nrmse_demeaned_pct: the "
                               "error's mean removed; frf: H1 = S_uy/S_uu (Welch, Hann, nperseg) of channel/command",
-                "warnings": self.warnings, "channels": self.channels}
+                "warnings": self.warnings, "field": self.field, "channels": self.channels}
 
     def figures(self) -> dict:
         from .figures import frf_figure, overlay_figure
@@ -148,7 +149,7 @@ def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, opti
             identified on is reported in ``warnings``); ValueError naming the flag when the rig has
             no MR damper, its law reads the other input, or the value is not a finite number >= 0.
     """
-    from .law import predict_at
+    from .law import FIELD_INPUTS, choice_name, predict_at, rig_field
 
     rig = predict_at(rig, current, voltage)
     if mode not in ("displacement", "force"):
@@ -164,6 +165,10 @@ def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, opti
     out = Comparison(name=record_name(record), mode=mode, time=np.asarray(record.time), measured={}, simulated={},
                      frf_measured={}, frf_simulated={}, frequencies=freq, f_max=f_max,
                      warnings=sim.warnings(record_rig(rig, record)))
+    if rig.effects.mr_damper:
+        kind, value = rig_field(rig)
+        out.field = {"input": kind, "value": value, "unit": FIELD_INPUTS[kind][1],
+                     "law": choice_name(rig, "mr_law"), "given": current is not None or voltage is not None}
     for ch in chans:
         m, s = np.asarray(record.channels[ch], dtype=float), np.asarray(sim.channels[ch], dtype=float)
         out.measured[ch], out.simulated[ch] = m, s
