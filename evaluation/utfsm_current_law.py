@@ -32,6 +32,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from doc_tables import write_between  # evaluation/ (the script's own folder)
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(os.environ.get("SH_SHARED_DIR", ROOT.parent / "shared")) / "real-data" / "utfsm-mts-mrdamper"
@@ -323,9 +324,7 @@ def main(argv=None) -> int:
             figure(records, preds, base, FIGURE)
             print(f"wrote {FIGURE}")
         doc = ROOT / "docs" / "lab-records.md"
-        s = doc.read_text()
-        i, j = s.index(START) + len(START), s.index(END)
-        doc.write_text(s[:i] + "\n" + text + "\n" + s[j:])
+        write_between(doc, START, END, text)
         print(f"wrote the tables into {doc}")
     print(f"total {time.perf_counter() - t_all:.0f} s")
     return 0
