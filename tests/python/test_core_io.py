@@ -139,7 +139,8 @@ def _rigs(draw) -> sh.Rig:
         rig.mr_alpha_c = rig.mr_bw_decay = 0.0
     else:  # alpha(u) >= 0 and beta, gamma finite at the run's u
         u = max(rig.mr_voltage, rig.mr_current)
-        rig.mr_alpha_c = max(rig.mr_alpha_c, -(rig.mr_alpha_a + rig.mr_alpha_b * u) / max(u * u, 1e-300))
+        # (1 - 1e-9): alpha(u) just above 0, not on it, where rounding could give -2e-16
+        rig.mr_alpha_c = max(rig.mr_alpha_c, -(1.0 - 1e-9) * (rig.mr_alpha_a + rig.mr_alpha_b * u) / max(u * u, 1e-300))
         rig.mr_bw_decay = max(rig.mr_bw_decay, -1.0 / max(u, 1e-300))
     rig.mr_law_min, rig.mr_law_max = sorted((rig.mr_law_min, rig.mr_law_max))
     rig.validate()
