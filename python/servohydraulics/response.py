@@ -182,6 +182,19 @@ def limit_warnings(flags: np.ndarray, time: np.ndarray, peak_force: float, rig: 
     """Notes on the physical limits a run hit, from its per-row OutputFlag bits
     (``rig`` adds the limit values): the notes of :func:`limit_notes`."""
     return [note for _, note, _ in limit_notes(flags, time, peak_force, rig)]
+def mr_law_warnings(rig: Rig | None) -> list[str]:
+    """A note when the rig's MR damper runs at a field input outside the range its law was
+    identified on (``mr_law_min`` ... ``mr_law_max``): the run extrapolates the law."""
+    if rig is None or not rig.effects.mr_damper:
+        return []
+    current = rig.mr_input == _core.MrInput.Current
+    u = float(rig.mr_current if current else rig.mr_voltage)
+    lo, hi = float(rig.mr_law_min), float(rig.mr_law_max)
+    if lo <= u <= hi:
+        return []
+    kind, unit = ("current", "A") if current else ("voltage", "V")
+    return [f"MR damper {kind} {u:g} {unit} is outside the range its law was identified on ({lo:g} ... {hi:g} {unit}, "
+            "specimen.mr_law_min/mr_law_max): the run extrapolates the law"]
 
 
 class Channels(Mapping):
@@ -240,12 +253,15 @@ class Response:
         path: the file of a record, else None.
         metadata: how a record was read (``read_record``: columns, units, scales, offsets, the
             file's header block); empty for a run.
+        settings: rig keys the record was made at, which its simulation uses over any rig's
+            (e.g. ``{"mr_current": 0.5}``: an MR damper's coil current; ``identification.run``);
+            empty unless given (:meth:`with_settings`).
     """
 
     def __init__(self, channels: Mapping[str, ArrayLike], *, kind: str = "record", mode: str | None = None,
                  dt: float | None = None, rig: Rig | None = None, work: _core.RunSummary | Work | None = None,
                  units: Mapping[str, str] | None = None, path: str | Path | None = None,
-                 metadata: Mapping[str, Any] | None = None):
+                 metadata: Mapping[str, Any] | None = None, settings: Mapping[str, float] | None = None):
         if kind not in KINDS:
             raise ValueError(f"invalid kind = {kind!r}: expected one of {list(KINDS)}")
         if "time" not in channels:
@@ -260,6 +276,7 @@ class Response:
         self.kind, self.mode, self.rig, self.work = kind, mode, rig, work
         self.path = None if path is None else Path(path)
         self.metadata = dict(metadata or {})
+        self.settings = dict(settings or {})
         t = data["time"]
         self.dt = float(dt) if dt is not None else (float((t[-1] - t[0]) / (t.size - 1)) if t.size > 1 else math.nan)
         status = None if work is None else work.status
@@ -288,6 +305,14 @@ class Response:
     def __repr__(self) -> str:
         return (f"Response(kind={self.kind!r}, mode={self.mode!r}, rows={len(self)}, dt={self.dt:.6g}, "
                 f"status={self.status!r}, channels={list(self.channels)})")
+
+    def with_settings(self, **settings: float) -> Response:
+        """A copy (sharing the channel arrays) whose ``settings`` are these rig keys [SI] over its own."""
+        import copy
+
+        out = copy.copy(self)
+        out.settings = {**self.settings, **{k: float(v) for k, v in settings.items()}}
+        return out
 
     # ---- outcome ---------------------------------------------------------------------
     @property
@@ -329,6 +354,7 @@ class Response:
         if peak is None:
             peak = float(np.max(np.abs(self.channels.get("force", np.zeros(0))), initial=0.0))
         out = [(code, text) for code, text, _ in limit_notes(self.flags, self.time, peak, rig)]
+        out += [("run_mr_law", text) for text in mr_law_warnings(rig)]
         out += [("run_solver", text) for text in solver_warnings(self.work)]
         if not self.success:
             out.append(("run_failed", self.message))

@@ -18,15 +18,22 @@ def print_checks(checks) -> None:
 def _run(args: argparse.Namespace) -> int:
     from ..identification import compare
     from ..identification.checks import check_accept
+    from ..identification.law import field_value
     from ..readers import layout_of
     from ..records import read_record
     from ..rig import load_rig
     from ..simulate import solver_options
 
     accept = check_accept(args.accept)
+    if args.current is not None and args.voltage is not None:
+        raise ValueError("invalid --current and --voltage together: an MR damper's law reads one field input; "
+                         "give --current (amperes) or --voltage (volts)")
+    current = None if args.current is None else field_value(args.current, "--current")
+    voltage = None if args.voltage is None else field_value(args.voltage, "--voltage")
     rec = read_record(args.record, layout_of(args))
     options = None if args.method is None else solver_options(method=args.method)
-    c = compare(rec, load_rig(args.rig), args.mode, dt=args.dt, options=options, accept=accept)
+    c = compare(rec, load_rig(args.rig), args.mode, dt=args.dt, options=options, accept=accept, current=current,
+                voltage=voltage)
     path = c.write(args.out)
     print_checks(c.checks)
     for ch, m in c.channels.items():
@@ -54,6 +61,10 @@ def register(sub) -> None:
                    help="controller sample time [s] (default: the record's sample time)")
     p.add_argument("--method", choices=list(METHODS), default=None,
                    help="integrator (default: compare's reference, cvode)")
+    p.add_argument("--current", default=None, metavar="AMPS",
+                   help="the MR damper's coil current [A] of the record: the rig's field law predicts the damper "
+                        "there (a value outside the law's identified range is reported as an extrapolation)")
+    p.add_argument("--voltage", default=None, metavar="VOLTS", help="the same for a voltage-driven MR damper [V]")
     add_accept(p)
     add_arguments(p)
     p.set_defaults(func=_run)

@@ -66,6 +66,7 @@ CODES: dict[str, tuple[str, str]] = {
     "run_supply": (WARNING, "the simulated run reached the supply pressure"),
     "run_spool": (WARNING, "the simulated run saturated the spool"),
     "run_drive": (WARNING, "the simulated run saturated the valve drive"),
+    "run_mr_law": (WARNING, "the MR damper ran outside the field range its law was identified on"),
     "run_solver": (WARNING, "the integrator's notes on the simulated run"),
     "run_failed": (WARNING, "the simulated run failed"),
 }

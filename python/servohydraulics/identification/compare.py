@@ -35,6 +35,7 @@ from .run import (
     nrmse_demeaned_pct,
     nrmse_pct,
     record_name,
+    record_rig,
     simulate_record,
 )
 
@@ -68,6 +69,7 @@ class Comparison:
     warnings: list = field(default_factory=list)  #: the simulated run's limits and solver notes (``Response.warnings``)
     checks: list = field(default_factory=list)  #: ``checks.Check``: the record's plausibility and the run's limits
     command: np.ndarray | None = field(default=None, repr=False)  #: the record's command (for the zoom windows)
+    field: dict | None = None  #: the MR damper's field input the record ran at (input, value, unit, law), else None
 
     def nrmse(self, channel: str) -> float:
         return self.channels[channel]["nrmse_pct"]
@@ -77,7 +79,8 @@ class Comparison:
                 "dt_s": float(self.time[1] - self.time[0]), "command_band_hz": self.f_max,
                 "definition": "nrmse_pct = 100 rms(sim - measured) / std(measured); nrmse_demeaned_pct: the "
                               "error's mean removed; frf: H1 = S_uy/S_uu (Welch, Hann, nperseg) of channel/command",
-                "warnings": self.warnings, "checks": [c.to_dict() for c in self.checks], "channels": self.channels}
+                "warnings": self.warnings, "checks": [c.to_dict() for c in self.checks], "field": self.field,
+                "channels": self.channels}
 
     def figure_names(self) -> list[str]:
         """The figures :meth:`write` writes (``NAME.png``)."""
@@ -149,7 +152,8 @@ def frf_points(measured: FrequencyResponse, simulated: FrequencyResponse, freque
 
 
 def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, options=None,
-            frequencies=None, simulated: Response | None = None, accept=None, check: bool = True) -> Comparison:
+            frequencies=None, simulated: Response | None = None, accept=None, check: bool = True,
+            current: float | None = None, voltage: float | None = None) -> Comparison:
     """Simulates the record's command through the rig and compares (see the module docstring).
 
     Args:
@@ -162,7 +166,14 @@ def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, opti
         accept: codes of warning-level checks the user acknowledges (``checks.CODES``).
         check: run the record's plausibility checks first (``checks.record_checks``; an error
             raises ``checks.CheckError``, a ValueError); ``identify`` checks its records once itself.
+        current, voltage: the MR damper's coil current [A] or voltage [V] the record was made at (its
+            law predicts the damper there, ``law.predict_at``; a value outside the range the law was
+            identified on is reported in ``warnings``); ValueError naming the flag when the rig has
+            no MR damper, its law reads the other input, or the value is not a finite number >= 0.
     """
+    from .law import FIELD_INPUTS, choice_name, predict_at, rig_field
+
+    rig = predict_at(rig, current, voltage)
     if mode not in ("displacement", "force"):
         raise ValueError(f"invalid mode = {mode!r}: a record compares in 'displacement' or 'force' control")
     check_record(record)
@@ -176,8 +187,14 @@ def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, opti
                       dtype=float)
     out = Comparison(name=record_name(record), mode=mode, time=np.asarray(record.time), measured={}, simulated={},
                      command=u,
-                     frf_measured={}, frf_simulated={}, frequencies=freq, f_max=f_max, warnings=sim.warnings(rig),
-                     checks=found + settle(run_checks(sim, rig, str(record.path or record_name(record))), accept))
+                     frf_measured={}, frf_simulated={}, frequencies=freq, f_max=f_max,
+                     warnings=sim.warnings(record_rig(rig, record)),
+                     checks=found + settle(run_checks(sim, record_rig(rig, record),
+                                                      str(record.path or record_name(record))), accept))
+    if rig.effects.mr_damper:
+        kind, value = rig_field(rig)
+        out.field = {"input": kind, "value": value, "unit": FIELD_INPUTS[kind][1],
+                     "law": choice_name(rig, "mr_law"), "given": current is not None or voltage is not None}
     for ch in chans:
         m, s = np.asarray(record.channels[ch], dtype=float), np.asarray(sim.channels[ch], dtype=float)
         out.measured[ch], out.simulated[ch] = m, s
