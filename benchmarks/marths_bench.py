@@ -2,11 +2,15 @@
     PYTHONPATH=python SERVOHYDRAULICS_CORE_DIR=build/dev python benchmarks/marths_bench.py --data ../shared/marths-data
 The nominal El Centro RoDeAC run (42,169 steps): the C++ loop alone and the whole trial (loop + J1-J10), median
 of 5, and the per-step times of a run that reads the clock around each step; then 20 perturbed runs through
-sh.sweep on 2 processes (pool start-up included), and the whole command's run (nominal + 20 perturbed)."""
+sh.sweep on 2 processes (pool start-up included), and the whole command's run (nominal + 20 perturbed); then the
+nominal El Centro RoDeAC run on the nonlinear two-actuator rig (--plant nonlinear: dopri5 with the CVODE fallback),
+the loop alone (median of 3) and with the rig's channels replayed (keep_signals).  The load average is printed
+before and after (the machine is shared)."""
 
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import numpy as np
@@ -21,6 +25,7 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--perturbed", type=int, default=20)
     a = ap.parse_args()
+    print("load average (1, 5, 15 min) before: " + ", ".join(f"{v:.1f}" for v in os.getloadavg()))
     data, rec = marths.load_data(a.data), marths.load_record(a.data, "elcentro")
     st = marths.structures(data)
     marths.run_trial(data, rec, "rodeac", structures_=st)  # warm: imports (SciPy's FFT), caches
@@ -46,6 +51,18 @@ def main() -> None:
     print(f"{a.perturbed} perturbed El Centro RoDeAC runs on {a.workers} processes: {pert:.1f} s wall (pool start-up "
           f"included; C++ loop per run median {np.median(walls):.3f} s); nominal + {a.perturbed} perturbed: "
           f"{total:.1f} s")
+    import servohydraulics as sh
+
+    rig = sh.marths_rig()
+    loops = []
+    for _ in range(3):
+        loops.append(marths.run_trial(data, rec, "rodeac", plant=rig, structures_=st).wall_time)
+    t0 = time.perf_counter()
+    marths.run_trial(data, rec, "rodeac", plant=rig, structures_=st, keep_signals=True)
+    whole = time.perf_counter() - t0
+    print(f"nominal El Centro RoDeAC run on the nonlinear rig: C++ loop median of 3 = {np.median(loops):.3f} s; "
+          f"whole trial with the rig's channels replayed = {whole:.3f} s")
+    print("load average (1, 5, 15 min) after: " + ", ".join(f"{v:.1f}" for v in os.getloadavg()))
 
 
 if __name__ == "__main__":

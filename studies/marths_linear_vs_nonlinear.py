@@ -1,0 +1,262 @@
+"""The same compensator on the maRTHS benchmark's identified linear plant and on our nonlinear two-actuator rig.
+
+Issue 23, item 5: the virtual multi-axial RTHS benchmark (BENCHMARK.md: the 29-DOF reference and numerical
+substructure, the physical frame's feedback force, the sensors and noise) run with RoDeAC (and, for contrast,
+its fixed FIR ``rodeac_fixed`` and no compensation ``none``) behind five plants:
+
+* ``identified``: the benchmark's identified 2 x 2 transfer matrix (plantFRAME_SS), linear;
+* ``rig-linear``: the calibrated two-actuator rig (``sh.marths_rig()``, docs/multi-actuator.md) with its
+  nonlinear effects off (load pressure, flow curve, friction, spool and drive saturation): its own linear
+  plant, fitted to the identified one over 0-50 Hz.  Identified vs rig-linear is the calibration's mismatch;
+* ``rig``: the calibrated rig, every effect on (Zhao et al. 2003's actuator: the valve flow's load-pressure
+  root, the flow curve, compressibility, leakage, piston friction F_c = 31.6 N, saturations);
+* ``rig-small-valve``: actuator 1's servovalve ``VALVE_FACTOR`` times smaller (K_v / k) and its proportional
+  gain k times larger (G_p k): the same small-signal loop gain, hence the same linearisation and the same
+  identified plant, but its spool must open k times wider for the same flow and meets its stops;
+* ``rig-friction``: seal friction F_c = ``FRICTION_N`` on both pistons (the calibrated rig has the paper's
+  31.6 N, 0.02 % of the forces this frame asks of the actuators).
+
+Rig versus rig-linear is what the nonlinearity does; the two variants are what the identified plant cannot
+show at all.  For each run: J1-J10 (BENCHMARK.md section 8), and on the rigs the channels only a physical
+model has (the loop's commands replayed on the rig: identical strokes): each actuator's spool against its
+limit, the load-cell forces, their difference F1 - F2 and the opposing force (the force that cancels in the x
+resultant: the actuators pushing against each other through the frame's rotational stiffness).
+
+    python studies/marths_linear_vs_nonlinear.py --out OUT [--data ../shared/marths-data]
+        [--records elcentro,kobe,morgan] [--controllers rodeac,rodeac_fixed,none] [--write]
+
+writes ``OUT/results.json`` (every J component unrounded, the rig's peaks, per run), ``OUT/table.md`` and
+``OUT/linear_vs_nonlinear_<record>.png``; ``--write`` also puts the El Centro figure in docs/figures and the
+tables in docs/multi-actuator.md (between ``<!-- marths_linear_vs_nonlinear -->`` markers).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+import servohydraulics as sh
+from servohydraulics import marths
+from servohydraulics.atomic import FileSet, replace_marked, write_with
+from servohydraulics.multi_rig import MultiActuatorRig
+
+ROOT = Path(__file__).resolve().parents[1]
+#: Actuator 1's valve is this many times smaller in rig-small-valve (its G_p as many times larger).
+VALVE_FACTOR = 8.0
+#: Coulomb (seal) friction on each piston in rig-friction [N].
+FRICTION_N = 2000.0
+PLANTS = ("identified", "rig-linear", "rig", "rig-small-valve", "rig-friction")
+CONTROLLERS = ("rodeac", "rodeac_fixed", "none")
+LINEAR_OFF = ("load_pressure", "flow_nonlinearity", "coulomb_friction", "spool_saturation", "drive_saturation",
+              "lugre_friction")
+
+
+def _variant(base: MultiActuatorRig, change) -> MultiActuatorRig:
+    rigs = [sh.copy_rig(r) for r in base.rigs]
+    for i, r in enumerate(rigs):
+        change(i, r)
+    out = MultiActuatorRig(rigs, base.arms, base.angles, base.specimen)
+    out.frame = base.frame
+    return out
+
+
+def plants() -> dict[str, MultiActuatorRig | None]:
+    """The five plants (None: the identified plant)."""
+    base = sh.marths_rig()
+
+    def linear(i, r):
+        for name in LINEAR_OFF:
+            setattr(r.effects, name, False)
+
+    def small_valve(i, r):
+        if i == 0:
+            r.K_v /= VALVE_FACTOR
+            r.G_p *= VALVE_FACTOR
+
+    def friction(i, r):
+        r.F_c = FRICTION_N
+        r.effects.coulomb_friction = True
+
+    return {"identified": None, "rig-linear": _variant(base, linear), "rig": base,
+            "rig-small-valve": _variant(base, small_valve), "rig-friction": _variant(base, friction)}
+
+
+def run_all(data_dir: Path, records: list[str], controllers: list[str]) -> tuple[dict, dict]:
+    """Every (record, plant, controller): results (JSON-able) and the kept trials of RoDeAC for the figures."""
+    data = marths.load_data(data_dir)
+    st = marths.structures(data)
+    ps = plants()
+    results: dict = {}
+    kept: dict = {}
+    from tqdm import tqdm
+
+    jobs = [(r, p, c) for r in records for p in PLANTS for c in controllers]
+    for rec_name, pname, ctrl in tqdm(jobs, desc="runs"):
+        rec = marths.load_record(data_dir, rec_name)
+        t0 = time.perf_counter()
+        trial = marths.run_trial(data, rec, ctrl, plant=ps[pname], structures_=st, keep_signals=True)
+        entry = {"J": trial.J, "ok": trial.ok, "stable": trial.stable, "failure_time": trial.failure_time,
+                 "peak_voltage_V": trial.peak_voltage, "loop_wall_time_s": trial.wall_time,
+                 "wall_time_s": time.perf_counter() - t0}
+        if trial.rig is not None:
+            entry["rig"] = marths.rig_summary(trial.rig, trial.response.channels)
+        results.setdefault(rec_name, {}).setdefault(pname, {})[ctrl] = entry
+        if ctrl == controllers[0]:
+            kept[(rec_name, pname)] = trial
+    return results, kept
+
+
+def _f(v: float, nd: int = 2) -> str:
+    return "nan" if not math.isfinite(v) else f"{v:.{nd}f}"
+
+
+def j_table(results: dict, record: str, controller: str) -> str:
+    """Every J component (rows) for each plant (columns), one record and controller."""
+    plist = [p for p in PLANTS if p in results[record]]
+    head = "| J | component | unit | " + " | ".join(plist) + " |\n|---|---|---|" + "---:|" * len(plist) + "\n"
+    rows = []
+    for j, comps in marths.J_COMPONENTS.items():
+        for i, c in enumerate(comps):
+            vals = [_f(results[record][p][controller]["J"][j][i]) for p in plist]
+            rows.append(f"| {j} | {c} | {marths.J_UNITS[j]} | " + " | ".join(vals) + " |")
+    return head + "\n".join(rows) + "\n"
+
+
+def summary_table(results: dict, record: str) -> str:
+    """Per plant and controller: the main J and the rig's peaks."""
+    head = ("| plant | controller | J2 act1 / act2 [%] | J3 act1 / act2 [%] | J5 x / θ [%] | J7 x / θ [%] | "
+            "J9 x / θ [%] | peak spool act1 / act2 [-] | peak F1 - F2 [kN] | peak opposing force [kN] |\n"
+            "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n")
+    rows = []
+    for p in PLANTS:
+        if p not in results[record]:
+            continue
+        for c, e in results[record][p].items():
+            J = e["J"]
+            pair = {j: f"{_f(J[j][0])} / {_f(J[j][1])}" for j in ("J2", "J3", "J5", "J7", "J9")}
+            rig = e.get("rig")
+            if rig:
+                a = rig["actuators"]
+                extra = (f"{a[0]['peak_spool']:.3f} / {a[1]['peak_spool']:.3f} | "
+                         f"{rig['peak_force_difference_N'] / 1e3:.1f} | {rig['peak_opposing_force_N'] / 1e3:.1f}")
+            else:
+                extra = "- | - | -"
+            flag = "" if e["stable"] else " (not stable)"
+            rows.append(f"| {p} | {c}{flag} | {pair['J2']} | {pair['J3']} | {pair['J5']} | {pair['J7']} | "
+                        f"{pair['J9']} | {extra} |")
+    return head + "\n".join(rows) + "\n"
+
+
+def _window(t: np.ndarray, s: np.ndarray, half: float = 1.5) -> np.ndarray:
+    k = int(np.argmax(np.abs(s)))
+    return (t > t[k] - half) & (t < t[k] + half)
+
+
+def figure(kept: dict, record: str, controller: str):
+    """Tracking and errors in x and θ, per-actuator tracking error, the spools and the force fighting."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(11, 10))
+    base = kept[(record, "identified")].response.channels
+    t = base["time"]
+    w = _window(t, base["x_numerical"])
+    styles = {"identified": ("k", "-"), "rig-linear": ("tab:gray", ":"), "rig": ("tab:blue", "-"),
+              "rig-small-valve": ("tab:red", "-"), "rig-friction": ("tab:green", "-")}
+    shown = [p for p in ("identified", "rig", "rig-small-valve", "rig-friction") if (record, p) in kept]
+    for col, (q, unit) in enumerate((("x", "mm"), ("theta", "mrad"))):
+        ax = fig.add_subplot(4, 2, 1 + col)
+        ax.plot(t[w], 1e3 * base[f"{q}_numerical"][w], color="0.6", lw=2.0, label="target (numerical, identified)")
+        for p in shown:
+            s = kept[(record, p)].response.channels
+            ax.plot(t[w], 1e3 * s[f"{q}_estimate"][w], color=styles[p][0], ls=styles[p][1], lw=0.8, label=p)
+        ax.set_ylabel(f"{'x' if q == 'x' else 'θ'} measured [{unit}]")
+        ax.legend(fontsize=6, loc="upper right")
+        ax = fig.add_subplot(4, 2, 3 + col)
+        for p in shown:
+            s = kept[(record, p)].response.channels
+            ax.plot(t[w], 1e3 * (s[f"{q}_estimate"] - s[f"{q}_numerical"])[w], color=styles[p][0], ls=styles[p][1],
+                    lw=0.8, label=p)
+        ax.set_ylabel(f"{'x' if q == 'x' else 'θ'} error vs numerical [{unit}]")
+        ax.set_xlabel("time [s]")
+    for col, act in enumerate((1, 2)):
+        ax = fig.add_subplot(4, 2, 5 + col)
+        for p in ("rig", "rig-small-valve"):
+            if (record, p) in kept and kept[(record, p)].rig is not None:
+                r = kept[(record, p)].rig
+                ax.plot(r.time, r[f"actuator{act}.spool"], color=styles[p][0], lw=0.6, label=p)
+        ax.axhline(1.0, color="k", ls=":", lw=0.8)
+        ax.axhline(-1.0, color="k", ls=":", lw=0.8)
+        ax.set_ylabel(f"actuator {act} spool [-]")
+        ax.legend(fontsize=6, loc="lower right")
+    ax = fig.add_subplot(4, 2, 7)
+    for p in ("rig", "rig-small-valve", "rig-friction"):
+        if (record, p) in kept and kept[(record, p)].rig is not None:
+            r = kept[(record, p)].rig
+            ax.plot(r.time, 1e-3 * (r["actuator1.force"] - r["actuator2.force"]), color=styles[p][0], lw=0.6,
+                    label=p)
+    ax.set_ylabel("F1 - F2 [kN]")
+    ax.set_xlabel("time [s]")
+    ax.legend(fontsize=6, loc="lower right")
+    ax = fig.add_subplot(4, 2, 8)
+    for p in ("rig", "rig-friction"):
+        if (record, p) in kept and kept[(record, p)].rig is not None:
+            r = kept[(record, p)].rig
+            ww = _window(r.time, r["actuator1.velocity"], 1.0)
+            ax.plot(r.time[ww], r["actuator1.friction"][ww], color=styles[p][0], lw=0.8, label=f"{p}: friction")
+    ax.set_ylabel("actuator 1 friction [N]")
+    ax.set_xlabel("time [s]")
+    ax.legend(fontsize=6, loc="lower right")
+    fig.suptitle(f"maRTHS, {record} × {marths.EQ_INTENSITY}, {controller}: the identified linear plant against the "
+                 "nonlinear two-actuator rig (rows 1-2: 3 s around the peak)", fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "marths-data")
+    ap.add_argument("--records", default="elcentro", help="comma-separated: elcentro, kobe, morgan")
+    ap.add_argument("--controllers", default=",".join(CONTROLLERS), help="comma-separated; the first is plotted")
+    ap.add_argument("--out", type=Path, required=True, help="output folder")
+    ap.add_argument("--write", action="store_true", help="also the docs figure and the tables in the docs")
+    args = ap.parse_args()
+    records = [r.strip() for r in args.records.split(",") if r.strip()]
+    controllers = [c.strip() for c in args.controllers.split(",") if c.strip()]
+    for r in records:
+        if r not in marths.RECORDS:
+            raise SystemExit(f"error: invalid --records entry = {r!r}: expected one of {sorted(marths.RECORDS)}")
+    for c in controllers:
+        if c not in marths.CONTROLLERS:
+            raise SystemExit(f"error: invalid --controllers entry = {c!r}: expected one of "
+                             f"{sorted(marths.CONTROLLERS)}")
+    results, kept = run_all(args.data, records, controllers)
+    text = [f"Valve factor {VALVE_FACTOR:g} (rig-small-valve), seal friction {FRICTION_N:g} N (rig-friction); "
+            "noise seed 123; J in % (J1, J4 in ms), unrounded to 2 decimals.", ""]
+    for r in records:
+        text += [f"**{r} × {marths.EQ_INTENSITY}, {controllers[0]}: every J component**", "",
+                 j_table(results, r, controllers[0]), f"**{r}: all controllers, with the rig's peaks**", "",
+                 summary_table(results, r)]
+    table = "\n".join(text)
+    print(table)
+    args.out.mkdir(parents=True, exist_ok=True)
+    with FileSet() as files:
+        files.write_text(args.out / "results.json", json.dumps(
+            {"valve_factor": VALVE_FACTOR, "friction_N": FRICTION_N, "results": results}, indent=2, allow_nan=True))
+        files.write_text(args.out / "table.md", table)
+        for r in records:
+            figure(kept, r, controllers[0]).savefig(files.path(args.out / f"linear_vs_nonlinear_{r}.png"), dpi=110)
+    if args.write:
+        r = records[0]
+        write_with(ROOT / "docs" / "figures" / "marths_linear_vs_nonlinear.png",
+                   lambda p: figure(kept, r, controllers[0]).savefig(p, dpi=100, format="png"))
+        replace_marked(ROOT / "docs" / "multi-actuator.md", "marths_linear_vs_nonlinear", table)
+    print(f"wrote {args.out}")
+
+
+if __name__ == "__main__":
+    main()
