@@ -221,4 +221,6 @@ def test_the_study_variants():
     f = np.array([0.5, 5.0, 20.0])
     np.testing.assert_allclose(ps["rig-small-valve"].frequency_response(f), ps["rig"].frequency_response(f),
                                rtol=1e-9, atol=1e-12)
-    assert ps["rig-small-valve"].rigs[0].K_v == pytest.approx(ps["rig"].rigs[0].K_v / mod.VALVE_FACTOR)
+    k = mod.SMALL_VALVE_ACTUATOR
+    assert ps["rig-small-valve"].rigs[k].K_v == pytest.approx(ps["rig"].rigs[k].K_v / mod.VALVE_FACTOR)
+    assert ps["rig-small-valve"].rigs[k].G_p == pytest.approx(ps["rig"].rigs[k].G_p * mod.VALVE_FACTOR)
