@@ -29,7 +29,7 @@ from servohydraulics.multi_rig import MultiActuatorRig
 
 @pytest.fixture(scope="module")
 def pristine(tmp_path_factory):
-    return write_folder(tmp_path_factory.mktemp("marths-nl") / "data")
+    return write_folder(tmp_path_factory.mktemp("marths-nl") / "data", duration=1.0)
 
 
 @pytest.fixture(scope="module")
