@@ -25,8 +25,9 @@ resultant: the actuators pushing against each other through the frame's rotation
     python studies/marths_linear_vs_nonlinear.py --out OUT [--data ../shared/marths-data]
         [--records elcentro,kobe,morgan] [--controllers rodeac,rodeac_fixed,none] [--write]
 
-writes ``OUT/results.json`` (every J component unrounded, the rig's peaks, per run), ``OUT/table.md`` and
-``OUT/linear_vs_nonlinear_<record>.png``; ``--write`` also puts the El Centro figure in docs/figures and the
+writes ``OUT/results.json`` (every J component unrounded, the rig's peaks, per run), ``OUT/signals.npz`` (what the
+figures plot), ``OUT/table.md`` and ``OUT/linear_vs_nonlinear_<record>.png`` (``--replot``: these two again from
+the first two, without running); ``--write`` also puts the El Centro figure in docs/figures and the
 tables in docs/multi-actuator.md (between ``<!-- marths_linear_vs_nonlinear -->`` markers).
 """
 
@@ -210,42 +211,45 @@ def figure(kept: dict, record: str, controller: str):
         ax.set_ylabel(f"{'x' if q == 'x' else 'θ'} measured [{unit}]")
         ax.legend(fontsize=6, loc="upper right")
         ax = fig.add_subplot(4, 2, 3 + col)
-        for p in shown:
+        for p in reversed(shown):  # the identified plant's on top
             s = kept[(record, p)]
-            ax.plot(t[w], 1e3 * (s[f"{q}_estimate"] - s[f"{q}_numerical"])[w], color=styles[p][0], ls=styles[p][1],
-                    lw=0.8, label=p)
+            ax.plot(t, 1e3 * (s[f"{q}_estimate"] - s[f"{q}_numerical"]), color=styles[p][0], ls=styles[p][1],
+                    lw=0.5, label=p)
         ax.set_ylabel(f"{'x' if q == 'x' else 'θ'} error vs numerical [{unit}]")
-        ax.set_xlabel("time [s]")
+        ax.set_xlabel("time [s] (whole record)")
     for col, act in enumerate((1, 2)):
         ax = fig.add_subplot(4, 2, 5 + col)
-        for p in ("rig", "rig-small-valve"):
+        for p in ("rig-small-valve", "rig"):
             if "rig.time" in kept.get((record, p), {}):
                 r = kept[(record, p)]
-                ax.plot(r["rig.time"], r[f"actuator{act}.spool"], color=styles[p][0], lw=0.6, label=p)
+                ax.plot(r["rig.time"], r[f"actuator{act}.spool"], color=styles[p][0], lw=0.5, label=p)
         ax.axhline(1.0, color="k", ls=":", lw=0.8)
         ax.axhline(-1.0, color="k", ls=":", lw=0.8)
         ax.set_ylabel(f"actuator {act} spool [-]")
         ax.legend(fontsize=6, loc="lower right")
     ax = fig.add_subplot(4, 2, 7)
-    for p in ("rig", "rig-small-valve", "rig-friction"):
+    for p in ("rig-small-valve", "rig-friction", "rig"):
         if "rig.time" in kept.get((record, p), {}):
             r = kept[(record, p)]
-            ax.plot(r["rig.time"], 1e-3 * (r["actuator1.force"] - r["actuator2.force"]), color=styles[p][0], lw=0.6,
+            ax.plot(r["rig.time"], 1e-3 * (r["actuator1.force"] - r["actuator2.force"]), color=styles[p][0], lw=0.5,
                     label=p)
     ax.set_ylabel("F1 - F2 [kN]")
     ax.set_xlabel("time [s]")
     ax.legend(fontsize=6, loc="lower right")
     ax = fig.add_subplot(4, 2, 8)
-    for p in ("rig", "rig-friction"):
+    for p in ("rig-friction", "rig"):
         if "rig.time" in kept.get((record, p), {}):
             r = kept[(record, p)]
-            ww = _window(r["rig.time"], r["actuator1.velocity"], 1.0)
-            ax.plot(r["rig.time"][ww], r["actuator1.friction"][ww], color=styles[p][0], lw=0.8, label=f"{p}: friction")
-    ax.set_ylabel("actuator 1 friction [N]")
+            ww = _window(r["rig.time"], base["x_numerical"], 1.0)
+            ax.plot(r["rig.time"][ww], 1e-3 * r["actuator1.friction"][ww], color=styles[p][0], lw=0.8,
+                    label=f"{p}: friction")
+            ax.plot(r["rig.time"][ww], 1e-3 * r["actuator1.force"][ww] / 10, color=styles[p][0], lw=0.5, ls="--",
+                    label=f"{p}: load cell / 10")
+    ax.set_ylabel("actuator 1 [kN]")
     ax.set_xlabel("time [s]")
     ax.legend(fontsize=6, loc="lower right")
     fig.suptitle(f"maRTHS, {record} × {marths.EQ_INTENSITY}, {controller}: the identified linear plant against the "
-                 "nonlinear two-actuator rig (rows 1-2: 3 s around the peak)", fontsize=9)
+                 "nonlinear two-actuator rig (row 1: 3 s around the peak)", fontsize=9)
     fig.tight_layout()
     return fig
 
@@ -258,6 +262,8 @@ def main() -> None:
     ap.add_argument("--out", type=Path, required=True, help="output folder")
     ap.add_argument("--write", action="store_true", help="also the docs figure and the tables in the docs")
     ap.add_argument("--workers", type=int, default=2, help="processes (default 2)")
+    ap.add_argument("--replot", action="store_true",
+                    help="no runs: the tables and figures from OUT/results.json and OUT/signals.npz of an earlier run")
     args = ap.parse_args()
     records = [r.strip() for r in args.records.split(",") if r.strip()]
     controllers = [c.strip() for c in args.controllers.split(",") if c.strip()]
@@ -268,23 +274,39 @@ def main() -> None:
         if c not in marths.CONTROLLERS:
             raise SystemExit(f"error: invalid --controllers entry = {c!r}: expected one of "
                              f"{sorted(marths.CONTROLLERS)}")
-    t0 = time.perf_counter()
-    results, kept = run_all(args.data, records, controllers, args.workers)
-    wall = time.perf_counter() - t0
+    args.out.mkdir(parents=True, exist_ok=True)
+    if args.replot:  # the tables and figures again from a run's results.json and signals.npz
+        saved = json.loads((args.out / "results.json").read_text())
+        results, wall, workers = saved["results"], saved["wall_time_s"], saved["workers"]
+        with np.load(args.out / "signals.npz") as z:
+            kept: dict = {}
+            for key in z.files:
+                r, p, k = key.split("|")
+                kept.setdefault((r, p), {})[k] = z[key]
+        records = list(results)
+        controllers = list(results[records[0]][PLANTS[0]])
+    else:
+        t0 = time.perf_counter()
+        results, kept = run_all(args.data, records, controllers, args.workers)
+        wall, workers = time.perf_counter() - t0, args.workers
+        with FileSet() as files:  # the runs first: a figure can be redone with --replot
+            files.write_text(args.out / "results.json", json.dumps(
+                {"valve_factor": VALVE_FACTOR, "small_valve_actuator": SMALL_VALVE_ACTUATOR + 1,
+                 "friction_N": FRICTION_N, "wall_time_s": wall, "workers": workers, "results": results},
+                indent=2, allow_nan=True))
+            with open(files.path(args.out / "signals.npz"), "wb") as fh:
+                np.savez_compressed(fh, **{f"{r}|{p}|{k}": v for (r, p), sig in kept.items() for k, v in sig.items()})
     text = [f"Valve factor {VALVE_FACTOR:g} on actuator {SMALL_VALVE_ACTUATOR + 1} (rig-small-valve), seal friction "
             f"{FRICTION_N:g} N (rig-friction); noise seed 123; J in % (J1, J4 in ms), shown to 2 decimals "
             f"(OUT/results.json: unrounded). {len(records) * len(PLANTS) * len(controllers)} runs in {wall:.0f} s on "
-            f"{args.workers} processes.", ""]
+            f"{workers} processes.", ""]
     for r in records:
         text += [f"**{r} × {marths.EQ_INTENSITY}, {controllers[0]}: every J component**", "",
                  j_table(results, r, controllers[0]), f"**{r}: all controllers, with the rig's peaks**", "",
                  summary_table(results, r)]
     table = "\n".join(text)
     print(table)
-    args.out.mkdir(parents=True, exist_ok=True)
     with FileSet() as files:
-        files.write_text(args.out / "results.json", json.dumps(
-            {"valve_factor": VALVE_FACTOR, "friction_N": FRICTION_N, "results": results}, indent=2, allow_nan=True))
         files.write_text(args.out / "table.md", table)
         for r in records:
             figure(kept, r, controllers[0]).savefig(files.path(args.out / f"linear_vs_nonlinear_{r}.png"), dpi=110)
