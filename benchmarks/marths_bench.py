@@ -4,8 +4,8 @@ The nominal El Centro RoDeAC run (42,169 steps): the C++ loop alone and the whol
 of 5, and the per-step times of a run that reads the clock around each step; then 20 perturbed runs through
 sh.sweep on 2 processes (pool start-up included), and the whole command's run (nominal + 20 perturbed); then the
 nominal El Centro rodeac_fixed and none runs on the nonlinear two-actuator rig (--plant nonlinear: dopri5 with the
-CVODE fallback), the loop alone, once each (RoDeAC itself oscillates there at 167 Hz: docs/multi-actuator.md).  The load average is printed
-before and after (the machine is shared)."""
+CVODE fallback), the loop alone, once each (RoDeAC itself oscillates there at 167 Hz: docs/multi-actuator.md).
+The load average is printed before and after (the machine is shared)."""
 
 from __future__ import annotations
 
