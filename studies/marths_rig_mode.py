@@ -11,7 +11,7 @@ about 167 Hz from t ~ 9 s of El Centro.  This script gives the evidence behind t
 
     python studies/marths_rig_mode.py [--data ../shared/marths-data] [--seconds 11] [--write]
 
-(``--write``: the output also between the ``<!-- marths_rig_mode -->`` markers of docs/multi-actuator.md.)
+(``--write``: the output also between ``<!-- marths_rig_mode -->`` markers, if docs/multi-actuator.md has them.)
 """
 
 from __future__ import annotations
