@@ -18,12 +18,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from marths_support import write_folder
+from marths_support import assert_refused, run_cli, write_folder
 from scipy.linalg import expm
 
 import servohydraulics as sh
 from servohydraulics import marths
-from servohydraulics.cli import main
 from servohydraulics.multi_rig import MultiActuatorRig
 
 
@@ -119,15 +118,10 @@ def test_the_replay_is_the_loops_run_with_every_effect_and_the_daq(data, record)
     np.testing.assert_array_equal(t.rig["actuator1.command"], u[:, 0])
 
 
-def _cli(capsys, *argv):
-    code = main([str(a) for a in argv])
-    cap = capsys.readouterr()
-    return code, cap.out, cap.err
-
 
 def test_the_command_on_the_nonlinear_rig(pristine, tmp_path, capsys):
     out = tmp_path / "out"
-    code, stdout, err = _cli(capsys, "marths-benchmark", "--data", pristine, "--plant", "nonlinear", "--quiet",
+    code, stdout, err = run_cli(capsys, "marths-benchmark", "--data", pristine, "--plant", "nonlinear", "--quiet",
                              "--out", out)
     assert code == 0, err
     res = json.loads((out / "results.json").read_text())
@@ -150,7 +144,7 @@ def test_a_rig_file_as_the_plant(pristine, tmp_path, capsys):
     rig = sh.marths_rig()
     sh.save_multi_rig(rig, tmp_path / "mine.toml")
     out = tmp_path / "out"
-    code, _, err = _cli(capsys, "marths-benchmark", "--data", pristine, "--plant", tmp_path / "mine.toml",
+    code, _, err = run_cli(capsys, "marths-benchmark", "--data", pristine, "--plant", tmp_path / "mine.toml",
                         "--quiet", "--out", out)
     assert code == 0, err
     res = json.loads((out / "results.json").read_text())
@@ -158,43 +152,33 @@ def test_a_rig_file_as_the_plant(pristine, tmp_path, capsys):
     assert "rig" in res["runs"]["nominal"]
 
 
-def _refused(capsys, tmp_path, argv, named):
-    out = tmp_path / "never"
-    code, _, err = _cli(capsys, "marths-benchmark", *argv, "--quiet", "--out", out)
-    assert code == 2, err
-    assert err.startswith("servohydraulics marths-benchmark: error: "), err
-    assert "Traceback" not in err
-    for part in named:
-        assert part in err, err
-    assert not out.exists()
-
 
 def test_bad_plants_are_named(pristine, tmp_path, capsys):
     d = ["--data", pristine]
-    _refused(capsys, tmp_path, [*d, "--plant", "linear"], ["invalid plant = 'linear'", "identified | nonlinear"])
-    _refused(capsys, tmp_path, [*d, "--plant", tmp_path / "none.toml"], ["invalid plant = ", "none.toml",
+    assert_refused(capsys, tmp_path, [*d, "--plant", "linear"], ["invalid plant = 'linear'", "identified | nonlinear"])
+    assert_refused(capsys, tmp_path, [*d, "--plant", tmp_path / "none.toml"], ["invalid plant = ", "none.toml",
                                                                           "no such file"])
-    _refused(capsys, tmp_path, [*d, "--plant", "nonlinear", "--perturbed", "3"],
+    assert_refused(capsys, tmp_path, [*d, "--plant", "nonlinear", "--perturbed", "3"],
              ["invalid perturbed = 3 with plant = 'nonlinear'", "identified plant's uncertainty"])
     bad = tmp_path / "bad.toml"
     bad.write_text("[fixture\narms = [0.3]\n")
-    _refused(capsys, tmp_path, [*d, "--plant", bad], ["bad.toml", "is not valid TOML"])
+    assert_refused(capsys, tmp_path, [*d, "--plant", bad], ["bad.toml", "is not valid TOML"])
     # a valid rig file with three actuators: the benchmark's coupler drives two
     three = tmp_path / "three.toml"
     three.write_text('[fixture]\narms = [0.3, 0.3, 0.4]\nangles_deg = [-30, 30, 5]\n[specimen]\nframe = "marths"\n'
                      "[[actuators]]\n[[actuators]]\n[[actuators]]\n")
-    _refused(capsys, tmp_path, [*d, "--plant", three], ["three.toml", "(count) = 3", "drives 2 actuators"])
+    assert_refused(capsys, tmp_path, [*d, "--plant", three], ["three.toml", "(count) = 3", "drives 2 actuators"])
     # a bad value inside a rig file: the file, the key and the value
     sh.save_multi_rig(sh.marths_rig(), tmp_path / "k.toml")
     text = (tmp_path / "k_actuator2.toml").read_text().replace("K_v = 0.016", "K_v = -0.016")
     (tmp_path / "k_actuator2.toml").write_text(text)
-    _refused(capsys, tmp_path, [*d, "--plant", tmp_path / "k.toml"], ["k.toml", "K_v", "-0.016"])
+    assert_refused(capsys, tmp_path, [*d, "--plant", tmp_path / "k.toml"], ["k.toml", "K_v", "-0.016"])
 
 
 def test_a_missing_actuator_file_is_named(pristine, tmp_path, capsys):
     sh.save_multi_rig(sh.marths_rig(), tmp_path / "m.toml")
     (tmp_path / "m_actuator1.toml").unlink()
-    _refused(capsys, tmp_path, ["--data", pristine, "--plant", tmp_path / "m.toml"], ["m_actuator1.toml"])
+    assert_refused(capsys, tmp_path, ["--data", pristine, "--plant", tmp_path / "m.toml"], ["m_actuator1.toml"])
 
 
 def test_the_frame_has_one_home():
