@@ -22,25 +22,26 @@ constexpr double e1 = 71.0 / 57600.0, e3 = -71.0 / 16695.0, e4 = 71.0 / 1920.0, 
 constexpr double kSafety = 0.9, kShrink = 0.2, kGrow = 5.0;
 }  // namespace
 
-Dopri5Integrator::Dopri5Integrator(const Dynamics& dyn, double dt, const SolverOptions& opt, const State& y_prime)
+Dopri5Integrator::Dopri5Integrator(const Dynamics& dyn, double dt, const SolverOptions& opt, const State& y_prime,
+                                   bool checked)
     : n_(dyn.num_states()),
       rtol_(opt.rtol),
       max_steps_(opt.max_steps_per_sample),
       stiff_steps_(opt.stiff_steps),
       dt_(dt),
+      gap_(dyn),
       h_(dt) {
   absolute_tolerances(dyn, opt, atol_);
   if (opt.stiff_fallback) {
     // Absolute tolerances 1e-2 of these cut the error on high-gain rigs ~7x but made one of 150
     // such rigs overrun max_steps_per_sample (10x the steps): the check below flags instead.
     implicit_ = std::make_unique<CvodeIntegrator>(dyn, dt, opt, y_prime);
-    SolverOptions tight = opt;
-    tight.rtol = opt.rtol / kShadowTighten;  // the absolute tolerances follow rtol
-    shadow_ = std::make_unique<CvodeIntegrator>(dyn, dt, tight, y_prime);
+    if (checked) {
+      SolverOptions tight = opt;
+      tight.rtol = opt.rtol / kShadowTighten;  // the absolute tolerances follow rtol
+      shadow_ = std::make_unique<Dopri5Integrator>(dyn, dt, tight, y_prime, false);
+    }
   }
-  // A run that stays near rest is checked against a millionth of the rig's scales, not against zero.
-  floor_x_ = 1e-6 * state_scale(dyn, kX);
-  floor_f_ = 1e-6 * state_scale(dyn, kP) * dyn.rig().A;
 }
 
 void Dopri5Integrator::reset(const State& y, double t) noexcept {
@@ -49,46 +50,36 @@ void Dopri5Integrator::reset(const State& y, double t) noexcept {
   h_ = dt_;
   hold_ = 0;
   shadow_live_ = false;
-  since_stiff_ = 0;
-  peak_x_ = peak_f_ = 0.0;
+  gap_.reset();
   if (implicit_) implicit_->reset(y, t);
   if (shadow_) shadow_->reset(y, t);
 }
 
-void Dopri5Integrator::track_peaks(const Dynamics& dyn, const Dynamics::Input& in, const State& y) noexcept {
-  Output o;
-  dyn.outputs(y.data(), in, o);
-  peak_x_ = std::max(peak_x_, std::fabs(o.displacement));
-  peak_f_ = std::max(peak_f_, std::fabs(o.force));
-}
-
 // The error of the result grows with its tolerance: the shadow, kShadowTighten times tighter, is
 // off by less, so the gap between the two measures the result's error (kShadowGap).  The shadow
-// follows the run from the state where the first stiff sample began, so that an error the loop
-// amplifies from sample to sample shows in the gap as it does in the result.
+// follows the run from the state where its first stiff sample began to its end, explicit samples
+// included: an error the loop amplifies from sample to sample, or one that a sharp event far from
+// the stiff stretches makes (a force reversal), shows in the gap as it does in the result.
 void Dopri5Integrator::verify(const Dynamics& dyn, const Dynamics::Input& in, const State& y_start,
                               double t_start, const State& y, double t_next, Status& st) noexcept {
   if (!shadow_live_) {
     shadow_y_ = y_start;
+    shadow_->reset(shadow_y_, t_start);
     shadow_live_ = true;
   }
-  shadow_->reset(shadow_y_, t_start);
   double ts = t_start;
   const Status s = shadow_->advance(dyn, in, shadow_y_, ts, t_next);
   st.internal_steps += s.internal_steps;
   st.rhs_evals += s.rhs_evals;
-  if (!s.ok()) {  // the tighter run failed (too much work) where the result did not: restart next sample
-    shadow_live_ = false;
+  if (!s.ok()) {  // the tighter run failed (too much work) where the result did not: it restarts from the result
+    shadow_y_ = y;
+    shadow_->reset(shadow_y_, t_next);
+    gap_.track(dyn, in, y);
+    st.run_error_estimate = gap_.run_gap() / (kShadowGap * kVerifyTolerance);
     return;
   }
-  Output o, os;
-  dyn.outputs(y.data(), in, o);
-  dyn.outputs(shadow_y_.data(), in, os);
-  peak_x_ = std::max(peak_x_, std::fabs(o.displacement));
-  peak_f_ = std::max(peak_f_, std::fabs(o.force));
-  const double gap = std::max(std::fabs(o.displacement - os.displacement) / std::max(peak_x_, floor_x_),
-                              std::fabs(o.force - os.force) / std::max(peak_f_, floor_f_));
-  st.error_estimate = gap / (kShadowGap * kVerifyTolerance);
+  st.error_estimate = gap_.gap(dyn, in, y, shadow_y_) / (kShadowGap * kVerifyTolerance);
+  st.run_error_estimate = gap_.run_gap() / (kShadowGap * kVerifyTolerance);
   st.inaccurate = !(st.error_estimate <= 1.0);
 }
 
@@ -162,12 +153,8 @@ Dopri5Integrator::Outcome Dopri5Integrator::explicit_sample(const Dynamics& dyn,
 
 Status Dopri5Integrator::implicit_sample(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t,
                                          double t_next) noexcept {
-  const State y_start = y;
-  const double t_start = t;
   implicit_->reset(y, t);
   Status st = implicit_->advance(dyn, in, y, t, t_next);
-  if (st.ok() && shadow_) verify(dyn, in, y_start, t_start, y, t_next, st);
-  since_stiff_ = 0;
   ++restarts_;
   fsal_ = false;
   h_ = dt_;
@@ -179,12 +166,12 @@ Status Dopri5Integrator::implicit_sample(const Dynamics& dyn, const Dynamics::In
 Status Dopri5Integrator::advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t,
                                  double t_next) noexcept {
   Status st;
+  const State y0 = y;
+  const double t0 = t;
   if (hold_ > 0 && implicit_) {
     --hold_;
     st = implicit_sample(dyn, in, y, t, t_next);
   } else {
-    const State y0 = y;
-    const double t0 = t;
     const Outcome out = explicit_sample(dyn, in, y, t, t_next, st);
     if (out != Outcome::Done) {
       y = y0;
@@ -200,12 +187,13 @@ Status Dopri5Integrator::advance(const Dynamics& dyn, const Dynamics::Input& in,
         fsal_ = false;
         h_ = dt_;
       }
-    } else if (shadow_live_ && ++since_stiff_ <= kShadowFollow) {
-      verify(dyn, in, y0, t0, y, t_next, st);  // the shadow still follows an error made in a stiff stretch
-    } else {
-      shadow_live_ = false;
-      if (shadow_) track_peaks(dyn, in, y);
     }
+  }
+  if (shadow_ && st.ok()) {
+    if (shadow_live_ || st.stiff)
+      verify(dyn, in, y0, t0, y, t_next, st);  // from the first stiff sample to the end of the run
+    else
+      gap_.track(dyn, in, y);
   }
   steps_done_ += st.internal_steps;
   rhs_done_ += st.rhs_evals;

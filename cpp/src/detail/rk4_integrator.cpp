@@ -65,18 +65,13 @@ Rk4Integrator::Rk4Integrator(const Dynamics& dyn, double dt, const SolverOptions
     : n_(dyn.num_states()),
       substeps_(opt.rk4_substeps > 0 ? opt.rk4_substeps : rk4_automatic_substeps(dyn, dt, opt)),
       max_refinements_(opt.rk4_max_refinements),
-      rtol_(opt.rk4_flag_rtol) {
-  SolverOptions flag = opt;
-  flag.rtol = opt.rk4_flag_rtol;
-  absolute_tolerances(dyn, flag, atol_);
-}
+      flag_rtol_(opt.rk4_flag_rtol),
+      gap_(dyn) {}
 
-double Rk4Integrator::sweep(const Dynamics& dyn, const Dynamics::Input& in, State& y, int n, double h) const
-    noexcept {
-  State k1, k2, k3, k4, tmp, err{};
-  const int m = n_;
-  dyn.rhs(y.data(), in, k1.data());
+void Rk4Integrator::sweep(const Dynamics& dyn, const Dynamics::Input& in, State& y, int n, int m, double h) noexcept {
+  State k1, k2, k3, k4, tmp;
   for (int s = 0; s < n; ++s) {
+    dyn.rhs(y.data(), in, k1.data());
     for (int i = 0; i < m; ++i) tmp[i] = y[i] + 0.5 * h * k1[i];
     dyn.rhs(tmp.data(), in, k2.data());
     for (int i = 0; i < m; ++i) tmp[i] = y[i] + 0.5 * h * k2[i];
@@ -84,46 +79,41 @@ double Rk4Integrator::sweep(const Dynamics& dyn, const Dynamics::Input& in, Stat
     for (int i = 0; i < m; ++i) tmp[i] = y[i] + h * k3[i];
     dyn.rhs(tmp.data(), in, k4.data());
     for (int i = 0; i < m; ++i) y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-    dyn.rhs(y.data(), in, k1.data());  // k5 of this substep, k1 of the next
-    for (int i = 0; i < m; ++i) err[i] += std::fabs(h / 6.0 * (k4[i] - k1[i]));
   }
-  double sum = 0.0;
-  for (int i = 0; i < m; ++i) {
-    const double q = err[i] / (atol_[i] + rtol_ * std::max(peak_[i], std::fabs(y[i])));
-    sum += q * q;
-  }
-  return std::sqrt(sum / m);  // NaN if the state blew up: flagged, and the plant's guard fails the sample
 }
 
 void Rk4Integrator::reset(const State& y0, double) noexcept {
   steps_done_ = rhs_done_ = flagged_ = 0;
-  for (int i = 0; i < n_; ++i) peak_[i] = 0.0;
-  track_peak(y0);
-}
-
-void Rk4Integrator::track_peak(const State& y) noexcept {
-  for (int i = 0; i < n_; ++i) peak_[i] = std::max(peak_[i], std::fabs(y[i]));
+  refined_ = 0;
+  companion_ = y0;
+  gap_.reset();
 }
 
 Status Rk4Integrator::advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t,
                               double t_next, int substeps) noexcept {
   Status st;
-  const State y0 = y;
-  int n = substeps > 0 ? substeps : substeps_;
-  track_peak(y0);
-  for (int r = 0;; ++r) {
-    st.error_estimate = sweep(dyn, in, y, n, (t_next - t) / n);
-    st.internal_steps += n;
-    st.rhs_evals += 4 * n + 1;
-    // Flagged if the configured substeps missed the tolerance, refined or not: the local estimate
-    // does not bound the error carried into later samples, so a refined sample still says so.
-    if (r == 0) st.inaccurate = !(st.error_estimate <= 1.0);
-    if (st.error_estimate <= 1.0 || r >= max_refinements_ || 2L * n > SolverOptions::kMaxSubsteps) break;
-    y = y0;
-    n *= 2;
+  const int n = (substeps > 0 ? substeps : substeps_) << refined_;
+  const double h = (t_next - t) / n;
+  sweep(dyn, in, y, n, n_, h);
+  st.internal_steps = n;
+  st.rhs_evals = 4 * n;
+  if (flag_rtol_ > 0.0) {
+    sweep(dyn, in, companion_, 2 * n, n_, 0.5 * h);
+    st.internal_steps += 2 * n;
+    st.rhs_evals += 8 * n;
+    st.error_estimate = gap_.gap(dyn, in, y, companion_) / flag_rtol_;
+    st.run_error_estimate = gap_.run_gap() / flag_rtol_;
+    st.inaccurate = !(st.error_estimate <= 1.0);
+    if (st.inaccurate) {
+      ++flagged_;
+      bool finite = true;
+      for (int i = 0; i < n_; ++i) finite = finite && std::isfinite(companion_[i]);
+      if (finite && refined_ < max_refinements_ && 2L * n <= SolverOptions::kMaxSubsteps) {
+        y = companion_;  // go on from the more accurate run, at twice the substeps
+        ++refined_;
+      }
+    }
   }
-  if (st.inaccurate) ++flagged_;
-  track_peak(y);
   t = t_next;
   steps_done_ += st.internal_steps;
   rhs_done_ += st.rhs_evals;
