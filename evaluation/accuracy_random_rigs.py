@@ -247,9 +247,9 @@ def run_case(sh, rig, mode: str, u: np.ndarray, dt: float, rtol: float | None = 
             if which == "rk4" and _rk4_substeps(sh, rig, mode, dt) > RK4_MAX_SUBSTEPS:
                 out[which] = {"skipped": True}
                 continue
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             r = sh.simulate(rig, mode, u, dt=dt, options=_options(sh, which, rtol), raise_on_failure=False)
-            wall = time.perf_counter() - t0
+            wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         except ValueError as e:  # refused at construction: a clear error is a status, not a wrong answer
             out[which] = {"error": math.nan, "status": f"refused: {e}", "flagged": True, "within": False,
                           "flag_measure": math.inf, "sample_flagged": True}
@@ -265,13 +265,14 @@ def run_case(sh, rig, mode: str, u: np.ndarray, dt: float, rtol: float | None = 
                       "within": bool(r.success and err <= TOLERANCE[which]), "flag_measure": measure,
                       "sample_flagged": bool(not r.success or r.work.inaccurate_samples > 0),
                       "stiff_samples": int(getattr(r.work, "stiff_samples", 0)),
-                      "inaccurate_samples": int(getattr(r.work, "inaccurate_samples", 0)), "wall_s": wall}
+                      "inaccurate_samples": int(getattr(r.work, "inaccurate_samples", 0)), "wall_s": wall,
+                      "cpu_s": cpu}
     return out
 
 
 def _new_counts() -> dict:
     return {"within": 0, "flagged": 0, "silent": 0, "worst_silent": 0.0, "worst": 0.0, "silent_cases": [],
-            "flagged_within": 0, "sample_flagged_within": 0, "skipped": 0, "wall_s": 0.0}
+            "flagged_within": 0, "sample_flagged_within": 0, "skipped": 0, "wall_s": 0.0, "cpu_s": 0.0}
 
 
 def _finish_counts(c: dict) -> None:
@@ -310,6 +311,7 @@ def survey(sh, rigs: int, seed: int = 16, duration: float = 1.0, dt: float = 5e-
                 c["skipped"] += 1
                 continue
             c["wall_s"] += r.get("wall_s", 0.0)
+            c["cpu_s"] += r.get("cpu_s", 0.0)
             if math.isfinite(r["error"]):
                 c["worst"] = max(c["worst"], r["error"])
             if r["within"]:
@@ -333,7 +335,8 @@ def survey(sh, rigs: int, seed: int = 16, duration: float = 1.0, dt: float = 5e-
     for c in list(counts.values()) + [s for w in sweep.values() for s in w.values()]:
         _finish_counts(c)
     return {"family": family, "rigs": rigs, "seed": seed, "duration_s": duration, "dt_s": dt,
-            "tolerance": TOLERANCE, "rtol": rtol, "reference": reference, "reference_failed": skipped,
+            "methods": list(methods), "tolerance": TOLERANCE, "rtol": rtol, "reference": reference,
+            "reference_failed": skipped,
             "reference_uncertain": uncertain, "counts": counts,
             "flag_sweep": {w: {str(sc): {k: s[k] for k in ("within", "flagged", "silent", "flagged_within",
                                                             "flag_precision", "flag_recall", "flag_rate_within")}
