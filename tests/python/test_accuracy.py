@@ -153,3 +153,27 @@ def test_stiff_samples_within_the_stated_accuracy_are_not_flagged():
     assert default.work.stiff_samples > 0.5 * u.size
     assert ar._error(default, ref) <= ar.TOLERANCE["default"]
     assert default.work.inaccurate_samples == 0 and default.work.error_estimate <= 1
+
+
+def test_the_cli_warns_when_the_default_misses(tmp_path, capsys):
+    """Issue 26, defect 4 from the command line: `servohydraulics simulate` on the high-gain rig
+    (its loop amplifies the stiff samples' integration error) writes a record the explicit
+    reference at rtol 1e-10 puts more than 1e-3 off, and says so on stderr; the same rig under a
+    small command, within 1e-3, gets no such warning."""
+    from servohydraulics.cli import main
+    from servohydraulics.excitations import sine
+
+    rig, _ = _high_gain_case(HIGH_GAIN, 0.0, 1.0, 0.0)
+    rig_file = sh.save_rig(rig, tmp_path / "high_gain.toml")
+    ref_opts = sh.solver_options("arkode_erk", rtol=1e-10, atol_fraction=1e-3, max_steps_per_sample=1000000)
+    for amp, misses in ((0.005, True), (0.00127, False)):
+        out = tmp_path / f"r{amp}.csv"
+        assert main(["simulate", "--rig", str(rig_file), "--amplitude", str(amp), "--frequency", "1",
+                     "--duration", "0.25", "--out", str(out)]) == 0
+        err = capsys.readouterr().err
+        ref = sh.simulate(rig, "displacement", sine(amp, 1.0, 0.25, 5e-4), options=ref_opts)
+        rec = sh.read_record(out)
+        gap = max(np.max(np.abs(rec.displacement - ref.displacement)) / np.max(np.abs(ref.displacement)),
+                  np.max(np.abs(rec.force - ref.force)) / np.max(np.abs(ref.force)))
+        assert bool(gap > ar.TOLERANCE["default"]) is misses, gap
+        assert ("warning: the run turned stiff and its check" in err) is misses, err
