@@ -481,8 +481,10 @@ def markdown(r: dict, accuracy: dict | None = None, soak: str = f"{SOAK_BEGIN}\n
                   "`stiff_fallback = False`. ARKODE's ARKStep with the same Dormand-Prince table does the same "
                   "work per sample but its per-step overhead keeps it short of the 5 us median (table), so it "
                   "stays a reference, with its SDIRK table and CVODE. RK4 with its automatic substeps stays the "
-                  "real-time option (fixed cost): its embedded 3rd-order estimate (one extra right-hand side per "
-                  "sample) flags a sample whose error exceeds `rk4_flag_rtol` (`RunSummary.inaccurate_samples`)."]
+                  "real-time option (fixed cost): a companion run at twice the substeps (8 more right-hand sides "
+                  "per substep) flags a sample where the two differ by more than `rk4_flag_rtol` of the peak "
+                  "displacement or force (`RunSummary.inaccurate_samples`, `RunSummary.error_estimate`); "
+                  "`rk4_flag_rtol = 0` drops the check for the cheapest step."]
     sw = r["sweep"]
     lines += ["", "## Sweeps: 1 to 2 worker processes", "",
               f"`sh.sweep` over {sw['runs']} runs of {sw['duration_s']:g} s (the default method, displacement sine): "
