@@ -52,7 +52,7 @@ def rows(files: list[str], method: str, sweep: bool) -> list[str]:
         sample = c.get("sample_flagged_within")
         out.append(f"| {d['family']} | {d['seed']} | {label} | {compared} ({d['reference_uncertain']} uncertain"
                    f"{', ' + str(c['skipped']) + ' skipped' if c['skipped'] else ''}) | {c['within']} | "
-                   f"{c['flagged'] + c['silent']} | {c['flagged']} | {c['silent']} | {c['worst_silent']:.1e} | "
+                   f"{c['flagged'] + c['silent']} | {c['flagged']} | {c['silent']} | {c['worst_silent']:.2e} | "
                    f"{_pct(c['flagged_within'], c['within'])} | {'-' if sample is None else sample} | "
                    f"{_f(c['flag_precision'])} | {_f(c['flag_recall'])} | "
                    f"{_f(c.get('cpu_s'), 0)} | {c['wall_s']:.0f} |")
