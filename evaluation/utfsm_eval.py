@@ -22,6 +22,8 @@ import sys
 import time
 from pathlib import Path
 
+from doc_tables import write_between  # evaluation/ (the script's own folder)
+
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(os.environ.get("SH_SHARED_DIR", ROOT.parent / "shared")) / "real-data" / "utfsm-mts-mrdamper"
 RECORDS = {"chirp20Hz_0A": 0.0, "chirp20Hz_1A": 1.0, "sweep15Hz_0A": 0.0, "sweep15Hz_0p5A": 0.5,
@@ -129,9 +131,7 @@ def main(argv=None) -> int:
     print(text)
     if not args.no_docs:
         doc = ROOT / "docs" / "lab-records.md"
-        s = doc.read_text()
-        i, j = s.index(START) + len(START), s.index(END)
-        doc.write_text(s[:i] + "\n" + text + "\n" + s[j:])
+        write_between(doc, START, END, text)
         print(f"wrote the table into {doc}")
     print(f"total {time.perf_counter() - t0:.0f} s")
     return 0

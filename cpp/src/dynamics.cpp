@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "detail/math.hpp"
 
@@ -284,21 +285,51 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
 }
 
 // Dispatch on the gradient width num_states() + 1, a compile-time constant in each case.
-void Dynamics::evaluate_any(const double* y, const Input& in, Algebra& g) const noexcept {
+template <class F>
+decltype(auto) Dynamics::at_width(F&& f) const noexcept {
   static_assert(kCap == 17, "one case per width from kNumStates + 1 to kMaxStates + 1");
   switch (ng_) {
-    case 7: return evaluate<7>(y, in, g);
-    case 8: return evaluate<8>(y, in, g);
-    case 9: return evaluate<9>(y, in, g);
-    case 10: return evaluate<10>(y, in, g);
-    case 11: return evaluate<11>(y, in, g);
-    case 12: return evaluate<12>(y, in, g);
-    case 13: return evaluate<13>(y, in, g);
-    case 14: return evaluate<14>(y, in, g);
-    case 15: return evaluate<15>(y, in, g);
-    case 16: return evaluate<16>(y, in, g);
-    default: return evaluate<kCap>(y, in, g);
+    case 7: return f(std::integral_constant<int, 7>{});
+    case 8: return f(std::integral_constant<int, 8>{});
+    case 9: return f(std::integral_constant<int, 9>{});
+    case 10: return f(std::integral_constant<int, 10>{});
+    case 11: return f(std::integral_constant<int, 11>{});
+    case 12: return f(std::integral_constant<int, 12>{});
+    case 13: return f(std::integral_constant<int, 13>{});
+    case 14: return f(std::integral_constant<int, 14>{});
+    case 15: return f(std::integral_constant<int, 15>{});
+    case 16: return f(std::integral_constant<int, 16>{});
+    default: return f(std::integral_constant<int, kCap>{});
   }
+}
+
+void Dynamics::evaluate_any(const double* y, const Input& in, Algebra& g) const noexcept {
+  at_width([&](auto w) { evaluate<decltype(w)::value>(y, in, g); });
+}
+
+// The actuator without the structure (Dynamics::actuator): the friction laws along the stroke, then
+// the servo controller (Eq 1) and the valve (Eqs 2-4), as evaluate does them.
+template <int W>
+LawForce Dynamics::evaluate_actuator(const double* y, const Input& in, Algebra& g) const noexcept {
+  g.zero<W>();
+  LawForce f;
+  each_law([&](const auto& law) {
+    using L = std::decay_t<decltype(law)>;
+    if constexpr (std::is_same_v<L, TanhFriction> || std::is_same_v<L, LuGreFriction>) {
+      const LawForce l = law.eval(y, g);
+      f.F += l.F;
+      f.dF_dx += l.dF_dx;
+      f.dF_dv += l.dF_dv;
+      f.dF_dz += l.dF_dz;
+    }
+  });
+  const bool delayed = servo_controller<W>(y, in, g);
+  valve<W>(y, delayed ? g.vdrive : g.drive, delayed ? g.dvdrive : g.ddrive, g);
+  return f;
+}
+
+LawForce Dynamics::actuator(const double* y, const Input& in, Algebra& g) const noexcept {
+  return at_width([&](auto w) { return evaluate_actuator<decltype(w)::value>(y, in, g); });
 }
 
 void Dynamics::rhs(const double* y, const Input& in, double* ydot) const noexcept {
@@ -306,6 +337,10 @@ void Dynamics::rhs(const double* y, const Input& in, double* ydot) const noexcep
   evaluate_any(y, in, g);
   ydot[kX] = y[kV];
   ydot[kV] = g.a;
+  actuator_rates(y, g, ydot);
+}
+
+void Dynamics::actuator_rates(const double* y, const Algebra& g, double* ydot) const noexcept {
   const bool actuator = mode_ != ControlMode::Free;
   ydot[kP] = actuator ? g.pdot : 0.0;
   const bool valve = actuator && rig_.effects.servovalve_dynamics;
@@ -324,6 +359,11 @@ void Dynamics::jacobian(const double* y, const Input& in, Jacobian& J, State* B)
   J[kX][kV] = 1.0;
   for (int j = 0; j < n; ++j) J[kV][j] = g.da[j];
   if (B) (*B)[kV] = g.da[ku_];
+  actuator_jacobian(g, J, B);
+}
+
+void Dynamics::actuator_jacobian(const Algebra& g, Jacobian& J, State* B) const noexcept {
+  const int n = layout_.num_states;
   for (int j = 0; j < n; ++j) J[kZ][j] = g.dzdot[j];
   jacobian_appended(g, J, B);
   if (mode_ == ControlMode::Free) return;
@@ -371,15 +411,20 @@ void Dynamics::outputs(const double* y, const Input& in, Output& out, OutputGrad
   out.drive = actuator ? g.drive : 0.0;
   out.flow = actuator ? g.Q : 0.0;
   out.specimen_force = g.Fsp;
+  out.flags = flags(y, g.spool_sat, g.drive_sat, out.force);
+}
+
+std::uint32_t Dynamics::flags(const double* y, bool spool_saturated, bool drive_saturated, double force) const
+    noexcept {
   std::uint32_t f = 0;
-  if (std::fabs(out.force) > rig_.F_cap) f |= kCapacityExceeded;
-  if (actuator) {
+  if (std::fabs(force) > rig_.F_cap) f |= kCapacityExceeded;
+  if (mode_ != ControlMode::Free) {
     if (std::fabs(y[kP]) >= 0.98 * rig_.p_s) f |= kSupplyLimited;
-    if (g.spool_sat) f |= kSpoolSaturated;
-    if (g.drive_sat) f |= kDriveSaturated;
+    if (spool_saturated) f |= kSpoolSaturated;
+    if (drive_saturated) f |= kDriveSaturated;
     if (std::fabs(y[kX]) > rig_.stroke) f |= kStrokeExceeded;
   }
-  out.flags = f;
+  return f;
 }
 
 State Dynamics::equilibrium(double x0) const noexcept {

@@ -19,9 +19,8 @@
 namespace servohydraulics {
 
 namespace {
-// The divergence guard: a state beyond these is a failed run, not a result.
-constexpr double kMaxDisplacement = 100.0;  // [m]
-constexpr double kMaxPressureRatio = 100.0; // [p_s]
+using detail::kMaxDisplacement;   // the divergence guard (detail/ode_system.hpp)
+using detail::kMaxPressureRatio;
 
 using Integrator = std::variant<detail::Dopri5Integrator, detail::CvodeIntegrator, detail::Rk4Integrator,
                                 detail::ArkodeIntegrator>;

@@ -4,6 +4,7 @@
 // the samples where the result departs from it.
 #pragma once
 
+#include "detail/ode_system.hpp"
 #include "detail/output_gap.hpp"
 #include "servohydraulics/dynamics.hpp"
 #include "servohydraulics/solver_options.hpp"
@@ -11,10 +12,18 @@
 
 namespace servohydraulics::detail {
 
-class Rk4Integrator {
+//! RK4 over a system of the OdeSystem interface (ode_system.hpp): the single-actuator plant
+//! (Rk4Integrator) or the coupled multi-actuator rig (the check compares OdeSystem::checked_values:
+//! the displacement and load-cell force of the plant, every actuator's stroke and force of the rig).
+template <class System>
+class BasicRk4Integrator {
  public:
+  using Sys = OdeSystem<System>;
+  using State = typename Sys::State;
+  using Input = typename Sys::Input;
+
   //! options.rk4_substeps per sample of dt [s], or the automatic rule if 0 (may throw Error).
-  Rk4Integrator(const Dynamics& dyn, double dt, const SolverOptions& options);
+  BasicRk4Integrator(const System& sys, double dt, const SolverOptions& options);
 
   void reset(const State& y0, double) noexcept;
   //! The classical RK4 over substeps() equal substeps (`substeps` > 0 replaces the configured
@@ -29,7 +38,7 @@ class Rk4Integrator {
   //! rk4_flag_rtol).  With rk4_max_refinements > 0 a flagged sample ends on the companion's state
   //! (the more accurate run) and the run goes on at twice the substeps, the companion too, at most
   //! that many times (the flagged sample stays flagged).
-  Status advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t, double t_next,
+  Status advance(const System& sys, const Input& in, State& y, double& t, double t_next,
                  int substeps = 0) noexcept;
 
   int substeps() const noexcept { return substeps_; }
@@ -39,17 +48,21 @@ class Rk4Integrator {
   long total_flagged() const noexcept { return flagged_; }
 
  private:
-  //! n classical RK4 substeps of size h from y (updated); 4 n evaluations of the right-hand side.
-  static void sweep(const Dynamics& dyn, const Dynamics::Input& in, State& y, int n, int m, double h) noexcept;
+  //! n classical RK4 substeps of size h from y (updated, its first m states); 4 n evaluations of
+  //! the right-hand side.
+  static void sweep(const System& sys, const Input& in, State& y, int n, int m, double h) noexcept;
 
   int n_;
   int substeps_;
   int max_refinements_;
-  double flag_rtol_;    //!< 0: no companion, no flag
-  int refined_ = 0;     //!< refinements since the reset: the substeps are 2^refined_ x the configured ones
-  State companion_{};   //!< the companion's state at the current time
-  OutputGap gap_;       //!< the run's peaks and the gap between the result and the companion
+  double flag_rtol_;         //!< 0: no companion, no flag
+  int refined_ = 0;          //!< refinements since the reset: the substeps are 2^refined_ x the configured ones
+  State companion_{};        //!< the companion's state at the current time
+  OutputGap<System> gap_;    //!< the run's peaks and the gap between the result and the companion
   long steps_done_ = 0, rhs_done_ = 0, flagged_ = 0;
 };
+
+//! The single-actuator plant's fixed-step integrator.
+using Rk4Integrator = BasicRk4Integrator<Dynamics>;
 
 }  // namespace servohydraulics::detail

@@ -22,7 +22,7 @@ from scipy.signal import savgol_filter
 from .. import _core
 from ..identification.coordinates import Coordinates
 from ..identification.run import simulate_command
-from ..identification.stats import LEVEL, ar1_coefficient, ar1_effective_n, quantile
+from ..identification.stats import LEVEL, ar1_coefficient, ar1_effective_n, noise_sigma, quantile
 from ..identification.stats import covariance as hac_covariance
 from ..rig import Rig
 from ..simulate import MODES, SimulationError, solver_options
@@ -42,15 +42,9 @@ CHANNELS = {mode: tuple(c for c in SIM_CHANNELS if not (mode == "free" and c in 
 N_SEGMENTS = 6  #: held-out split: contiguous segments, even ones train, odd ones test
 
 
-def noise_sigma(y: np.ndarray) -> float:
-    """Noise standard deviation of a record channel from its third differences
-    (robust MAD; smooth signal content sampled well above its bandwidth cancels)."""
-    d3 = np.diff(y, 3)
-    return float(1.4826 * np.median(np.abs(d3 - np.median(d3))) / math.sqrt(20.0))
-
-
-def make_case(rec: Any, mode: str, name: str) -> Case:
-    """A record (``read_record``'s result: ``.channels``, ``.dt``) prepared for the diagnosis."""
+def make_case(rec: Any, mode: str, name: str, controller_dt: float | None = None) -> Case:
+    """A record (``read_record``'s result: ``.channels``, ``.dt``) prepared for the diagnosis,
+    simulated with the controller sample ``controller_dt`` [s] (None: the record's)."""
     ch = rec.channels
     t = ch["time"] - ch["time"][0]
     dt = rec.dt
@@ -86,7 +80,7 @@ def make_case(rec: Any, mode: str, name: str) -> Case:
     derived["rms_v"] = float(np.sqrt(np.mean(derived["velocity"] ** 2)))
     x0, x0_sd = initial_displacement(t, x, sigma["displacement"])
     return Case(name, mode, dt, t, np.asarray(ch["command"], float), meas, scale, sigma, train, derived,
-                x0, x0_sd, float(np.max(np.abs(derived["velocity"]))))
+                x0, x0_sd, float(np.max(np.abs(derived["velocity"]))), controller_dt)
 
 
 def initial_displacement(t: np.ndarray, x: np.ndarray, sigma: float) -> tuple[float, float]:
@@ -134,7 +128,7 @@ def simulate_case(rig: Rig, case: Case, tau: float, x0: float) -> Sim:
     that run fails."""
     for opts in (solver_options(), solver_options(method="cvode")):
         try:
-            r = simulate_command(rig, case.mode, case.u, case.dt, float(x0), opts, delay=tau)
+            r = simulate_command(rig, case.mode, case.u, case.dt, float(x0), opts, dt=case.controller_dt, delay=tau)
         except (SimulationError, ValueError):
             continue
         return {c: r.channels[c] for c in SIM_CHANNELS}

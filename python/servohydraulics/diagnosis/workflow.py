@@ -17,7 +17,9 @@ from typing import Any
 
 import numpy as np
 
+from ..identification.checks import gate
 from ..identification.records import as_records
+from ..identification.run import controller_ratio
 from ..rig import Rig, rig_to_dict
 from ..simulate import MODES
 from . import engine
@@ -62,6 +64,8 @@ class Diagnosis:
     record_shift: float = 0.0  #: the part of it < 0: the record's command shifted (response rows lead it) [s]
     summary: str = ""
     runtime_s: float = 0.0
+    checks: list = field(default_factory=list)  #: the records' plausibility checks (``identification.checks``)
+    dt: float | None = None  #: the controller sample time the records were simulated with [s] (None: each record's)
     #: arrays for the report (not in the JSON): cases, sims_before, sims_after, history, signatures
     plots: dict[str, Any] = field(default_factory=dict, repr=False)
 
@@ -85,6 +89,8 @@ class Diagnosis:
             "record_shift_s": self.record_shift,
             "rig_updated": rig_to_dict(self.rig),
             "runtime_s": self.runtime_s,
+            "controller_dt_s": self.dt,
+            "checks": [c.to_dict() for c in self.checks],
         }
 
     def write(self, out: str | Path) -> Path:
@@ -182,7 +188,8 @@ class _Passing:
 
 def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = True,
              keep: int = KEEP, max_effects: int = MAX_EFFECTS, candidates: Sequence[str] | None = None,
-             refit_interacting: bool = True, joint_refit: bool = True) -> Diagnosis:
+             refit_interacting: bool = True, joint_refit: bool = True, dt: float | None = None, layout=None,
+             accept=None) -> Diagnosis:
     """Finds the effect the model ``rig`` is missing in lab ``records``.
 
     Args:
@@ -201,12 +208,26 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
         joint_refit: after each effect from the second on, re-fit all
             accepted effects' parameters together (``joint.joint_refit``); kept
             only if its BIC is not worse than the greedy fit's.
+        dt: the controller's sample time [s] (default: each record's own).  A record sampled
+            slower than the controller (a 1 kHz record of a 2 kHz rig) simulated at its own
+            rate holds the command twice as long and shows a spurious command delay; with
+            ``dt`` the command is interpolated onto the controller's grid
+            (``identification.run.simulate_command``, as ``compare`` and ``identify`` do).
+        layout: how record paths are read (``read_record``'s ``layout``: units, columns...).
+        accept: codes of warning-level plausibility checks acknowledged (``identification.checks``);
+            an error-level check raises ``CheckError`` (a ValueError) before any work.
 
     Returns:
         A ``Diagnosis`` (``.write(dir)`` writes diagnosis.json, rig_updated.toml, report.md).
     """
     t_start = time.time()
-    setup = _prepare(records, rig, mode, candidates, keep, refit_interacting, joint_refit)
+    recs = as_records(records, layout)
+    if mode not in MODES:
+        raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(MODES)}")
+    for r in recs:
+        controller_ratio(r.dt, r.time.size, dt)
+    checks = gate(recs, rig, mode, dt, accept)
+    setup = _prepare(recs, rig, mode, candidates, keep, refit_interacting, joint_refit, dt)
     current = copy.copy(rig)
     x0 = engine.refine_x0(current, setup.cases, 0.0)
     sims0 = engine.simulate_all(current, setup.cases, 0.0, x0)
@@ -223,11 +244,13 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
             break
         _accept(setup, state, outcome)
     setup.bar.close()
-    return _result(setup, state, sims0, last, time.time() - t_start)
+    d = _result(setup, state, sims0, last, time.time() - t_start)
+    d.checks, d.dt = checks, dt
+    return d
 
 
 def _prepare(records, rig: Rig, mode: str, candidates: Sequence[str] | None, keep: int, refit_interacting: bool,
-             joint_refit: bool) -> _Setup:
+             joint_refit: bool, dt: float | None = None) -> _Setup:
     """Checks the arguments and prepares the records (unique names)."""
     if mode not in MODES:
         raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(MODES)}")
@@ -237,7 +260,7 @@ def _prepare(records, rig: Rig, mode: str, candidates: Sequence[str] | None, kee
     cases: list[Case] = []
     for i, r in enumerate(recs):
         path = getattr(r, "path", None)
-        c = engine.make_case(r, mode, str(path) if path else f"record{i}")
+        c = engine.make_case(r, mode, str(path) if path else f"record{i}", dt)
         cases.append(dataclasses.replace(c, name=f"{c.name}#{i}") if any(c.name == o.name for o in cases) else c)
     return _Setup(rig, mode, cases, names, keep, refit_interacting, joint_refit)
 

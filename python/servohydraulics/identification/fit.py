@@ -36,7 +36,7 @@ from ..rig import Error, Rig
 from ..simulate import make_plant, solver_options
 from .coordinates import Coordinates
 from .frf import FrequencyResponse, command_band, h1
-from .run import initial_displacement, simulate_record
+from .run import initial_displacement, record_rig, simulate_record
 
 MIN_COHERENCE = 0.9
 MAX_POINTS = 80  #: frequency points per channel in stage 1 (log-spaced thinning)
@@ -102,7 +102,7 @@ def fit_frequency(records: list[Response], rig: Rig, coords: Coordinates, mode: 
         out = []
         for rec, ch, f, H, coh in targets:
             try:  # an invalid rig (ValueError naming the key) or a singular model: a failed point
-                Hm = linear_response(coords.apply(rig, zz), mode, x0s[id(rec)], (ch,), f)[0]
+                Hm = linear_response(record_rig(coords.apply(rig, zz), rec), mode, x0s[id(rec)], (ch,), f)[0]
             except (ValueError, np.linalg.LinAlgError):
                 return np.full(sum(2 * t[2].size for t in targets), FAILED)
             e = np.sqrt(coh) * (Hm - H) / np.abs(H)

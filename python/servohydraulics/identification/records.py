@@ -35,6 +35,7 @@ from ..atomic import FileSet, check_folder
 from ..records import read_record
 from ..response import Response
 from ..rig import Rig, load_rig, save_rig
+from .checks import check_accept, gate
 from .compare import Comparison, channels_of, compare, save_figures, write_json
 from .coordinates import FORCE_KEYS, LOOP_KEYS, Coordinates, check_keys, specimen_keys, use_specimen
 from .fit import (
@@ -48,7 +49,18 @@ from .fit import (
     not_improved_flags,
     time_costs,
 )
-from .generic import generic_rig, specimen_start
+from .generic import generic_rig, record_scales, specimen_start
+from .law import (
+    MR_LAWS,
+    FieldInput,
+    check_law,
+    coordinate_scales,
+    field_input,
+    law_keys,
+    law_start,
+    start_range,
+    with_fields,
+)
 from .run import check_record, controller_ratio, simulate_record
 from .stats import LEVEL, ar1_coefficient, ar1_effective_n, covariance, quantile
 
@@ -82,6 +94,9 @@ class Identification:
     status: dict = field(default_factory=dict)  #: key -> "identified", "not identified" or "at bound"
     costs: dict = field(default_factory=dict)  #: time-domain cost of the start and of each stage
     kept: str = "time"  #: which of "start", "frequency", "time" the result is
+    checks: list = field(default_factory=list)  #: ``checks.Check``: the records' plausibility, the runs' limits
+    field_input: FieldInput | None = None  #: the MR damper's field per record (``currents=``/``voltages=``)
+    law: str | None = None  #: the MR damper's field law fitted across the records (``law.py``)
 
     def to_dict(self) -> dict[str, Any]:
         units = _units()
@@ -95,9 +110,13 @@ class Identification:
             "derived": derived(self.rig, self.mode), "flags": self.flags, "channel_weights": self.weights,
             "integrator": self.integrator, "n_eff": self.n_eff, "rho1": self.rho1, "nfev": self.nfev,
             "runtime_s": self.runtime_s, "costs": self.costs, "kept": self.kept,
+            "checks": [c.to_dict() for c in self.checks],
+            "field": None if self.field_input is None else {**self.field_input.to_dict(), "law": self.law},
             "records": [{"record": b.name, "before": {c: b.channels[c]["nrmse_pct"] for c in b.channels},
-                         "after": {c: a.channels[c]["nrmse_pct"] for c in a.channels}, "warnings": a.warnings}
-                        for b, a in zip(self.before, self.after)],
+                         "after": {c: a.channels[c]["nrmse_pct"] for c in a.channels}, "warnings": a.warnings,
+                         **({} if self.field_input is None else
+                            {self.field_input.kind: self.field_input.values[i]})}
+                        for i, (b, a) in enumerate(zip(self.before, self.after))],
         }
 
     def markdown(self) -> str:
@@ -134,19 +153,25 @@ def _units() -> dict[str, str]:
     return {p.key: p.unit for p in PARAMETERS}
 
 
-def as_records(records) -> list:
+def as_records(records, layout=None) -> list:
     """Records from records (anything with ``channels``: a Response) or record paths (a single
-    one is accepted); the paths read by ``read_record``."""
+    one is accepted); the paths read by ``read_record`` with ``layout`` (a ``readers.Layout``,
+    a layout file or a dict of its fields: columns, units, scale...)."""
     if isinstance(records, (str, Path)) or hasattr(records, "channels"):
         records = [records]
-    out = [r if hasattr(r, "channels") else read_record(r) for r in records]
+    out = [r if hasattr(r, "channels") else read_record(r, layout) for r in records]
     if not out:
         raise ValueError("invalid records = []: give at least one record")
     return out
 
 
-def _start_rig(rig, records: list[Response]) -> tuple[Rig, bool]:
+def _start_rig(rig, records: list[Response], scale_from_largest_force: bool = False) -> tuple[Rig, bool]:
+    """The start: ``rig`` (a Rig or a rig file), or the generic rig scaled from the first record
+    (``scale_from_largest_force``: from the record of the largest peak force, so that a damper's
+    strongest record sizes the generic actuator, whose load-pressure term scales with F / F_cap)."""
     if rig is None:
+        if scale_from_largest_force:
+            return generic_rig(max(records, key=lambda r: record_scales(r)["F_pk"])), True
         return generic_rig(records[0]), True
     if isinstance(rig, (str, Path)):
         return load_rig(rig), False
@@ -245,21 +270,51 @@ def _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar
     return z, nfev
 
 
-def _setup(records, rig, fit, mode: str, specimen: str, channels, dt: float | None = None
-           ) -> tuple[list, Rig, bool, tuple, tuple]:
-    """(records, start rig, generic start?, keys, channels), validated (with the controller ``dt``)."""
+def _field_setup(recs: list, specimen: str | None, currents, voltages, law: str | None
+                 ) -> tuple[list, str, FieldInput | None, str | None]:
+    """(records with their field values, specimen, field input, law), validated: the field
+    (``law.field_input``) needs the MR damper, a law needs the field."""
+    field_in = field_input(recs, currents, voltages)
+    if field_in is None:
+        if law is not None:
+            raise ValueError(f"invalid law = {law!r}: a field law needs the records' field values (currents= or "
+                             "voltages=, --current or --voltage)")
+        return recs, specimen or "linear", None, None
+    if specimen not in (None, "mr_damper"):
+        raise ValueError(f"invalid specimen = {specimen!r} with {field_in.kind}s: the field per record drives an MR "
+                         "damper's law; use specimen 'mr_damper'")
+    return with_fields(recs, field_in), "mr_damper", field_in, check_law(law or "spencer")
+
+
+def _setup(records, rig, fit, mode: str, specimen: str | None, channels, dt: float | None = None,
+           currents=None, voltages=None, law: str | None = None) -> tuple[list, Rig, bool, tuple, tuple, dict]:
+    """(records, start rig, generic start?, keys, channels, field setup), validated (with the
+    controller ``dt``); the field setup: ``field`` (FieldInput or None), ``law``, ``notes`` (the
+    law's coefficients held), ``scales`` (coordinate scales of the keys that may start at 0)."""
     if mode not in LOOP_KEYS:
         raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(LOOP_KEYS)}")
     recs = [check_record(r) for r in as_records(records)]
     for r in recs:
         controller_ratio(r.dt, r.time.size, dt)
+    recs, specimen, field_in, law = _field_setup(recs, specimen, currents, voltages, law)
     spec = specimen_keys(specimen)
     x = np.asarray(recs[0].displacement, dtype=float)
     if rig is None and np.ptp(x) == 0:  # the generic start scales from the motion
         raise ValueError(f"{recs[0].path or 'record'}: invalid displacement = constant {float(x[0])!r}: the generic "
                          "start scales the rig from the motion; give a start rig")
-    start, generic = _start_rig(rig, recs)
-    if generic:
+    start, generic = _start_rig(rig, recs, scale_from_largest_force=field_in is not None)
+    extra = {"field": field_in, "law": law, "notes": [], "scales": None}
+    if field_in is not None:
+        use_specimen(start, specimen)
+        if generic:
+            law_start(start, recs, field_in, law)
+        else:
+            start.mr_law = MR_LAWS[law]
+            start_range(start, field_in)
+        spec, extra["notes"] = law_keys(law, field_in.levels)
+        extra["scales"] = coordinate_scales(start, field_in)
+        start.validate()
+    elif generic:
         specimen_start(start, recs[0], specimen)
     use_specimen(start, specimen)
     keys = check_keys(start, fit if fit is not None else LOOP_KEYS[mode] + spec)
@@ -268,7 +323,7 @@ def _setup(records, rig, fit, mode: str, specimen: str, channels, dt: float | No
         missing = [c for c in chans if c not in channels_of(r, mode)]
         if missing:
             raise ValueError(f"record {r.path or '?'}: channel(s) {missing} absent or constant")
-    return recs, start, generic, keys, chans
+    return recs, start, generic, keys, chans, extra
 
 
 def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options, dt, max_nfev, progress, workers):
@@ -287,9 +342,11 @@ def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options,
 
 
 def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | None = None,
-             mode: str = "displacement", specimen: str = "linear", channels: Sequence[str] | None = None,
+             mode: str = "displacement", specimen: str | None = None, channels: Sequence[str] | None = None,
              dt: float | None = None, frequency_stage: bool = True, max_nfev: int = 60,
-             progress: bool = True, workers: int | None = None) -> Identification:
+             progress: bool = True, workers: int | None = None, layout=None, accept=None,
+             currents: Sequence[float] | None = None, voltages: Sequence[float] | None = None,
+             law: str | None = None) -> Identification:
     """Identifies rig keys from lab records (see the module docstring).
 
     Args:
@@ -297,20 +354,36 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         rig: the start (a Rig or a rig TOML path); None: the generic rig scaled from the first record.
         fit: keys to fit; default ``LOOP_KEYS[mode]`` + ``SPECIMEN_KEYS[specimen]``.
         mode: the records' control mode, ``"displacement"`` or ``"force"``.
-        specimen: ``"linear"``, ``"bouc_wen"`` or ``"mr_damper"`` (``keys.SPECIMEN_KEYS``; a generic start
-            scales the specimen from the record, ``generic.specimen_start``).
+        specimen: ``"linear"`` (the default), ``"bouc_wen"`` or ``"mr_damper"`` (``keys.SPECIMEN_KEYS``; a
+            generic start scales the specimen from the record, ``generic.specimen_start``); with
+            ``currents``/``voltages`` ``"mr_damper"`` (the default then).
         channels: the channels fitted (default: those the records carry, displacement and force).
         dt: controller sample time [s] (default: the records' own).
         frequency_stage: run stage 1 (the H1 fit of the linearised model) before the time domain.
         max_nfev: the time-domain stage's budget of residual evaluations (Jacobians not counted).
         progress: a tqdm bar over the simulations.
         workers: threads for the Jacobian's columns (default: up to 2).
+        layout: how record paths are read (``read_record``'s ``layout``: a ``readers.Layout``, a
+            layout file or a dict of its fields, e.g. ``{"units": {"displacement": "mm"}}``).
+        accept: codes of warning-level checks acknowledged (``checks.CODES``).  The records are
+            checked against the start rig (a generic start: the rig-free checks only) before any
+            fit; an error-level check raises ``checks.CheckError`` (a ValueError).
+        currents: an MR damper's coil current [A] per record, in order (``law.py``): one rig fitted to
+            all the records, each simulated at its own current; the damper's law coefficients are the
+            fitted keys (``law.law_keys``).  ValueError: a count that does not match the records, a
+            value that is not a finite number >= 0, or ``voltages`` as well.
+        voltages: the same for a voltage-driven damper [V].
+        law: the field law, ``"spencer"`` (linear, the default) or ``"quiroz2022"`` (the UTFSM
+            thesis': alpha quadratic, beta and gamma decaying exponentially); needs the field.
     """
     if isinstance(max_nfev, bool) or not isinstance(max_nfev, (int, np.integer)) or max_nfev < 1:
         raise ValueError(f"invalid max_nfev = {max_nfev!r}: must be an integer >= 1")
     t_start = time.perf_counter()
-    recs, start, generic, keys, chans = _setup(records, rig, fit, mode, specimen, channels, dt)
-    coords = Coordinates.about(start, keys)
+    check_accept(accept)
+    recs, start, generic, keys, chans, extra = _setup(as_records(records, layout), rig, fit, mode, specimen,
+                                                      channels, dt, currents, voltages, law)
+    found = gate(recs, None if generic else start, mode, dt, accept)
+    coords = Coordinates.about(start, keys, extra["scales"])
     runtime: dict[str, float] = {}
     z1, stage1_keys, nfev = np.zeros(len(keys)), [], {}
     if frequency_stage:
@@ -328,10 +401,10 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
     s1_vals = coords.values(z1)
     out_rig = coords.apply(start, final.z)
     t0 = time.perf_counter()
-    before = [compare(r, start, mode, simulated=simulate_record(start, r, mode, dt=dt, options=options))
+    before = [compare(r, start, mode, simulated=simulate_record(start, r, mode, dt=dt, options=options), check=False)
               for r in recs]
-    after = [compare(r, out_rig, mode, simulated=simulate_record(out_rig, r, mode, dt=dt, options=options))
-             for r in recs]
+    after = [compare(r, out_rig, mode, simulated=simulate_record(out_rig, r, mode, dt=dt, options=options),
+                     accept=accept, check=False) for r in recs]
     runtime["compare"] = time.perf_counter() - t0
     runtime["total"] = time.perf_counter() - t_start
     return Identification(
@@ -339,11 +412,12 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         start_values={k: float(v) for k, v in zip(keys, coords.start)},
         stage1_values={k: (float(s1_vals[i]) if k in stage1_keys else None) for i, k in enumerate(keys)},
         intervals=u["intervals"], std=u["std"], correlation=u["correlation"],
-        flags=not_improved_flags(kept, costs) + separability_flags(keys, values, u["intervals"], u["correlation"],
-                                                                   u["status"]),
+        flags=extra["notes"] + not_improved_flags(kept, costs) + separability_flags(
+            keys, values, u["intervals"], u["correlation"], u["status"]),
         before=before, after=after, generic_start=generic, weights=weights, integrator=options.method.name.lower(),
         n_eff=float(u["n_eff"]), rho1=float(u["rho1"]), nfev=nfev, runtime_s=runtime, status=u["status"],
-        costs=costs, kept=kept)
+        costs=costs, kept=kept, checks=found + [c for a in after for c in a.checks], field_input=extra["field"],
+        law=extra["law"])
 
 
 __all__ = ["Comparison", "Identification", "as_records", "identify", "key_status", "separability_flags",

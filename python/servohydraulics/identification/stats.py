@@ -183,5 +183,12 @@ def covariance(J: ArrayLike, r: ArrayLike, scale: ArrayLike | None = None,
     return Covariance(cov, identified, s)
 
 
-__all__ = ["LEVEL", "NULL_LOADING", "RCOND", "Covariance", "ar1_coefficient", "ar1_effective_n",
+def noise_sigma(y: np.ndarray) -> float:
+    """Noise standard deviation of a record channel from its third differences
+    (robust MAD; smooth signal content sampled well above its bandwidth cancels)."""
+    d3 = np.diff(y, 3)
+    return float(1.4826 * np.median(np.abs(d3 - np.median(d3))) / math.sqrt(20.0))
+
+
+__all__ = ["LEVEL", "NULL_LOADING", "RCOND", "Covariance", "ar1_coefficient", "ar1_effective_n", "noise_sigma",
            "bartlett_bandwidth", "covariance", "lag1_autocorrelation", "long_run_covariance", "quantile"]
