@@ -2,11 +2,15 @@
     PYTHONPATH=python SERVOHYDRAULICS_CORE_DIR=build/dev python benchmarks/marths_bench.py --data ../shared/marths-data
 The nominal El Centro RoDeAC run (42,169 steps): the C++ loop alone and the whole trial (loop + J1-J10), median
 of 5, and the per-step times of a run that reads the clock around each step; then 20 perturbed runs through
-sh.sweep on 2 processes (pool start-up included), and the whole command's run (nominal + 20 perturbed)."""
+sh.sweep on 2 processes (pool start-up included), and the whole command's run (nominal + 20 perturbed); then the
+nominal El Centro rodeac_fixed and none runs on the nonlinear two-actuator rig (--plant nonlinear: dopri5 with the
+CVODE fallback), the loop alone, once each (RoDeAC itself oscillates there at 167 Hz: docs/multi-actuator.md).
+The load average is printed before and after (the machine is shared)."""
 
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import numpy as np
@@ -21,6 +25,7 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--perturbed", type=int, default=20)
     a = ap.parse_args()
+    print("load average (1, 5, 15 min) before: " + ", ".join(f"{v:.1f}" for v in os.getloadavg()))
     data, rec = marths.load_data(a.data), marths.load_record(a.data, "elcentro")
     st = marths.structures(data)
     marths.run_trial(data, rec, "rodeac", structures_=st)  # warm: imports (SciPy's FFT), caches
@@ -46,6 +51,15 @@ def main() -> None:
     print(f"{a.perturbed} perturbed El Centro RoDeAC runs on {a.workers} processes: {pert:.1f} s wall (pool start-up "
           f"included; C++ loop per run median {np.median(walls):.3f} s); nominal + {a.perturbed} perturbed: "
           f"{total:.1f} s")
+    import servohydraulics as sh
+
+    rig = sh.marths_rig()
+    for ctrl in ("rodeac_fixed", "none"):  # RoDeAC oscillates on the rig (docs/multi-actuator.md): not a timing
+        t = marths.run_trial(data, rec, ctrl, plant=rig, structures_=st)
+        steps = t.work.internal_steps / marths.samples(rec)
+        print(f"nominal El Centro {ctrl} run on the nonlinear rig (--plant nonlinear): C++ loop {t.wall_time:.3f} s, "
+              f"{steps:.1f} dopri5 steps per sample; keep_signals replays it for the rig's channels: as much again")
+    print("load average (1, 5, 15 min) after: " + ", ".join(f"{v:.1f}" for v in os.getloadavg()))
 
 
 if __name__ == "__main__":

@@ -280,6 +280,13 @@ void expose_marths(py::module_& m) {
       .def_static("from_parameters", &PhysicalFrame::from, py::arg("parameters") = PhysicalFrameParameters{})
       .def_readonly("K", &PhysicalFrame::K).def_readonly("M", &PhysicalFrame::M).def_readonly("C", &PhysicalFrame::C)
       .def_readonly("G", &PhysicalFrame::G).def_readonly("omegas", &PhysicalFrame::omegas);
+  py::enum_<FrameReduction>(r, "FrameReduction")
+      .value("Guyan", FrameReduction::Guyan)
+      .value("Static", FrameReduction::Static);
+  py::class_<CondensedFrame>(r, "CondensedFrame")
+      .def_static("from_parameters", &CondensedFrame::from, py::arg("parameters") = PhysicalFrameParameters{},
+                  py::arg("reduction") = FrameReduction::Guyan)
+      .def_readonly("K", &CondensedFrame::K).def_readonly("M", &CondensedFrame::M).def_readonly("C", &CondensedFrame::C);
   py::class_<FrameFeedback>(r, "FrameFeedback")
       .def(py::init<const PhysicalFrame&, double>(), py::arg("frame"), py::arg("dt"))
       .def("reset", &FrameFeedback::reset)

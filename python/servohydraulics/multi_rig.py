@@ -74,54 +74,10 @@ def marths_frame(reduction: str = "guyan") -> dict[str, np.ndarray]:
     """
     if reduction not in ("guyan", "static"):
         raise ValueError(f"invalid reduction = {reduction!r}: expected 'guyan' or 'static'")
-    inch = 0.0254
-    Lb, Lc = 0.762, 0.64135
-    Ic, Ib = 0.7 * 2.520 * inch**4, 4.21372e-7
-    Ac, Ab = 1.670 * inch**2, 7.56e-4
-    E, rho = 200e9, 7850.0
-
-    def local(L: float, I: float) -> np.ndarray:  # noqa: E741 - the second moment of area
-        k = E * I / L**3 * np.array([[12, 6 * L, -12, 6 * L], [6 * L, 4 * L * L, -6 * L, 2 * L * L],
-                                     [-12, -6 * L, 12, -6 * L], [6 * L, 2 * L * L, -6 * L, 4 * L * L]])
-        return k  # (transverse, rotation) at both ends: the axial terms are removed
-
-    kc, kb = local(Lc, Ic), local(Lb, Ib)
-    # The script's global matrix from the columns (turned by pi/2: the transverse DOF is X) and the beam.
-    # Column ends: 1 = base (X = 0, pinned, rotation theta3/theta4), 2 = top (X1, theta1/theta2).
-    c_tt, c_tr_top, c_rr_top = kc[2, 2], -kc[2, 3], kc[3, 3]
-    c_tr_base, c_rr_base, c_rr_cross = -kc[2, 1], kc[1, 1], kc[1, 3]
-    K5 = np.array([
-        [2 * c_tt, c_tr_top, c_tr_top, c_tr_base, c_tr_base],
-        [c_tr_top, c_rr_top + kb[3, 3], kb[3, 1], 0.0, c_rr_cross],
-        [c_tr_top, kb[1, 3], c_rr_top + kb[1, 1], c_rr_cross, 0.0],
-        [c_tr_base, 0.0, c_rr_cross, c_rr_base, 0.0],
-        [c_tr_base, c_rr_cross, 0.0, 0.0, c_rr_base]])
-    mb, mc = rho * Ab * Lb, rho * Ac * Lc
-    diag = np.array([(mb + 2 * mc) / 2, (mb / 2 * Lb**2 + mc / 2 * Lc**2) / 3, (mb / 2 * Lb**2 + mc / 2 * Lc**2) / 3,
-                     mc / 2 * Lc**2 / 3, mc / 2 * Lc**2 / 3])
-    Koo, Kot = K5[2:, 2:], K5[2:, :2]
-    G = -np.linalg.solve(Koo, Kot)
-    K2 = K5[:2, :2] + K5[:2, 2:] @ G
-
-    def modal_damping(M: np.ndarray, K: np.ndarray) -> np.ndarray:
-        w2, phi = np.linalg.eig(np.linalg.solve(M, K))
-        order = np.argsort(np.sqrt(w2.real))
-        w = np.round(100 * np.sqrt(w2.real[order])) / 100
-        phi = phi.real[:, order]
-        C = np.zeros_like(M)
-        for i in range(M.shape[0]):
-            f = phi[:, i]
-            C += M @ (2 * 0.05 * w[i] * np.outer(f, f) / (f @ M @ f)) @ M
-        return C
-
-    if reduction == "static":
-        M2 = np.diag(diag[:2])
-        return {"M": M2, "C": modal_damping(M2, K2), "K": K2}
-    M5 = 1.1 * np.diag(diag)
-    C5 = modal_damping(M5, K5)
-    T = np.vstack([np.eye(2), G])
-    K = T.T @ K5 @ T
-    return {"M": T.T @ M5 @ T, "C": T.T @ C5 @ T, "K": 0.5 * (K + K.T)}
+    R = _core.marths
+    kind = R.FrameReduction.Guyan if reduction == "guyan" else R.FrameReduction.Static
+    fr = R.CondensedFrame.from_parameters(R.PhysicalFrameParameters(), kind)  # the one home: marths/structure.cpp
+    return {"M": np.array(fr.M), "C": np.array(fr.C), "K": np.array(fr.K)}
 
 
 def _matrix(name: str, value: Any, rotation: bool) -> list[float]:

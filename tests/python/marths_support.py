@@ -85,3 +85,25 @@ def write_folder(folder: Path, duration: float = 2.0) -> Path:
                                       ("MorganAccelNoScaling.mat", "MorganAccel"))):
         sio.savemat(folder / fname, {var: ground_motion(duration, seed=i)})
     return folder
+
+
+def run_cli(capsys, *argv) -> tuple[int, str, str]:
+    """``servohydraulics ARGV`` in process: (exit code, stdout, stderr)."""
+    from servohydraulics.cli import main
+
+    code = main([str(a) for a in argv])
+    cap = capsys.readouterr()
+    return code, cap.out, cap.err
+
+
+def assert_refused(capsys, tmp_path, argv, named) -> None:
+    """``marths-benchmark ARGV`` ends in ``error:`` naming every part of ``named``, exit 2, no
+    traceback, nothing written to its --out."""
+    out = tmp_path / "never"
+    code, _, err = run_cli(capsys, "marths-benchmark", *argv, "--quiet", "--out", out)
+    assert code == 2, err
+    assert err.startswith("servohydraulics marths-benchmark: error: "), err
+    assert "Traceback" not in err
+    for part in named:
+        assert part in err, err
+    assert not out.exists()

@@ -321,7 +321,8 @@ def test_cli_compare_field_input(tmp_path, capsys, two_records):
     code, _, err = _cli(capsys, "compare", rec, "--rig", rig_path, "--mode", "displacement", "--current", "1.5",
                         "--out", out)
     assert code == 0, err
-    assert "warning: MR damper current 1.5 A is outside the range its law was identified on (0 ... 1 A" in err
+    assert "[run_mr_law] simulated run: MR damper current 1.5 A is outside the range its law was identified on " \
+        "(0 ... 1 A" in err
     assert any("extrapolates" in w for w in json.loads((out / "comparison.json").read_text())["warnings"])
     plain = copy.copy(rig)
     plain.effects.mr_damper = False

@@ -15,10 +15,9 @@ import pytest
 import scipy.io as sio
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from marths_support import write_folder, write_xlsx
+from marths_support import assert_refused, run_cli, write_folder, write_xlsx
 
 from servohydraulics import marths
-from servohydraulics.cli import main
 
 FE = Path("FE_Model") / "REF_SAP2000_Model"
 
@@ -33,15 +32,10 @@ def folder(pristine, tmp_path):
     return Path(shutil.copytree(pristine, tmp_path / "data"))
 
 
-def _cli(capsys, *argv) -> tuple[int, str, str]:
-    code = main([str(a) for a in argv])
-    cap = capsys.readouterr()
-    return code, cap.out, cap.err
-
 
 def test_the_command_writes_results_report_and_plots(folder, tmp_path, capsys):
     out = tmp_path / "out"
-    code, stdout, err = _cli(capsys, "marths-benchmark", "--data", folder, "--record", "morgan", "--controller",
+    code, stdout, err = run_cli(capsys, "marths-benchmark", "--data", folder, "--record", "morgan", "--controller",
                              "rodeac", "--perturbed", "2", "--workers", "1", "--quiet", "--out", out)
     assert code == 0, err
     res = json.loads((out / "results.json").read_text())
@@ -78,7 +72,7 @@ def test_a_users_controller_by_module_and_class(folder, tmp_path, capsys, monkey
     (tmp_path / "mine.py").write_text("class Plain:\n    '''mine'''\n    def reset(self):\n        pass\n"
                                       "    def command(self, desired, measured):\n        return desired\n")
     monkeypatch.syspath_prepend(str(tmp_path))
-    code, _, err = _cli(capsys, "marths-benchmark", "--data", folder, "--controller", "mine:Plain", "--quiet",
+    code, _, err = run_cli(capsys, "marths-benchmark", "--data", folder, "--controller", "mine:Plain", "--quiet",
                         "--out", tmp_path / "o")
     assert code == 0, err
     res = json.loads((tmp_path / "o" / "results.json").read_text())
@@ -86,16 +80,6 @@ def test_a_users_controller_by_module_and_class(folder, tmp_path, capsys, monkey
     assert res["runs"]["nominal"]["J"] == none.J
     assert res["meta"]["controller"] == "mine:Plain"
 
-
-def _assert_refused(capsys, tmp_path, argv, named):
-    out = tmp_path / "never"
-    code, _, err = _cli(capsys, "marths-benchmark", *argv, "--quiet", "--out", out)
-    assert code == 2, err
-    assert err.startswith("servohydraulics marths-benchmark: error: "), err
-    assert "Traceback" not in err
-    for part in named:
-        assert part in err, err
-    assert not out.exists()
 
 
 @pytest.mark.parametrize("argv, named", [
@@ -110,11 +94,11 @@ def _assert_refused(capsys, tmp_path, argv, named):
 ], ids=["record", "controller", "module", "perturbed_fraction", "perturbed_negative", "perturbed_text", "workers",
         "seed"])
 def test_bad_arguments_are_named(folder, tmp_path, capsys, argv, named):
-    _assert_refused(capsys, tmp_path, ["--data", folder, *argv], named)
+    assert_refused(capsys, tmp_path, ["--data", folder, *argv], named)
 
 
 def test_a_missing_folder_is_named(tmp_path, capsys):
-    _assert_refused(capsys, tmp_path, ["--data", tmp_path / "nowhere"], ["invalid data =", "not a directory"])
+    assert_refused(capsys, tmp_path, ["--data", tmp_path / "nowhere"], ["invalid data =", "not a directory"])
 
 
 # ----------------------------------------------------------------------------- corrupt files
@@ -224,7 +208,7 @@ def _defects():
 @pytest.mark.parametrize("name, rel, action, named", _defects(), ids=[d[0] for d in _defects()])
 def test_a_corrupt_file_is_named(folder, tmp_path, capsys, name, rel, action, named):
     action(folder)
-    _assert_refused(capsys, tmp_path, ["--data", folder], [f"error: {folder / rel}", *named])
+    assert_refused(capsys, tmp_path, ["--data", folder], [f"error: {folder / rel}", *named])
 
 
 FILES = [str(p) for p in marths.FILES.values()] + ["ElCentroAccelNoScaling.mat"]
@@ -233,7 +217,7 @@ FILES = [str(p) for p in marths.FILES.values()] + ["ElCentroAccelNoScaling.mat"]
 @pytest.mark.parametrize("rel", FILES)
 def test_a_missing_file_is_named(folder, tmp_path, capsys, rel):
     (folder / rel).unlink()
-    _assert_refused(capsys, tmp_path, ["--data", folder], [f"error: {folder / rel}: file not found"])
+    assert_refused(capsys, tmp_path, ["--data", folder], [f"error: {folder / rel}: file not found"])
 
 
 GARBAGE = [b"", b"\x00" * 64, b"MATLAB 5.0 MAT-file" + b"\x00" * 200, b"PK\x03\x04 not a zip", b"{not json",

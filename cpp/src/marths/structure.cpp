@@ -200,23 +200,52 @@ PhysicalFrame PhysicalFrame::from(const PhysicalFrameParameters& p) {
   const double m12z = (mb / 2.0 * p.Lb * p.Lb + mc / 2.0 * p.Lc * p.Lc) / 3.0 * p.mass_factor;
   const double m34z = mc / 2.0 * p.Lc * p.Lc / 3.0 * p.mass_factor;
   f.M = Eigen::Matrix<double, 5, 1>(m1x, m12z, m12z, m34z, m34z).asDiagonal();
-  // C = sum_i M (2 zeta w_i phi_i phi_i^T / (phi_i^T M phi_i)) M, w_i rounded to 0.01 rad/s (the scaling of
-  // phi_i cancels).  eig(M\K) has the eigenvalues and eigenvectors of the pair (K, M).
-  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>> es(0.5 * (f.K + f.K.transpose()), f.M);
-  require(es.info() == Eigen::Success && es.eigenvalues().minCoeff() > 0.0, "physical_frame.K",
-          es.eigenvalues().minCoeff(), "positive definite (the frame's modes)");
-  f.C.setZero();
-  for (int i = 0; i < 5; ++i) {
-    const double w = std::round(100.0 * std::sqrt(es.eigenvalues()(i))) / 100.0;
-    f.omegas[static_cast<std::size_t>(i)] = w;
-    const Eigen::Matrix<double, 5, 1> phi = es.eigenvectors().col(i);
-    const double m = phi.dot(f.M * phi);
-    f.C += f.M * (2.0 * p.zeta * w * phi * phi.transpose() / m) * f.M;
-  }
+  const Eigen::MatrixXd C = modal_damping(f.M, f.K, p.zeta, "physical_frame.K", f.omegas.data());
+  f.C = C;
   const Eigen::Matrix3d Koo = f.K.block<3, 3>(2, 2);
   const Eigen::Matrix<double, 3, 2> Kot = f.K.block<3, 2>(2, 0);
   f.G = -Koo.partialPivLu().solve(Kot);
   return f;
+}
+
+Eigen::MatrixXd modal_damping(const Eigen::MatrixXd& M, const Eigen::MatrixXd& K, double zeta, const char* field,
+                              double* omegas) {
+  require(K.rows() == K.cols() && M.rows() == K.rows() && M.cols() == K.rows(), field, static_cast<double>(K.rows()),
+          "square, the size of M");
+  // eig(M\K) has the eigenvalues and eigenvectors of the pair (K, M).
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (K + K.transpose()), M);
+  require(es.info() == Eigen::Success && es.eigenvalues().minCoeff() > 0.0, field,
+          es.info() == Eigen::Success ? es.eigenvalues().minCoeff() : 0.0, "positive definite (the frame's modes)");
+  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(K.rows(), K.cols());
+  for (Eigen::Index i = 0; i < K.rows(); ++i) {
+    const double w = std::round(100.0 * std::sqrt(es.eigenvalues()(i))) / 100.0;
+    if (omegas) omegas[i] = w;
+    const Eigen::VectorXd phi = es.eigenvectors().col(i);
+    const double m = phi.dot(M * phi);
+    C += M * (2.0 * zeta * w * phi * phi.transpose() / m) * M;
+  }
+  return C;
+}
+
+CondensedFrame CondensedFrame::from(const PhysicalFrameParameters& p, FrameReduction reduction) {
+  const PhysicalFrame f = PhysicalFrame::from(p);
+  Eigen::Matrix<double, 5, 2> T;
+  T.topRows<2>().setIdentity();
+  T.bottomRows<3>() = f.G;
+  CondensedFrame c;
+  const Eigen::Matrix2d K = T.transpose() * f.K * T;
+  c.K = 0.5 * (K + K.transpose());
+  if (reduction == FrameReduction::Guyan) {
+    c.M = T.transpose() * f.M * T;
+    c.C = T.transpose() * f.C * T;
+  } else {
+    PhysicalFrameParameters unscaled = p;  // M_phys_2dof = diag(M1x, M12z): without the mass factor
+    unscaled.mass_factor = 1.0;
+    const PhysicalFrame u = PhysicalFrame::from(unscaled);
+    c.M = Eigen::Vector2d(u.M(0, 0), u.M(1, 1)).asDiagonal();
+    c.C = modal_damping(c.M, c.K, p.zeta, "physical_frame.K");
+  }
+  return c;
 }
 
 FrameFeedback::FrameFeedback(const PhysicalFrame& frame, double dt)

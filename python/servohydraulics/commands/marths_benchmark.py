@@ -16,7 +16,8 @@ def _run(args) -> int:
         raise ValueError(f"invalid --seed = {args.seed}: expected a whole number >= 0")
     setup = prepare(args.data, args.record, args.controller, perturbed, args.seed, workers=args.workers,
                     daq_quantizer=args.daq_quantizer, daq_saturation=args.daq_saturation,
-                    exact_kinematics=args.exact_kinematics)  # every input validated: nothing written yet
+                    exact_kinematics=args.exact_kinematics,
+                    plant=args.plant)  # every input validated: nothing written yet
     check_folder(args.out)  # a folder that cannot hold the results fails before the runs
     run = execute(setup, progress=not args.quiet)
     out = write_outputs(run, args.out)
@@ -42,6 +43,10 @@ def register(sub) -> None:
                         "or your own as module:Class, imported from PYTHONPATH and built with no arguments, with "
                         "reset() and command(desired, measured[, desired_velocity=, desired_acceleration=]) -> "
                         "the two commands [m] (docs/marths-benchmark.md)")
+    p.add_argument("--plant", default="identified", metavar="identified | nonlinear | RIG.toml",
+                   help="behind the actuators: the benchmark's identified linear plant (default), the nonlinear "
+                        "two-actuator rig calibrated to it, or your multi-actuator rig file (docs/multi-actuator.md); "
+                        "on a nonlinear rig the report adds its spools, forces and force fighting")
     p.add_argument("--perturbed", default="0", help="perturbed-plant trials after the nominal one (default: 0)")
     p.add_argument("--seed", type=int, default=123,
                    help="noise seed of the nominal trial (default 123, the benchmark's) and the seed of the perturbed "

@@ -9,6 +9,8 @@ Fermandois, Front. Built Environ. 2024), on the C++ core.
     out = marths.run_benchmark("../shared/marths-data", "elcentro", "rodeac", perturbed=20)
     trial = marths.run_trial(data, rec, MyController())     # your own: reset() and command(desired, measured)
     trial = marths.run_trial(data, rec, "rodeac", plant=my_rig)  # any MultiActuatorSystem
+    trial = marths.run_trial(data, rec, "rodeac", plant=sh.marths_rig(), keep_signals=True)  # the nonlinear
+    trial.rig["actuator1.spool"]                             # rig; its channels, replayed (rig_summary)
 
 The C++ blocks (plant, structures, controllers, loop) are ``servohydraulics._core.marths``; the seam
 (``MultiActuatorSystem``, ``MultiTrackingController``, ``Coupler``) is in ``servohydraulics._core``.
@@ -18,9 +20,12 @@ from .. import _core
 from .benchmark import (
     CONTROLLERS,
     NOMINAL_SEED,
+    PLANTS,
     STABLE_J2_PCT,
     Trial,
+    applied_commands,
     as_controller,
+    benchmark_rig,
     controller_label,
     loop_config,
     make_controller,
@@ -29,7 +34,10 @@ from .benchmark import (
     nominal_plant,
     perturbed_model,
     perturbed_plant,
+    plant_label,
     plant_model,
+    replay_on_rig,
+    rig_summary,
     rodeac_config,
     run_trial,
     samples,
@@ -37,7 +45,7 @@ from .benchmark import (
 )
 from .data import DT, EQ_INTENSITY, FILES, FS, RECORDS, MarthsData, load_data, load_record
 from .evaluation import J_COMPONENTS, J_TITLES, J_UNITS, SATURATION_LIMIT, evaluate, finddelay, realizable
-from .report import Setup, check_perturbed, execute, j_table, prepare, run_benchmark, write_outputs
+from .report import Setup, check_perturbed, execute, j_table, prepare, rig_figure, run_benchmark, write_outputs
 
 core = _core.marths
 #: The multi-actuator controller interface: subclass it in Python (super().__init__(2)), or give any object
@@ -55,5 +63,6 @@ __all__ = [
     "MarthsData", "load_data", "load_record", "J_COMPONENTS", "J_TITLES", "J_UNITS", "SATURATION_LIMIT", "evaluate",
     "finddelay", "realizable", "check_perturbed", "j_table", "run_benchmark", "write_outputs", "core", "Setup",
     "prepare", "execute",
-    "MultiTrackingController", "MultiActuatorSystem",
+    "MultiTrackingController", "MultiActuatorSystem", "PLANTS", "applied_commands", "benchmark_rig", "plant_label",
+    "replay_on_rig", "rig_summary", "rig_figure",
 ]

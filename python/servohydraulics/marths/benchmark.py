@@ -6,11 +6,13 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 
 from .. import _core
+from ..multi_rig import MultiActuatorRig, MultiResponse, load_multi_rig, marths_rig, simulate_multi
 from ..response import Response, Work
 from ..rths.benchmark import build_user_object, trial_seed
 from ..rths.data import Record
@@ -22,7 +24,8 @@ TC = _core.rths  # the single-actuator compensators (tracking.hpp)
 
 __all__ = ["CONTROLLERS", "NOMINAL_SEED", "Trial", "structures", "plant_model", "nominal_plant", "perturbed_model",
            "perturbed_plant", "make_controller", "as_controller", "controller_label", "rodeac_config",
-           "mimo_feedforward_config", "run_trial", "loop_config"]
+           "mimo_feedforward_config", "run_trial", "loop_config", "PLANTS", "benchmark_rig", "plant_label",
+           "applied_commands", "replay_on_rig", "rig_summary"]
 
 #: The noise seed of the nominal trial (S1_Input_Data.m: rng(123)).
 NOMINAL_SEED = 123
@@ -56,6 +59,56 @@ def perturbed_model(seed: int, trial: int) -> Any:
 def perturbed_plant(seed: int, trial: int, dt: float = DT) -> Any:
     """The perturbed plant of ``trial`` as a ``MultiActuatorSystem`` (its own modal realisation)."""
     return R.IdentifiedPlant(perturbed_model(seed, trial).realize(), dt)
+
+
+#: The plants behind the actuators by name (besides a multi-actuator rig file): name -> description.
+PLANTS = {
+    "identified": "the benchmark's identified linear MIMO plant (plantFRAME_SS, BENCHMARK.md section 4)",
+    "nonlinear": "the nonlinear two-actuator rig calibrated to the identified plant (sh.marths_rig(), "
+                 "docs/multi-actuator.md): two of the paper's servo-hydraulic actuators on the benchmark's coupler "
+                 "and physical frame",
+}
+
+
+def benchmark_rig(plant: Any) -> MultiActuatorRig | None:
+    """The nonlinear rig a benchmark runs on: None for ``"identified"`` (the identified plant), the calibrated
+    two-actuator rig for ``"nonlinear"``, a :class:`MultiActuatorRig` as it is, or a multi-actuator rig file
+    (TOML, :func:`servohydraulics.load_multi_rig`).  ValueError naming the value (or the file, key and value)
+    otherwise; the rig must have two actuators (the benchmark's coupler)."""
+    if plant is None or (isinstance(plant, str) and plant == "identified"):
+        return None
+    if isinstance(plant, str) and plant == "nonlinear":
+        return marths_rig()
+    if isinstance(plant, MultiActuatorRig):
+        rig = plant
+    elif isinstance(plant, (str, Path)):
+        path = Path(plant)
+        if not path.is_file():
+            raise ValueError(f"invalid plant = {str(plant)!r}: expected {' | '.join(PLANTS)} or a multi-actuator rig "
+                             "file (TOML; no such file)")
+        try:
+            rig = load_multi_rig(path)
+        except FileNotFoundError as e:  # an actuator's rig file it names
+            raise ValueError(str(e)) from None
+        if rig.actuators != 2:
+            raise ValueError(f"{path}: invalid [[actuators]] (count) = {rig.actuators}: the benchmark's coupler "
+                             "drives 2 actuators")
+        return rig
+    else:
+        raise ValueError(f"invalid plant = {plant!r}: expected {' | '.join(PLANTS)}, a rig file or a MultiActuatorRig")
+    if rig.actuators != 2:
+        raise ValueError(f"invalid plant actuators = {rig.actuators}: the benchmark's coupler drives 2 actuators")
+    return rig
+
+
+def plant_label(plant: Any) -> tuple[str, str]:
+    """(name, description) of a plant for reports."""
+    if plant is None or (isinstance(plant, str) and plant in PLANTS):
+        name = plant or "identified"
+        return name, PLANTS[name]
+    if isinstance(plant, MultiActuatorRig):
+        return "rig", f"a nonlinear multi-actuator rig ({plant!r})"
+    return str(plant), "a nonlinear two-actuator rig from this file (docs/multi-actuator.md)"
 
 
 def noise_seed(seed: int, trial: int) -> int:
@@ -225,6 +278,8 @@ def _plant(plant: Any, data: MarthsData) -> Any:
         return nominal_plant(data)
     if isinstance(plant, _core.MultiActuatorSystem):
         return plant
+    if isinstance(plant, MultiActuatorRig):
+        return plant.make_plant(DT)
     if isinstance(plant, R.TransferMatrix):
         return R.IdentifiedPlant(plant.realize(), DT)
     if isinstance(plant, R.StateSpace):
@@ -246,6 +301,9 @@ class Trial:
     wall_time: float
     work: Work
     response: Response | None = None
+    #: on a nonlinear rig (``plant`` a MultiActuatorRig, ``keep_signals``): every rig channel, from
+    #: :func:`replay_on_rig` (the same commands on the same rig, run anew: identical strokes)
+    rig: MultiResponse | None = None
 
     @property
     def realizable(self) -> bool:
@@ -273,8 +331,10 @@ def run_trial(data: MarthsData, record: Record, controller: Any = "rodeac", plan
         controller: a built-in name (CONTROLLERS) or ``"module:Class"`` (built anew), or a controller object
             (``MultiTrackingController``, or any object with ``reset()`` and ``command(...)``); the loop resets it.
         plant: None (the nominal identified plant), a ``MultiActuatorSystem`` (e.g. ``perturbed_plant(...)``, or
-            a rig of nonlinear actuators bound from C++), a ``TransferMatrix`` or ``StateSpace`` (mm in and out),
-            or a Python object with the protocol of ``_core.PythonMultiActuatorSystem``.
+            a rig of nonlinear actuators bound from C++), a :class:`MultiActuatorRig` (stepped by its default
+            integrator; with ``keep_signals`` its channels are in ``Trial.rig``), a ``TransferMatrix`` or
+            ``StateSpace`` (mm in and out), or a Python object with the protocol of
+            ``_core.PythonMultiActuatorSystem``.
         seed: the sensor-noise seed (Simulink's Random Number block; 123: the benchmark's nominal trial).
         config: a ``MarthsLoopConfig`` (its seed is replaced by ``seed``); None: :func:`loop_config`.
     """
@@ -298,4 +358,56 @@ def run_trial(data: MarthsData, record: Record, controller: Any = "rodeac", plan
     trial = Trial(J, volts, work.ok, work.failure_time, wall, work)
     if keep_signals:
         trial.response = Response(out, kind="marths", dt=DT, work=work)
+        if isinstance(plant, MultiActuatorRig):
+            trial.rig = replay_on_rig(plant, out, cfg)
     return trial
+
+
+def applied_commands(rows: dict[str, np.ndarray], config: Any) -> np.ndarray:
+    """The commands the plant held, (n, 2) [m]: the controller's, or with the DAQ blocks on, the D/A's output
+    converted back (``CommandVoltage.millimetres`` of the logged voltage)."""
+    if not (config.daq_quantizer or config.daq_saturation):
+        return np.column_stack([rows["command_1"], rows["command_2"]])
+    return np.column_stack([[config.voltage[i].millimetres(v) * config.sensor_unit for v in rows[f"voltage_{i + 1}"]]
+                            for i in range(2)])
+
+
+def replay_on_rig(rig: MultiActuatorRig, rows: dict[str, np.ndarray], config: Any) -> MultiResponse | None:
+    """Every channel of the rig (forces, pressures, spools, friction, the node) during a loop run: the commands
+    the loop applied, run again from rest on the same rig by :func:`simulate_multi` (the same integrator on the
+    same inputs: the strokes equal the loop's ``displacement_1/2`` row by row).  None when the loop logged fewer
+    than two rows."""
+    u = applied_commands(rows, config)
+    if u.shape[0] < 2:
+        return None
+    return simulate_multi(rig, u, DT, raise_on_failure=False)
+
+
+def rig_summary(res: MultiResponse, rows: dict[str, np.ndarray] | None = None) -> dict[str, Any]:
+    """What the nonlinear rig shows and the linear plant cannot (SI): per actuator the peak load-cell force [N],
+    spool opening [-] (and its limit), valve drive [V] and friction [N], the share of samples with the spool
+    beyond 90 % of its limit; the force difference F1 - F2 and the opposing force (the force that cancels in the
+    x resultant) [N]; the limit warnings; with the loop's ``rows``, the largest stroke difference between the
+    loop and the replay [m] (0: the replay is the loop's run)."""
+    out: dict[str, Any] = {"actuators": []}
+    for i, r in enumerate(res.multi_rig.rigs, start=1):
+        spool = res[f"actuator{i}.spool"]
+        lim = float(r.x_v_max) if r.effects.spool_saturation else math.inf
+        out["actuators"].append({
+            "peak_force_N": float(np.max(np.abs(res[f"actuator{i}.force"]))),
+            "peak_spool": float(np.max(np.abs(spool))), "spool_limit": lim,
+            "spool_above_90pct_share": float(np.mean(np.abs(spool) > 0.9 * lim)) if math.isfinite(lim) else 0.0,
+            "peak_drive_V": float(np.max(np.abs(res[f"actuator{i}.drive"]))),
+            "peak_friction_N": float(np.max(np.abs(res[f"actuator{i}.friction"]))),
+            "peak_pressure_Pa": float(np.max(np.abs(res[f"actuator{i}.pressure"]))),
+        })
+    dF = res["actuator1.force"] - res["actuator2.force"]
+    out["peak_force_difference_N"] = float(np.max(np.abs(dF)))
+    out["rms_force_difference_N"] = float(np.sqrt(np.mean(dF * dF)))
+    out["peak_opposing_force_N"] = float(np.max(res["node.opposing_force"]))
+    out["warnings"] = res.warnings()
+    if rows is not None:
+        n = len(res.time)
+        out["replay_stroke_difference_m"] = float(max(
+            np.max(np.abs(res[f"actuator{i}.stroke"] - rows[f"displacement_{i}"][:n])) for i in (1, 2)))
+    return out

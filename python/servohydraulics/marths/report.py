@@ -17,11 +17,14 @@ from ..rths.evaluation import matlab_round
 from ..workers import check_workers, default_workers, process_pool
 from .benchmark import (
     NOMINAL_SEED,
+    benchmark_rig,
     controller_label,
     loop_config,
     make_controller,
     noise_seed,
     perturbed_plant,
+    plant_label,
+    rig_summary,
     run_trial,
     structures,
 )
@@ -79,14 +82,26 @@ class Setup:
     workers: int
     options: dict[str, bool]
     folder: Path
+    plant: Any = None       #: the nonlinear rig (MultiActuatorRig) or None: the identified plant
+    plant_name: str = "identified"
+    plant_description: str = ""
 
 
 def prepare(data: str | Path, record: str = "elcentro", controller: Any = "rodeac", perturbed: Any = 0,
             seed: int = NOMINAL_SEED, scale: float = EQ_INTENSITY, workers: int | None = None,
-            daq_quantizer: bool = False, daq_saturation: bool = False, exact_kinematics: bool = False) -> Setup:
+            daq_quantizer: bool = False, daq_saturation: bool = False, exact_kinematics: bool = False,
+            plant: Any = "identified") -> Setup:
     """Validates every argument and input file (ValueError naming the field or the file and the value) and
-    builds the nominal controller, before anything runs or is written."""
+    builds the nominal controller, before anything runs or is written.
+
+    ``plant``: ``"identified"`` (the benchmark's), ``"nonlinear"`` (the calibrated two-actuator rig), a
+    multi-actuator rig file or a ``MultiActuatorRig`` (:func:`benchmark_rig`); the perturbed trials draw the
+    identified plant's uncertainty and exist only on it."""
     n_pert = check_perturbed(perturbed)
+    rig = benchmark_rig(plant)
+    if rig is not None and n_pert > 0:
+        raise ValueError(f"invalid perturbed = {n_pert} with plant = {plant_label(plant)[0]!r}: the perturbed trials "
+                         "draw the identified plant's uncertainty (BENCHMARK.md section 4); a nonlinear rig has none")
     if record not in RECORDS:
         raise ValueError(f"invalid record = {record!r}: expected one of {sorted(RECORDS)}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
@@ -101,13 +116,13 @@ def prepare(data: str | Path, record: str = "elcentro", controller: Any = "rodea
     options = {"daq_quantizer": bool(daq_quantizer), "daq_saturation": bool(daq_saturation),
                "exact_kinematics": bool(exact_kinematics)}
     return Setup(d, rec, controller, built, name, description, n_pert, int(seed), float(scale), workers, options,
-                 Path(data))
+                 Path(data), rig, *plant_label(plant))
 
 
 def run_benchmark(data: str | Path, record: str = "elcentro", controller: Any = "rodeac", perturbed: Any = 0,
                   seed: int = NOMINAL_SEED, scale: float = EQ_INTENSITY, workers: int | None = None,
                   progress: bool = True, daq_quantizer: bool = False, daq_saturation: bool = False,
-                  exact_kinematics: bool = False) -> dict[str, Any]:
+                  exact_kinematics: bool = False, plant: Any = "identified") -> dict[str, Any]:
     """The nominal trial (noise seed ``seed``; 123 is the benchmark's) and ``perturbed`` perturbed trials
     (plants and noise seeded from ``seed`` and the trial number) of one record and controller.
 
@@ -117,19 +132,21 @@ def run_benchmark(data: str | Path, record: str = "elcentro", controller: Any = 
     the perturbed trials or None}``.
     """
     return execute(prepare(data, record, controller, perturbed, seed, scale, workers, daq_quantizer, daq_saturation,
-                           exact_kinematics), progress)
+                           exact_kinematics, plant), progress)
 
 
 def execute(setup: Setup, progress: bool = True) -> dict[str, Any]:
     """Runs a prepared benchmark (:func:`prepare`)."""
     s = setup
     st = structures(s.data)
-    nom = run_trial(s.data, s.record, s.built, seed=s.seed, scale=s.scale, config=loop_config(**s.options),
-                    structures_=st, keep_signals=True)
+    nom = run_trial(s.data, s.record, s.built, plant=s.plant, seed=s.seed, scale=s.scale,
+                    config=loop_config(**s.options), structures_=st, keep_signals=True)
     runs: dict[str, Any] = {"nominal": {
         "J": nom.J, "J_rounded": _round(nom.J), "realizable": nom.realizable, "peak_voltage_V": nom.peak_voltage,
         "ok": nom.ok, "stable": nom.stable, "failure_time": nom.failure_time, "noise_seed": s.seed,
         "wall_time_s": nom.wall_time}}
+    if nom.rig is not None:
+        runs["nominal"]["rig"] = rig_summary(nom.rig, nom.response.channels)
     table = None
     if s.perturbed > 0:
         from ..parameter_sweep import sweep
@@ -157,6 +174,7 @@ def execute(setup: Setup, progress: bool = True) -> dict[str, Any]:
             "eq_intensity": s.scale, "fs_Hz": FS, "samples": int(s.record.samples(FS)), "controller": s.name,
             "controller_description": s.description, "seed": s.seed,
             "noise": "Simulink Random Number block algorithm, one sequence on both channels",
+            "plant": s.plant_name, "plant_description": s.plant_description,
             "perturbed_runs": s.perturbed, **s.options, "saturation_limit_V": SATURATION_LIMIT,
             "J_components": {j: list(c) for j, c in J_COMPONENTS.items()}, "J_units": J_UNITS, "J_titles": J_TITLES}
     return {"results": {"meta": meta, "runs": runs}, "trial": nom, "table": table}
@@ -263,7 +281,39 @@ def _plots(trial, out: Path, files: FileSet) -> list[str]:
     fig.tight_layout()
     fig.savefig(files.path(out / "synchronisation.png"), dpi=110)
     names.append("synchronisation.png")
+    if trial.rig is not None:
+        fig = Figure(figsize=(10, 6))
+        rig_figure(fig, trial.rig)
+        fig.savefig(files.path(out / "rig.png"), dpi=110)
+        names.append("rig.png")
     return names
+
+
+def rig_figure(fig, res, label: str = "") -> None:
+    """Draws the nonlinear rig's channels of a run into ``fig``: each actuator's spool opening against its limit,
+    the two load-cell forces and their difference [kN], and the opposing force [kN]."""
+    t = res.time
+    ax = fig.add_subplot(3, 1, 1)
+    for i in range(1, res.actuators + 1):
+        ax.plot(t, res[f"actuator{i}.spool"], lw=0.6, label=f"actuator {i}")
+    lim = max(float(r.x_v_max) for r in res.multi_rig.rigs)
+    ax.axhline(lim, color="k", ls=":", lw=0.8)
+    ax.axhline(-lim, color="k", ls=":", lw=0.8)
+    ax.set_ylabel("spool opening [-]")
+    ax.legend(fontsize=7, loc="upper right")
+    ax = fig.add_subplot(3, 1, 2)
+    for i in (1, 2):
+        ax.plot(t, 1e-3 * res[f"actuator{i}.force"], lw=0.6, label=f"F{i} (load cell)")
+    ax.plot(t, 1e-3 * (res["actuator1.force"] - res["actuator2.force"]), lw=0.6, label="F1 - F2")
+    ax.set_ylabel("force [kN]")
+    ax.legend(fontsize=7, loc="upper right")
+    ax = fig.add_subplot(3, 1, 3)
+    ax.plot(t, 1e-3 * res["node.opposing_force"], lw=0.6)
+    ax.set_ylabel("opposing force [kN]")
+    ax.set_xlabel("time [s]")
+    fig.suptitle(f"Nonlinear rig{': ' + label if label else ''}: valve spools, actuator forces, force fighting",
+                 fontsize=9)
+    fig.tight_layout()
 
 
 def write_outputs(run: dict[str, Any], out: str | Path) -> Path:
@@ -285,6 +335,7 @@ def _report(res: dict[str, Any], plots: list[str]) -> str:
     lines = [f"# Multi-axial RTHS benchmark (maRTHS): {meta['record']} × {meta['eq_intensity']}, "
              f"controller {meta['controller']}", "",
              f"- controller: {meta['controller']}: {meta['controller_description']}",
+             f"- plant: {meta['plant']}: {meta['plant_description']}",
              f"- record: {meta['record_source']} ({meta['samples']} samples at {meta['fs_Hz']} Hz)",
              f"- sensor noise: {meta['noise']}, seed {meta['seed']} on the nominal trial"
              + (" (the benchmark's)" if meta["seed"] == NOMINAL_SEED else ""),
@@ -308,6 +359,25 @@ def _report(res: dict[str, Any], plots: list[str]) -> str:
                   "(J2 < 100 %); realizable as S5 decides "
                   f"(the last trial): {'yes' if p['realizable'] else 'no'}; trials not realizable: "
                   f"{p['not_realizable_trials'] or 'none'}."]
+    if "rig" in nom:
+        lines += ["", _rig_lines(nom["rig"])]
     lines += [""] + [f"![{Path(n).stem}]({n})" for n in plots] + [""]
     return "\n".join(lines)
+
+
+def _rig_lines(rig: dict[str, Any]) -> str:
+    """The nonlinear rig's peaks (report.md)."""
+    rows = ["What the nonlinear rig shows (the loop's commands replayed on the rig: identical strokes, largest "
+            f"difference {rig['replay_stroke_difference_m']:.3g} m):", "",
+            "| actuator | peak force [kN] | peak spool [-] (limit) | spool > 90 % of limit [% of samples] | "
+            "peak drive [V] | peak friction [N] |", "|---|---:|---:|---:|---:|---:|"]
+    for i, a in enumerate(rig["actuators"], start=1):
+        rows.append(f"| {i} | {a['peak_force_N'] / 1e3:.2f} | {a['peak_spool']:.3f} ({a['spool_limit']:g}) | "
+                    f"{100 * a['spool_above_90pct_share']:.2f} | {a['peak_drive_V']:.3f} | "
+                    f"{a['peak_friction_N']:.1f} |")
+    rows += ["", f"Force difference F1 - F2: peak {rig['peak_force_difference_N'] / 1e3:.2f} kN, rms "
+             f"{rig['rms_force_difference_N'] / 1e3:.2f} kN; peak opposing force (cancelling in the x resultant) "
+             f"{rig['peak_opposing_force_N'] / 1e3:.2f} kN.",
+             "Rig warnings: " + ("; ".join(rig["warnings"]) if rig["warnings"] else "none") + "."]
+    return "\n".join(rows)
 

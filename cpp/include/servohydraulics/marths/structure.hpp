@@ -123,6 +123,28 @@ struct PhysicalFrame {
   static PhysicalFrame from(const PhysicalFrameParameters& p);
 };
 
+//! Modal damping with the ratio zeta on every mode of (K, M) (symmetric; M positive definite):
+//! C = sum_i M (2 zeta w_i phi_i phi_i^T / (phi_i^T M phi_i)) M, w_i the natural frequencies rounded to 0.01 rad/s
+//! (physicalFrame_feedbackForce.m; the scaling of phi_i cancels).  omegas (K.rows() values, or nullptr) gets the
+//! rounded w_i, ascending [rad/s].  Throws Error naming `field` when K is not positive definite.
+Eigen::MatrixXd modal_damping(const Eigen::MatrixXd& M, const Eigen::MatrixXd& K, double zeta, const char* field,
+                              double* omegas = nullptr);
+
+//! How the physical frame is condensed to the interface node's (x, theta) (CondensedFrame).
+enum class FrameReduction {
+  Guyan,   //!< T^T K5 T, T^T M5 T, T^T C5 T with T = [I; G]: consistent, the slaves' inertia follows the node
+  Static,  //!< the scripts' simplified 2-DOF model: the same stiffness, M = diag(M1x, M12z), its own modal damping
+};
+
+//! The physical frame condensed to the node's q = (x [m], theta [rad]): the specimen of the nonlinear
+//! multi-actuator rig (multi_rig.hpp) on the benchmark's frame.  The stiffness is the benchmark's condensed
+//! one, K5tt + K5to G, in both reductions.  Static: M = diag(M1x, M12z) without mass_factor (K_phys_2dof,
+//! M_phys_2dof of the scripts) and modal_damping(M, K, zeta).
+struct CondensedFrame {
+  Eigen::Matrix2d M, C, K;  //!< [[kg, kg m], [kg m, kg m^2]], [[N s/m, N s], [N s, N m s]], [[N/m, N], [N, N m]]
+  static CondensedFrame from(const PhysicalFrameParameters& p = {}, FrameReduction reduction = FrameReduction::Guyan);
+};
+
 //! Section 6's feedback: q = [x, theta, G [x; theta]], D1 = (q_k - q_{k-1})/dt, D2 = (D1_k - D1_{k-1})/dt
 //! (Simulink Derivative blocks: 0 at k = 0), f = K q + C D1 + M D2.
 class FrameFeedback {
