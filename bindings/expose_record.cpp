@@ -25,7 +25,9 @@ void expose_record(py::module_& m) {
       .def_readonly("failure_time", &RunSummary::failure_time)
       .def_readonly("first_capacity_time", &RunSummary::first_capacity_time)
       .def_readonly("stiff_samples", &RunSummary::stiff_samples)
-      .def_readonly("inaccurate_samples", &RunSummary::inaccurate_samples);
+      .def_readonly("inaccurate_samples", &RunSummary::inaccurate_samples)
+      .def_readonly("error_estimate", &RunSummary::error_estimate)
+      .def_readonly("max_sample_error_estimate", &RunSummary::max_sample_error_estimate);
 
   m.def(
       "run_record",

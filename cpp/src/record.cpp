@@ -16,6 +16,9 @@ bool RunSummary::count(const Status& st, double t) noexcept {
   if (st.internal_steps > max_internal_steps) max_internal_steps = st.internal_steps;
   stiff_samples += st.stiff ? 1 : 0;
   inaccurate_samples += st.inaccurate ? 1 : 0;
+  if (!std::isnan(max_sample_error_estimate) && !(st.error_estimate <= max_sample_error_estimate))
+    max_sample_error_estimate = st.error_estimate;  // a NaN estimate sticks
+  error_estimate = st.run_error_estimate;
   if (!st.ok()) {
     status = st;
     failure_time = t;

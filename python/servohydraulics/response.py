@@ -129,23 +129,39 @@ def _first_time(time: np.ndarray, flags: np.ndarray, bit: int) -> float:
     return float(time[np.argmax((flags & bit) > 0)])
 
 
-def solver_warnings(work: Any) -> list[str]:
-    """Notes on how the integrator coped: samples flagged as inaccurate (by the real-time option's
-    (RK4) error estimate, or the default's check of its stiff samples), samples the default pair
-    found stiff (CVODE took them)."""
-    out = []
-    n_bad = getattr(work, "inaccurate_samples", 0) if work is not None else 0
-    n_stiff = getattr(work, "stiff_samples", 0) if work is not None else 0
-    if n_bad and n_stiff:
-        out.append(f"{n_bad} stiff sample(s) flagged inaccurate: a looser run departs from the result by more "
-                   "than the default's 1e-3 of the peak displacement or force allows (a high-gain loop that "
-                   "amplifies the integration error); use a smaller rtol")
-    elif n_bad:
-        out.append(f"{n_bad} sample(s) flagged inaccurate by the RK4 error estimate: use the default "
-                   "method (dopri5), more rk4_substeps or rk4_max_refinements")
+def solver_notes(work: Any) -> list[tuple[str, str]]:
+    """(code, note) of how the integrator coped: ``run_accuracy`` for a run whose accuracy check
+    says it probably misses the method's stated accuracy (``work.error_estimate`` > 1: the
+    real-time option's (RK4) companion at twice the substeps, or the default's check of a run that
+    turned stiff, a second run at rtol / 10; measured against the run's peak displacement and
+    force), ``run_solver`` for the samples the default pair found stiff (CVODE took them)."""
+    out: list[tuple[str, str]] = []
+    if work is None:
+        return out
+    est = getattr(work, "error_estimate", 0.0)
+    n_bad = getattr(work, "inaccurate_samples", 0)
+    n_stiff = getattr(work, "stiff_samples", 0)
+    if not est <= 1.0:  # NaN too: the check itself went non-finite
+        where = f"; {n_bad} sample(s) flagged" if n_bad else ""
+        if n_stiff:
+            out.append(("run_accuracy",
+                        f"the run turned stiff and its check (a second run at rtol / 10) departs from it by "
+                        f"{est:.3g}x the bound: it may miss the default's stated 1e-3 of the peak displacement or "
+                        f"force (a high-gain or supply-limited loop that amplifies the integration error{where}); "
+                        "use a smaller rtol"))
+        else:
+            out.append(("run_accuracy",
+                        f"a run at twice the RK4 substeps departs from this one by {est:.3g}x rk4_flag_rtol of "
+                        f"the peak displacement or force: it probably misses RK4's stated 1e-2{where}; use the "
+                        "default method (dopri5), more rk4_substeps or rk4_max_refinements"))
     if n_stiff:
-        out.append(f"{n_stiff} sample(s) were stiff for the explicit pair and integrated by CVODE")
+        out.append(("run_solver", f"{n_stiff} sample(s) were stiff for the explicit pair and integrated by CVODE"))
     return out
+
+
+def solver_warnings(work: Any) -> list[str]:
+    """The notes of :func:`solver_notes`."""
+    return [text for _, text in solver_notes(work)]
 
 
 def limit_notes(flags: np.ndarray, time: np.ndarray, peak_force: float, rig: Rig | None = None
@@ -182,6 +198,8 @@ def limit_warnings(flags: np.ndarray, time: np.ndarray, peak_force: float, rig: 
     """Notes on the physical limits a run hit, from its per-row OutputFlag bits
     (``rig`` adds the limit values): the notes of :func:`limit_notes`."""
     return [note for _, note, _ in limit_notes(flags, time, peak_force, rig)]
+
+
 def mr_law_warnings(rig: Rig | None) -> list[str]:
     """A note when the rig's MR damper runs at a field input outside the range its law was
     identified on (``mr_law_min`` ... ``mr_law_max``): the run extrapolates the law."""
@@ -347,15 +365,15 @@ class Response:
 
     def notes(self, rig: Rig | None = None) -> list[tuple[str, str]]:
         """(code, note) of every warning (:meth:`warnings`): the limits the run hit
-        (``limit_notes``' codes), ``run_solver`` for the integrator's notes and ``run_failed``
-        for a failure."""
+        (``limit_notes``' codes), ``run_mr_law``, ``run_accuracy`` and ``run_solver`` for the
+        integrator's notes (:func:`solver_notes`) and ``run_failed`` for a failure."""
         rig = self.rig if rig is None else rig
         peak = getattr(self.work, "peak_force", None)
         if peak is None:
             peak = float(np.max(np.abs(self.channels.get("force", np.zeros(0))), initial=0.0))
         out = [(code, text) for code, text, _ in limit_notes(self.flags, self.time, peak, rig)]
         out += [("run_mr_law", text) for text in mr_law_warnings(rig)]
-        out += [("run_solver", text) for text in solver_warnings(self.work)]
+        out += solver_notes(self.work)
         if not self.success:
             out.append(("run_failed", self.message))
         return out
@@ -422,4 +440,4 @@ def finish(res: Response, raise_on_failure: bool) -> Response:
 
 
 __all__ = ["Channels", "Response", "Work", "SimulationError", "channel_units", "limit_notes", "limit_warnings",
-           "solver_warnings", "uniform_dt"]
+           "solver_notes", "solver_warnings", "uniform_dt"]

@@ -38,8 +38,9 @@ def solver_options(method: str = DEFAULT_METHOD, rtol: float | None = None, rest
     ``method``: ``"dopri5"`` (default: Dormand-Prince 5(4) with error control at ``rtol``, a sample
     where it turns stiff is redone by CVODE, or reported as status ``stiff`` if ``stiff_fallback`` is
     False), ``"rk4"`` (the real-time option: fixed cost, ``rk4_substeps`` per sample or automatic,
-    samples flagged by its error estimate at ``rk4_flag_rtol``, redone with doubled substeps up to
-    ``rk4_max_refinements`` times), ``"cvode"`` (BDF, the reference), ``"arkode_erk"``,
+    checked by a companion run at twice the substeps that flags where the two differ by more than
+    ``rk4_flag_rtol`` of the peaks (0: no check), the rest of the run at doubled substeps from a
+    flagged sample up to ``rk4_max_refinements`` times), ``"cvode"`` (BDF, the reference), ``"arkode_erk"``,
     ``"arkode_dirk"`` (SUNDIALS ARKODE references).  Absolute tolerances scale with the rig:
     ``rtol * atol_fraction * state_scale`` (``_core.absolute_tolerances``).  A keyword left at None
     keeps the core's default."""
@@ -156,8 +157,10 @@ def simulate(rig: Rig, mode: str = "displacement", command: ArrayLike | None = N
     Returns:
         A :class:`~servohydraulics.response.Response` of kind ``"plant"``: the
         plant's channels, ``command``, ``flags``, ``internal_steps``, ``rhs_evals``;
-        ``work.stiff_samples`` and ``work.inaccurate_samples`` count the samples CVODE took
-        over and the RK4 samples its error estimate flagged (also in ``warnings()``).
+        ``work.stiff_samples`` counts the samples CVODE took over; ``work.error_estimate`` is
+        the run's accuracy check over its bound (> 1: the run probably misses the method's stated
+        accuracy, also in ``warnings()``: RK4's companion at twice the substeps, or the default's
+        check of a run that turned stiff), ``work.inaccurate_samples`` the samples it flagged.
     """
     dt = _check_dt(dt)
     u = _command_array(command, duration, dt)

@@ -228,6 +228,55 @@ def test_warnings_name_the_actuator():
     assert not any(x.startswith("actuator1: servovalve drive") for x in w)
 
 
+def _multi_error(res, ref) -> float:
+    """The largest error of any actuator's stroke or load-cell force, relative to its peak in ref."""
+    err = 0.0
+    for i in range(1, ref.actuators + 1):
+        for ch in ("stroke", "force"):
+            r, x = ref[f"actuator{i}.{ch}"], res[f"actuator{i}.{ch}"]
+            err = max(err, float(np.max(np.abs(x - r)) / np.max(np.abs(r))))
+    return err
+
+
+def test_accuracy_checks_measure_the_coupled_runs_error():
+    """The integrators' accuracy checks on the coupled rig (output_gap.hpp over every actuator's
+    stroke and force; work.error_estimate is the run's gap over the check's bound): against CVODE
+    at rtol 1e-10, the gap is the run's own error.  The default's check of a run that turned stiff
+    (a second dopri5 at rtol / 10, bound 0.5 x 1e-3) and RK4's companion at twice the substeps
+    (bound rk4_flag_rtol) each measure it within a factor 3; RK4 past its bound flags and warns,
+    at its automatic substeps it is silent."""
+    # Sharp friction on light pistons: the pair turns stiff and CVODE takes samples.
+    a = sh.zhao2003()
+    a.F_c, a.m_p = 400.0, 5.0
+    sp = node_specimen(M=[[8.0, 0.0], [0.0, 0.8]], K=[[2.3e6, 8.6e5], [8.6e5, 1.1e6]], C=[[500.0, 0.0], [0.0, 20.0]])
+    rig = MultiActuatorRig([a, a], [MARTHS_ARM] * 2, MARTHS_ANGLES, sp)
+    k = np.arange(600)
+    u = np.c_[0.005 * np.sin(2 * np.pi * 2 * k / 1024), 0.004 * np.sin(2 * np.pi * 3 * k / 1024)]
+    ref = sh.simulate_multi(rig, u, 1 / 1024, options=sh.solver_options("cvode", rtol=1e-10,
+                                                                        max_steps_per_sample=1000000))
+    for rtol in (1e-5, 1e-4):
+        res = sh.simulate_multi(rig, u, 1 / 1024, options=sh.solver_options(rtol=rtol))
+        assert res.work.stiff_samples > 0
+        assert 1 / 3 <= res.work.error_estimate * 0.5e-3 / _multi_error(res, ref) <= 3, rtol
+    # RK4 on two rigs of different gains, a square wave on one, a coarse loop sample.
+    a = sh.zhao2003()
+    b = sh.copy_rig(a)
+    b.G_p = 1.5 * a.G_p
+    rig, dt = _two(a, b), 1 / 256
+    t = np.arange(256) * dt
+    u = np.c_[0.01 * np.sin(2 * np.pi * 3 * t), 0.008 * np.sign(np.sin(2 * np.pi * 2 * t))]
+    ref = sh.simulate_multi(rig, u, dt, options=sh.solver_options("cvode", rtol=1e-10, max_steps_per_sample=100000))
+    for n in (2, 3):
+        res = sh.simulate_multi(rig, u, dt, options=sh.solver_options("rk4", rk4_substeps=n, rk4_flag_rtol=2e-3))
+        err = _multi_error(res, ref)
+        assert 1 / 3 <= res.work.error_estimate * 2e-3 / err <= 3, n
+        assert (res.work.error_estimate > 1) == (err > 2e-3), n  # errors 3.9e-3 and 1.4e-3 of the peaks
+        assert any("twice the RK4 substeps" in w for w in res.warnings()) == (err > 2e-3), n
+    auto = sh.simulate_multi(rig, u, dt, options=sh.solver_options("rk4"))
+    assert _multi_error(auto, ref) <= 1e-4
+    assert auto.work.error_estimate <= 1 and not any("twice the RK4 substeps" in w for w in auto.warnings())
+
+
 @pytest.mark.parametrize("text, needle", [
     ('[fixture]\narms = [0.3]\nangles = [0.1]\n[specimen]\nM = 5.0\n[[actuators]]\n', "specimen.M shape"),
     ('[fixture]\narms = [0.3, 0.3]\nangles = [0.1, -0.1]\n[specimen]\nM = [[5, 0], [0, 1]]\n'

@@ -45,7 +45,15 @@ struct RunSummary {
   long restarts = 0;              //!< CVodeReInit calls in the run
   int max_internal_steps = 0;     //!< the largest number in one sample
   long stiff_samples = 0;         //!< samples the default pair found stiff and CVODE integrated (Status::stiff)
-  long inaccurate_samples = 0;    //!< samples flagged Status::inaccurate (Rk4's estimate, dopri5's stiff-sample check)
+  long inaccurate_samples = 0;    //!< samples flagged Status::inaccurate (Rk4's companion, dopri5's stiff-run check)
+  //! The run's accuracy check (Status::run_error_estimate of its last sample): the largest gap
+  //! between the result and the method's check (Rk4's companion, dopri5's shadow of a run that
+  //! turned stiff) relative to the run's peak displacement and force, over the check's bound.
+  //! > 1 (or NaN): the run probably misses the method's stated accuracy; 0: nothing was checked.
+  //! The gap scales with it, so a bound b' flags the run iff this x the configured bound > b'.
+  double error_estimate = 0.0;
+  //! The largest Status::error_estimate of a sample (> 1: a sample was flagged; a NaN sticks).
+  double max_sample_error_estimate = 0.0;
   std::uint32_t flags_any = 0;    //!< OR of every row's OutputFlag bits
   //! max |force| [N]: the load cell (run_record, EFT, RPsD), the actuator force Force_act (RTHS)
   double peak_force = 0.0;

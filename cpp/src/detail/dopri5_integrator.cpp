@@ -24,25 +24,25 @@ constexpr double kSafety = 0.9, kShrink = 0.2, kGrow = 5.0;
 
 template <class System>
 BasicDopri5Integrator<System>::BasicDopri5Integrator(const System& sys, double dt, const SolverOptions& opt,
-                                                     const State& y_prime)
+                                                     const State& y_prime, bool checked)
     : n_(Sys::size(sys)),
       rtol_(opt.rtol),
       max_steps_(opt.max_steps_per_sample),
       stiff_steps_(opt.stiff_steps),
       dt_(dt),
+      gap_(sys),
       h_(dt) {
   Sys::tolerances(sys, opt, atol_);
   if (opt.stiff_fallback) {
     // Absolute tolerances 1e-2 of these cut the error on high-gain rigs ~7x but made one of 150
     // such rigs overrun max_steps_per_sample (10x the steps): the check below flags instead.
     implicit_ = std::make_unique<BasicCvodeIntegrator<System>>(sys, dt, opt, y_prime);
-    SolverOptions tight = opt;
-    tight.rtol = opt.rtol / kShadowTighten;  // the absolute tolerances follow rtol
-    shadow_ = std::make_unique<BasicCvodeIntegrator<System>>(sys, dt, tight, y_prime);
+    if (checked) {
+      SolverOptions tight = opt;
+      tight.rtol = opt.rtol / kShadowTighten;  // the absolute tolerances follow rtol
+      shadow_ = std::make_unique<BasicDopri5Integrator>(sys, dt, tight, y_prime, false);
+    }
   }
-  // A run that stays near rest is checked against a millionth of the rig's scales, not against zero.
-  checked_ = Sys::checked(sys);
-  Sys::checked_floors(sys, floor_);
 }
 
 template <class System>
@@ -52,47 +52,37 @@ void BasicDopri5Integrator<System>::reset(const State& y, double t) noexcept {
   h_ = dt_;
   hold_ = 0;
   shadow_live_ = false;
-  since_stiff_ = 0;
-  for (int j = 0; j < checked_; ++j) peak_[j] = 0.0;
+  gap_.reset();
   if (implicit_) implicit_->reset(y, t);
   if (shadow_) shadow_->reset(y, t);
 }
 
-template <class System>
-void BasicDopri5Integrator<System>::track_peaks(const System& sys, const Input& in, const State& y) noexcept {
-  double v[Sys::kMaxChecked];
-  Sys::checked_values(sys, y.data(), in, v);
-  for (int j = 0; j < checked_; ++j) peak_[j] = std::max(peak_[j], std::fabs(v[j]));
-}
-
 // The error of the result grows with its tolerance: the shadow, kShadowTighten times tighter, is
 // off by less, so the gap between the two measures the result's error (kShadowGap).  The shadow
-// follows the run from the state where the first stiff sample began, so that an error the loop
-// amplifies from sample to sample shows in the gap as it does in the result.
+// follows the run from the state where its first stiff sample began to its end, explicit samples
+// included: an error the loop amplifies from sample to sample, or one that a sharp event far from
+// the stiff stretches makes (a force reversal), shows in the gap as it does in the result.
 template <class System>
 void BasicDopri5Integrator<System>::verify(const System& sys, const Input& in, const State& y_start,
                                            double t_start, const State& y, double t_next, Status& st) noexcept {
   if (!shadow_live_) {
     shadow_y_ = y_start;
+    shadow_->reset(shadow_y_, t_start);
     shadow_live_ = true;
   }
-  shadow_->reset(shadow_y_, t_start);
   double ts = t_start;
   const Status s = shadow_->advance(sys, in, shadow_y_, ts, t_next);
   st.internal_steps += s.internal_steps;
   st.rhs_evals += s.rhs_evals;
-  if (!s.ok()) {  // the tighter run failed (too much work) where the result did not: restart next sample
-    shadow_live_ = false;
+  if (!s.ok()) {  // the tighter run failed (too much work) where the result did not: it restarts from the result
+    shadow_y_ = y;
+    shadow_->reset(shadow_y_, t_next);
+    gap_.track(sys, in, y);
+    st.run_error_estimate = gap_.run_gap() / (kShadowGap * kVerifyTolerance);
     return;
   }
-  double v[Sys::kMaxChecked], vs[Sys::kMaxChecked];
-  Sys::checked_values(sys, y.data(), in, v);
-  Sys::checked_values(sys, shadow_y_.data(), in, vs);
-  for (int j = 0; j < checked_; ++j) peak_[j] = std::max(peak_[j], std::fabs(v[j]));
-  // The largest gap, each relative to its value's peak so far (the first, then std::max over the others).
-  double gap = std::fabs(v[0] - vs[0]) / std::max(peak_[0], floor_[0]);
-  for (int j = 1; j < checked_; ++j) gap = std::max(gap, std::fabs(v[j] - vs[j]) / std::max(peak_[j], floor_[j]));
-  st.error_estimate = gap / (kShadowGap * kVerifyTolerance);
+  st.error_estimate = gap_.gap(sys, in, y, shadow_y_) / (kShadowGap * kVerifyTolerance);
+  st.run_error_estimate = gap_.run_gap() / (kShadowGap * kVerifyTolerance);
   st.inaccurate = !(st.error_estimate <= 1.0);
 }
 
@@ -168,12 +158,8 @@ typename BasicDopri5Integrator<System>::Outcome BasicDopri5Integrator<System>::e
 template <class System>
 Status BasicDopri5Integrator<System>::implicit_sample(const System& sys, const Input& in, State& y, double& t,
                                                       double t_next) noexcept {
-  const State y_start = y;
-  const double t_start = t;
   implicit_->reset(y, t);
   Status st = implicit_->advance(sys, in, y, t, t_next);
-  if (st.ok() && shadow_) verify(sys, in, y_start, t_start, y, t_next, st);
-  since_stiff_ = 0;
   ++restarts_;
   fsal_ = false;
   h_ = dt_;
@@ -186,12 +172,12 @@ template <class System>
 Status BasicDopri5Integrator<System>::advance(const System& sys, const Input& in, State& y, double& t,
                                               double t_next) noexcept {
   Status st;
+  const State y0 = y;
+  const double t0 = t;
   if (hold_ > 0 && implicit_) {
     --hold_;
     st = implicit_sample(sys, in, y, t, t_next);
   } else {
-    const State y0 = y;
-    const double t0 = t;
     const Outcome out = explicit_sample(sys, in, y, t, t_next, st);
     if (out != Outcome::Done) {
       y = y0;
@@ -207,12 +193,13 @@ Status BasicDopri5Integrator<System>::advance(const System& sys, const Input& in
         fsal_ = false;
         h_ = dt_;
       }
-    } else if (shadow_live_ && ++since_stiff_ <= kShadowFollow) {
-      verify(sys, in, y0, t0, y, t_next, st);  // the shadow still follows an error made in a stiff stretch
-    } else {
-      shadow_live_ = false;
-      if (shadow_) track_peaks(sys, in, y);
     }
+  }
+  if (shadow_ && st.ok()) {
+    if (shadow_live_ || st.stiff)
+      verify(sys, in, y0, t0, y, t_next, st);  // from the first stiff sample to the end of the run
+    else
+      gap_.track(sys, in, y);
   }
   steps_done_ += st.internal_steps;
   rhs_done_ += st.rhs_evals;

@@ -5,16 +5,18 @@
 // single actuator runs exactly the arithmetic it ran before (tests/cpp/dynamics_digest).
 //
 //   State, Input, kCapacity        the state vector (fixed capacity) and the held input of a sample
-//   kMaxChecked                    most values the dopri5 shadow compares (checked_values)
+//   kMaxChecked                    most values the checks compare (checked_values)
 //   kPrimeState                    where the CVODE priming step starts (for its error message)
 //   size(s)                        the active state count
 //   changed(a, b)                  the held input changed (a restart point for CVODE, FSAL)
 //   rhs(s, y, in, ydot)            the right-hand side
 //   jacobian(s, y, in, J)          df/dy into a dense column-major n x n array (SUNDIALS' layout)
 //   tolerances(s, options, atol)   the absolute tolerances (the rig-scaled ones)
-//   checked(s), checked_values(s, y, in, v), checked_floors(s, f)
-//                                  what the dopri5 shadow compares (the displacements and
-//                                  load-cell forces) and the least peaks it judges them against
+//   checked(s), checked_values(s, y, in, v), checked_scales(s, f)
+//                                  what the checks compare (output_gap.hpp: dopri5's shadow,
+//                                  RK4's companion; the displacements and load-cell forces) and
+//                                  their scales (a fraction of which is the least peak they are
+//                                  judged against)
 //   rk4_substeps(s, dt, options)   the automatic RK4 rule
 #pragma once
 
@@ -61,10 +63,11 @@ struct OdeSystem<Dynamics> {
     v[0] = o.displacement;
     v[1] = o.force;
   }
-  //! A millionth of the rig's scales: a run that stays near rest is not judged against zero.
-  static void checked_floors(const Dynamics& d, double* f) noexcept {
-    f[0] = 1e-6 * state_scale(d, kX);
-    f[1] = 1e-6 * state_scale(d, kP) * d.rig().A;
+  //! The rig's displacement and force scales (OutputGap's floor is a fraction of them: a run that
+  //! stays near rest is not judged against zero).
+  static void checked_scales(const Dynamics& d, double* f) noexcept {
+    f[0] = state_scale(d, kX);
+    f[1] = state_scale(d, kP) * d.rig().A;
   }
   static int rk4_substeps(const Dynamics& d, double dt, const SolverOptions& o) {
     return rk4_automatic_substeps(d, dt, o);
@@ -99,12 +102,12 @@ struct OdeSystem<MultiRig> {
       v[n + i] = o.actuator[static_cast<std::size_t>(i)].force;
     }
   }
-  static void checked_floors(const MultiRig& r, double* f) noexcept {
+  static void checked_scales(const MultiRig& r, double* f) noexcept {
     const int n = r.actuators();
     for (int i = 0; i < n; ++i) {
       const int p = r.offset(i);  // the actuator's load pressure
-      f[i] = 1e-6 * r.actuator(i).rig().stroke;
-      f[n + i] = 1e-6 * r.state_scale(p) * r.actuator(i).rig().A;
+      f[i] = r.actuator(i).rig().stroke;
+      f[n + i] = r.state_scale(p) * r.actuator(i).rig().A;
     }
   }
   static int rk4_substeps(const MultiRig& r, double dt, const SolverOptions& o) {

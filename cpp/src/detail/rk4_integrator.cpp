@@ -107,19 +107,15 @@ BasicRk4Integrator<System>::BasicRk4Integrator(const System& sys, double dt, con
     : n_(Sys::size(sys)),
       substeps_(opt.rk4_substeps > 0 ? opt.rk4_substeps : Sys::rk4_substeps(sys, dt, opt)),
       max_refinements_(opt.rk4_max_refinements),
-      rtol_(opt.rk4_flag_rtol) {
-  SolverOptions flag = opt;
-  flag.rtol = opt.rk4_flag_rtol;
-  Sys::tolerances(sys, flag, atol_);
-}
+      flag_rtol_(opt.rk4_flag_rtol),
+      gap_(sys) {}
 
 template <class System>
-double BasicRk4Integrator<System>::sweep(const System& sys, const Input& in, State& y, int n, double h) const
-    noexcept {
-  State k1, k2, k3, k4, tmp, err{};
-  const int m = n_;
-  Sys::rhs(sys, y.data(), in, k1.data());
+void BasicRk4Integrator<System>::sweep(const System& sys, const Input& in, State& y, int n, int m,
+                                       double h) noexcept {
+  State k1, k2, k3, k4, tmp;
   for (int s = 0; s < n; ++s) {
+    Sys::rhs(sys, y.data(), in, k1.data());
     for (int i = 0; i < m; ++i) tmp[i] = y[i] + 0.5 * h * k1[i];
     Sys::rhs(sys, tmp.data(), in, k2.data());
     for (int i = 0; i < m; ++i) tmp[i] = y[i] + 0.5 * h * k2[i];
@@ -127,49 +123,43 @@ double BasicRk4Integrator<System>::sweep(const System& sys, const Input& in, Sta
     for (int i = 0; i < m; ++i) tmp[i] = y[i] + h * k3[i];
     Sys::rhs(sys, tmp.data(), in, k4.data());
     for (int i = 0; i < m; ++i) y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-    Sys::rhs(sys, y.data(), in, k1.data());  // k5 of this substep, k1 of the next
-    for (int i = 0; i < m; ++i) err[i] += std::fabs(h / 6.0 * (k4[i] - k1[i]));
   }
-  double sum = 0.0;
-  for (int i = 0; i < m; ++i) {
-    const double q = err[i] / (atol_[i] + rtol_ * std::max(peak_[i], std::fabs(y[i])));
-    sum += q * q;
-  }
-  return std::sqrt(sum / m);  // NaN if the state blew up: flagged, and the plant's guard fails the sample
 }
 
 template <class System>
 void BasicRk4Integrator<System>::reset(const State& y0, double) noexcept {
   steps_done_ = rhs_done_ = flagged_ = 0;
-  for (int i = 0; i < n_; ++i) peak_[i] = 0.0;
-  track_peak(y0);
-}
-
-template <class System>
-void BasicRk4Integrator<System>::track_peak(const State& y) noexcept {
-  for (int i = 0; i < n_; ++i) peak_[i] = std::max(peak_[i], std::fabs(y[i]));
+  refined_ = 0;
+  companion_ = y0;
+  gap_.reset();
 }
 
 template <class System>
 Status BasicRk4Integrator<System>::advance(const System& sys, const Input& in, State& y, double& t,
                                            double t_next, int substeps) noexcept {
   Status st;
-  const State y0 = y;
-  int n = substeps > 0 ? substeps : substeps_;
-  track_peak(y0);
-  for (int r = 0;; ++r) {
-    st.error_estimate = sweep(sys, in, y, n, (t_next - t) / n);
-    st.internal_steps += n;
-    st.rhs_evals += 4 * n + 1;
-    // Flagged if the configured substeps missed the tolerance, refined or not: the local estimate
-    // does not bound the error carried into later samples, so a refined sample still says so.
-    if (r == 0) st.inaccurate = !(st.error_estimate <= 1.0);
-    if (st.error_estimate <= 1.0 || r >= max_refinements_ || 2L * n > SolverOptions::kMaxSubsteps) break;
-    y = y0;
-    n *= 2;
+  const int n = (substeps > 0 ? substeps : substeps_) << refined_;
+  const double h = (t_next - t) / n;
+  sweep(sys, in, y, n, n_, h);
+  st.internal_steps = n;
+  st.rhs_evals = 4 * n;
+  if (flag_rtol_ > 0.0) {
+    sweep(sys, in, companion_, 2 * n, n_, 0.5 * h);
+    st.internal_steps += 2 * n;
+    st.rhs_evals += 8 * n;
+    st.error_estimate = gap_.gap(sys, in, y, companion_) / flag_rtol_;
+    st.run_error_estimate = gap_.run_gap() / flag_rtol_;
+    st.inaccurate = !(st.error_estimate <= 1.0);
+    if (st.inaccurate) {
+      ++flagged_;
+      bool finite = true;
+      for (int i = 0; i < n_; ++i) finite = finite && std::isfinite(companion_[i]);
+      if (finite && refined_ < max_refinements_ && 2L * n <= SolverOptions::kMaxSubsteps) {
+        y = companion_;  // go on from the more accurate run, at twice the substeps
+        ++refined_;
+      }
+    }
   }
-  if (st.inaccurate) ++flagged_;
-  track_peak(y);
   t = t_next;
   steps_done_ += st.internal_steps;
   rhs_done_ += st.rhs_evals;

@@ -67,6 +67,8 @@ CODES: dict[str, tuple[str, str]] = {
     "run_spool": (WARNING, "the simulated run saturated the spool"),
     "run_drive": (WARNING, "the simulated run saturated the valve drive"),
     "run_mr_law": (WARNING, "the MR damper ran outside the field range its law was identified on"),
+    "run_accuracy": (WARNING, "the simulated run probably misses its integrator's stated accuracy (its check, a "
+                              "second run at a tighter tolerance or at twice the RK4 substeps, departs from it)"),
     "run_solver": (WARNING, "the integrator's notes on the simulated run"),
     "run_failed": (WARNING, "the simulated run failed"),
 }
