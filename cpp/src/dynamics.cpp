@@ -187,13 +187,13 @@ void Dynamics::structure(const double* y, const Input& in, Algebra& g) const noe
     laws.dF_dv += f.dF_dv;
     laws.dF_dz += f.dF_dz;
   });
+  if (specimen_on_) specimen<W>(y, g);
+  g.a = specimen_on_ ? (net - g.Fsp) / M_ : net / M_;
+  if constexpr (W == 0) return;  // the values alone (rhs)
   if (!specimen_on_) {
-    g.a = net / M_;
     g.da[kX] = -laws.dF_dx / M_;
     g.da[kV] = -laws.dF_dv / M_;
   } else {
-    specimen<W>(y, g);
-    g.a = (net - g.Fsp) / M_;
     for (int j = 0; j < W; ++j) g.da[j] = -g.dFsp[j] / M_;
     g.da[kX] = -(laws.dF_dx + g.dFsp[kX]) / M_;
     g.da[kV] = -(laws.dF_dv + g.dFsp[kV]) / M_;
@@ -213,13 +213,15 @@ bool Dynamics::servo_controller(const double* y, const Input& in, Algebra& g) co
   std::fill(draw, draw + W, 0.0);
   if (mode_ == ControlMode::Displacement) {
     raw = CF_ * (r.G_p * (in.u - y[kX]) + r.G_d * (in.u_rate - y[kV]));
-    draw[kX] = -CF_ * r.G_p;
-    draw[kV] = -CF_ * r.G_d;
-    draw[ku_] = CF_ * r.G_p;
+    if constexpr (W > 0) {
+      draw[kX] = -CF_ * r.G_p;
+      draw[kV] = -CF_ * r.G_d;
+      draw[ku_] = CF_ * r.G_p;
+    }
   } else {
     raw = CF_ * r.G_p * (in.u - g.F);
     for (int j = 0; j < W; ++j) draw[j] = -CF_ * r.G_p * g.dF[j];
-    draw[ku_] += CF_ * r.G_p;
+    if constexpr (W > 0) draw[ku_] += CF_ * r.G_p;
   }
   g.drive_sat = r.effects.drive_saturation && std::fabs(raw) >= r.v_max;
   g.drive = g.drive_sat ? std::copysign(r.v_max, raw) : raw;
@@ -239,12 +241,14 @@ void Dynamics::valve(const double* y, double vdrive, const double* dvdrive, Alge
   std::fill(dxv, dxv + W, 0.0);
   if (r.effects.servovalve_dynamics) {
     xv = y[kXv];
-    dxv[kXv] = 1.0;
     const double w2 = wv_ * wv_;
     g.xvdd = w2 * (r.K_s * vdrive - y[kXv]) - 2.0 * r.zeta_v * wv_ * y[kXvDot];
-    for (int j = 0; j < W; ++j) g.dxvdd[j] = w2 * r.K_s * dvdrive[j];
-    g.dxvdd[kXv] -= w2;
-    g.dxvdd[kXvDot] -= 2.0 * r.zeta_v * wv_;
+    if constexpr (W > 0) {
+      dxv[kXv] = 1.0;
+      for (int j = 0; j < W; ++j) g.dxvdd[j] = w2 * r.K_s * dvdrive[j];
+      g.dxvdd[kXv] -= w2;
+      g.dxvdd[kXvDot] -= 2.0 * r.zeta_v * wv_;
+    }
   } else {
     xv = r.K_s * vdrive;
     for (int j = 0; j < W; ++j) dxv[j] = r.K_s * dvdrive[j];
@@ -256,12 +260,12 @@ void Dynamics::valve(const double* y, double vdrive, const double* dvdrive, Alge
   // Valve flow, Eq (3).
   const double gs = flow_gain(g.s), R = pressure_factor(g.s, p);
   g.Q = r.K_v * gs * R;
+  // Actuator continuity, Eq (4): K_a p' = Q - C_l p - A x'.
+  g.pdot = (g.Q - r.C_l * p - r.A * v) / r.K_a;
+  if constexpr (W == 0) return;  // the values alone (rhs)
   const double dQds = r.K_v * flow_gain_slope(g.s) * R;
   for (int j = 0; j < W; ++j) g.dQ[j] = dQds * g.ds[j];
   g.dQ[kP] += r.K_v * gs * pressure_factor_dp(g.s, p);
-
-  // Actuator continuity, Eq (4): K_a p' = Q - C_l p - A x'.
-  g.pdot = (g.Q - r.C_l * p - r.A * v) / r.K_a;
   for (int j = 0; j < W; ++j) g.dpdot[j] = g.dQ[j] / r.K_a;
   g.dpdot[kP] -= r.C_l / r.K_a;
   g.dpdot[kV] -= r.A / r.K_a;
@@ -272,14 +276,16 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
   g.zero<W>();
   structure<W>(y, in, g);
   if (mode_ == ControlMode::Free) {
-    g.dF[ku_] = 1.0;
+    if constexpr (W > 0) g.dF[ku_] = 1.0;
     g.F = in.u;
     return;
   }
   // Load cell between piston and structure: F = pA - m_p a.
   g.F = y[kP] * rig_.A - mp_ * g.a;
-  for (int j = 0; j < W; ++j) g.dF[j] = -mp_ * g.da[j];
-  g.dF[kP] += rig_.A;
+  if constexpr (W > 0) {
+    for (int j = 0; j < W; ++j) g.dF[j] = -mp_ * g.da[j];
+    g.dF[kP] += rig_.A;
+  }
   const bool delayed = servo_controller<W>(y, in, g);
   valve<W>(y, delayed ? g.vdrive : g.drive, delayed ? g.dvdrive : g.ddrive, g);
 }
@@ -334,7 +340,7 @@ LawForce Dynamics::actuator(const double* y, const Input& in, Algebra& g) const 
 
 void Dynamics::rhs(const double* y, const Input& in, double* ydot) const noexcept {
   Algebra g;
-  evaluate_any(y, in, g);
+  evaluate<0>(y, in, g);  // the values alone: no gradient (the same values as every width computes)
   ydot[kX] = y[kV];
   ydot[kV] = g.a;
   actuator_rates(y, g, ydot);

@@ -108,17 +108,18 @@ void MrDamper::eval(const double* y, int iy, Algebra& g) const noexcept {
   double* dz = g.drate[iz];
   std::fill(dy, dy + W, 0.0);
   const double ydot = (alpha * y[iz] + c0 * v + k0 * (x - y[iy])) / cs;
+  const detail::Hysteretic h = detail::hysteretic_rate(v - ydot, y[iz], A, gamma, beta, n);
+  g.rate[iy] = ydot;
+  g.rate[iz] = h.f;
+  g.Fsp += c1 * ydot + k1 * (x - x0);
+  if constexpr (W == 0) return;  // the values alone (rhs)
   dy[kX] = k0 / cs;
   dy[kV] = c0 / cs;
   dy[iy] = -k0 / cs;
   dy[iz] = alpha / cs;
-  const detail::Hysteretic h = detail::hysteretic_rate(v - ydot, y[iz], A, gamma, beta, n);
-  g.rate[iy] = ydot;
-  g.rate[iz] = h.f;
   for (int j = 0; j < W; ++j) dz[j] = -h.df_dw * dy[j];
   dz[kV] += h.df_dw;
   dz[iz] += h.df_dz;
-  g.Fsp += c1 * ydot + k1 * (x - x0);
   for (int j = 0; j < W; ++j) g.dFsp[j] += c1 * dy[j];
   g.dFsp[kX] += k1;
 }
