@@ -492,8 +492,7 @@ void Dynamics::specimen_forces(const double* x, const double* v, std::size_t n, 
     at[kX] = xt;
     at[kV] = vt;
     Algebra g;
-    g.zero<kCap>();
-    specimen<kCap>(at.data(), g);
+    specimen<0>(at.data(), g);  // the values alone
     for (int i = 0; i < m; ++i) r[i] = g.rate[idx[i]];
     return g.Fsp;
   };

@@ -42,6 +42,7 @@ from .fit import (
     StageResult,
     best,
     channel_weights,
+    default_workers,
     fit_frequency,
     fit_options,
     fit_time,
@@ -62,6 +63,7 @@ from .law import (
     with_fields,
 )
 from .run import check_record, controller_ratio, simulate_record
+from .segments import AGREEMENT, Target
 from .stats import LEVEL, ar1_coefficient, ar1_effective_n, covariance, quantile
 
 MAX_CORRELATION = 0.95  #: |corr| above which two keys are reported as not separable
@@ -97,6 +99,8 @@ class Identification:
     checks: list = field(default_factory=list)  #: ``checks.Check``: the records' plausibility, the runs' limits
     field_input: FieldInput | None = None  #: the MR damper's field per record (``currents=``/``voltages=``)
     law: str | None = None  #: the MR damper's field law fitted across the records (``law.py``)
+    #: segments per record of the time stage's runs (``segments.Target``; 1: whole runs)
+    segments: list = field(default_factory=list)
 
     def to_dict(self) -> dict[str, Any]:
         units = _units()
@@ -109,7 +113,7 @@ class Identification:
             "correlation": {"keys": list(self.keys), "matrix": np.round(self.correlation, 4).tolist()},
             "derived": derived(self.rig, self.mode), "flags": self.flags, "channel_weights": self.weights,
             "integrator": self.integrator, "n_eff": self.n_eff, "rho1": self.rho1, "nfev": self.nfev,
-            "runtime_s": self.runtime_s, "costs": self.costs, "kept": self.kept,
+            "runtime_s": self.runtime_s, "segments": self.segments, "costs": self.costs, "kept": self.kept,
             "checks": [c.to_dict() for c in self.checks],
             "field": None if self.field_input is None else {**self.field_input.to_dict(), "law": self.law},
             "records": [{"record": b.name, "before": {c: b.channels[c]["nrmse_pct"] for c in b.channels},
@@ -245,28 +249,44 @@ def time_blocks(keys: tuple[str, ...], channels: tuple[str, ...], mode: str) -> 
     return [(np.ones(len(keys), dtype=bool), channels)]
 
 
-#: block sweeps of the time stage at most, and the move (in the fitting coordinates) below which
-#: a sweep has converged: the loop keys fitted on the displacement with a wrong specimen
-#: compensate for its force (the load does change the tracking), so the blocks are swept again
-#: with the specimen's new keys until neither moves (block coordinate descent)
-MAX_SWEEPS, SWEEP_TOL = 4, 2e-3
+#: block sweeps of the time stage at most.  A block fit has moved when a key moved by more than
+#: SWEEP_TOL in its fitting coordinate and by more than SWEEP_SD of its standard error (the block
+#: fit's HAC covariance, the other blocks held): the loop keys fitted on the displacement with a
+#: wrong specimen compensate for its force (the load does change the tracking), so the blocks are
+#: swept again with the specimen's new keys until none moves (block coordinate descent); a move
+#: below the records' resolution calls for no further sweep (a key the records do not determine,
+#: such as a damper's beta collapsing towards 0, wanders by units of log without changing the fit)
+MAX_SWEEPS, SWEEP_TOL, SWEEP_SD = 4, 2e-3, 0.1
 
 
-def _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar, workers):
-    """Stage 2 block by block (:func:`time_blocks`), the blocks swept until the keys stop moving
-    (``MAX_SWEEPS``, ``SWEEP_TOL``); returns the stage's z and its evaluations."""
+def _moved(s: StageResult, z_before: np.ndarray, active: np.ndarray, lengths: list[int]) -> bool:
+    """Whether a block fit moved a key beyond ``SWEEP_TOL`` and ``SWEEP_SD`` of its standard error."""
+    dz = np.abs(s.z - z_before)[active]
+    sd = covariance(s.jac, s.fun, None, lengths).sd if s.jac is not None else np.zeros(dz.size)
+    sd = np.where(np.isfinite(sd), sd, np.inf)  # a key the records do not determine: no move counts
+    return bool(np.any((dz > SWEEP_TOL) & (dz > SWEEP_SD * sd)))
+
+
+def _time_stage(target: Target, start, coords, z1, mode, chans, max_nfev, bar):
+    """Stage 2 block by block (:func:`time_blocks`) on ``target``'s runs, the blocks swept until
+    the last fits of all but one block did not move (``_moved``; the block fitted before them is
+    then at its optimum for the others' values) or ``MAX_SWEEPS``; returns the stage's z and its
+    evaluations."""
     z = np.array(z1, dtype=float)
-    nfev = 0
     blocks = time_blocks(coords.keys, chans, mode)
-    for _ in range(MAX_SWEEPS if len(blocks) > 1 else 1):
-        z_sweep = z.copy()
-        for active, block_chans in blocks:
-            w = channel_weights(coords.apply(start, z), recs, mode, block_chans, options, dt) \
-                if len(blocks) == 1 else None
-            s = fit_time(recs, start, coords, z, mode, block_chans, options, dt, max_nfev, bar, w, active, workers)
+    if len(blocks) == 1:
+        active, block_chans = blocks[0]
+        w = channel_weights(target, coords.apply(start, z), block_chans)
+        s = fit_time(target, start, coords, z, block_chans, max_nfev, bar, w, active)
+        return s.z, s.nfev
+    nfev, quiet = 0, 0
+    for sweep in range(MAX_SWEEPS):
+        for b, (active, block_chans) in enumerate(blocks):
+            s = fit_time(target, start, coords, z, block_chans, max_nfev, bar, None, active)
+            quiet = 0 if _moved(s, z, active, target.lengths_of(block_chans)) else quiet + 1
             z, nfev = s.z, nfev + s.nfev
-        if np.max(np.abs(z - z_sweep)) < SWEEP_TOL:
-            break
+            if (sweep > 0 or b == len(blocks) - 1) and quiet >= len(blocks) - 1:
+                return z, nfev
     return z, nfev
 
 
@@ -326,19 +346,51 @@ def _setup(records, rig, fit, mode: str, specimen: str | None, channels, dt: flo
     return recs, start, generic, keys, chans, extra
 
 
-def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options, dt, max_nfev, progress, workers):
+def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options, dt, max_nfev, progress, workers,
+                 before: list):
     """Stage 2 from stage 1's z1 (again from the start when that ends worse than the start), then
-    ``fit.keep_best`` of the start and the stages; returns keep_best's result and the evaluations."""
+    ``fit.keep_best`` of the start and the stages, on segmented runs (``segments.Target``, checked
+    against the whole runs ``before`` of the start and against those of the result; whole runs
+    where they disagree); returns keep_best's result, the evaluations, the whole runs of the result
+    and the segments per record."""
     from tqdm.auto import tqdm
 
+    workers = default_workers() if workers is None else max(1, int(workers))
+    targets = [Target.build(recs, mode, chans, options, dt, coords.apply(start, z1), workers)]
     with tqdm(desc="identify (simulations)", unit="sim", disable=not progress, leave=False) as bar:
-        stages = {"start": np.zeros(len(coords.keys)), "frequency": z1} if frequency_stage else {"start": z1}
-        stages["time"], nfev = _time_stage(recs, start, coords, z1, mode, chans, options, dt, max_nfev, bar, workers)
-        if frequency_stage and best(time_costs(recs, start, coords, stages, mode, chans, options, dt)) != "time":
-            stages["time"], n2 = _time_stage(recs, start, coords, stages["start"], mode, chans, options, dt,
-                                             max_nfev, bar, workers)
-            nfev += n2
-        return (*keep_best(recs, start, coords, stages, mode, chans, options, dt, bar, workers), nfev)
+        try:
+            target = targets[0]
+            if target.agrees(start, before) > AGREEMENT:
+                targets.append(target.whole_runs())
+                target = targets[-1]
+            stages = {"start": np.zeros(len(coords.keys)), "frequency": z1} if frequency_stage else {"start": z1}
+            stages["time"], nfev = _time_stage(target, start, coords, z1, mode, chans, max_nfev, bar)
+            if frequency_stage and best(time_costs(target, start, coords, stages)) != "time":
+                stages["time"], n = _time_stage(target, start, coords, stages["start"], mode, chans, max_nfev, bar)
+                nfev += n
+            kept = keep_best(target, start, coords, stages, bar)
+            after = _whole_runs(coords.apply(start, kept[3].z), recs, mode, dt, options, workers)
+            if target.agrees(coords.apply(start, kept[3].z), after) > AGREEMENT:  # polish on whole runs
+                targets.append(target.whole_runs())
+                target = targets[-1]
+                stages["time"], n = _time_stage(target, start, coords, kept[3].z, mode, chans, max_nfev, bar)
+                nfev += n
+                kept = keep_best(target, start, coords, stages, bar)
+                after = _whole_runs(coords.apply(start, kept[3].z), recs, mode, dt, options, workers)
+        finally:
+            for t in targets:
+                t.close()
+    return (*kept, nfev, after, [len(segs) for segs in target.segments])
+
+
+def _whole_runs(rig, recs, mode, dt, options, workers) -> list:
+    """``simulate_record`` of every record through the rig (whole runs), on ``workers`` threads."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    if workers <= 1 or len(recs) <= 1:
+        return [simulate_record(rig, r, mode, dt=dt, options=options) for r in recs]
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        return list(pool.map(lambda r: simulate_record(rig, r, mode, dt=dt, options=options), recs))
 
 
 def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | None = None,
@@ -392,8 +444,9 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         z1, nfev["frequency"], runtime["frequency"] = s1.z, s1.nfev, time.perf_counter() - t0
     options = fit_options(coords.apply(start, z1), recs, mode)
     t0 = time.perf_counter()
-    kept, costs, weights, final, nfev["time"] = _time_stages(recs, start, coords, z1, frequency_stage, mode, chans,
-                                                             options, dt, max_nfev, progress, workers)
+    before_runs = _whole_runs(start, recs, mode, dt, options, default_workers() if workers is None else workers)
+    kept, costs, weights, final, nfev["time"], after_runs, segments = _time_stages(
+        recs, start, coords, z1, frequency_stage, mode, chans, options, dt, max_nfev, progress, workers, before_runs)
     runtime["time"] = time.perf_counter() - t0
     lengths = [r.time.size for r in recs for _ in chans]
     u = uncertainty(final, coords, lengths)
@@ -401,10 +454,8 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
     s1_vals = coords.values(z1)
     out_rig = coords.apply(start, final.z)
     t0 = time.perf_counter()
-    before = [compare(r, start, mode, simulated=simulate_record(start, r, mode, dt=dt, options=options), check=False)
-              for r in recs]
-    after = [compare(r, out_rig, mode, simulated=simulate_record(out_rig, r, mode, dt=dt, options=options),
-                     accept=accept, check=False) for r in recs]
+    before = [compare(r, start, mode, simulated=sim, check=False) for r, sim in zip(recs, before_runs)]
+    after = [compare(r, out_rig, mode, simulated=sim, accept=accept, check=False) for r, sim in zip(recs, after_runs)]
     runtime["compare"] = time.perf_counter() - t0
     runtime["total"] = time.perf_counter() - t_start
     return Identification(
@@ -417,7 +468,7 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         before=before, after=after, generic_start=generic, weights=weights, integrator=options.method.name.lower(),
         n_eff=float(u["n_eff"]), rho1=float(u["rho1"]), nfev=nfev, runtime_s=runtime, status=u["status"],
         costs=costs, kept=kept, checks=found + [c for a in after for c in a.checks], field_input=extra["field"],
-        law=extra["law"])
+        law=extra["law"], segments=segments)
 
 
 __all__ = ["Comparison", "Identification", "as_records", "identify", "key_status", "separability_flags",

@@ -1,0 +1,308 @@
+"""How long identification and diagnosis of lab records take (issue 25, item 6), and where the time goes.
+
+    python benchmarks/lab_speed.py [--cases identify,diagnose10,diagnose10sim,sweep1A] [--json FILE]
+                                   [--profile] [--label NAME]
+
+The cases (records from ../shared/real-data/utfsm-mts-mrdamper, or $SH_SHARED_DIR/real-data/...):
+
+* ``identify``: ``servohydraulics identify chirp20Hz_0A.csv --mode displacement --specimen mr_damper
+  --out DIR`` (the UTFSM identification as docs/lab-records.md runs it, 61.5 s at 1 kHz), run
+  in-process through ``cli.main`` (the interpreter's start and ``import servohydraulics`` are not
+  counted: about 1 s on this machine), writing its report and plots.
+* ``diagnose10``: ``sh.diagnose`` of the first 10 s of ``chirp20Hz_1A`` (1 A) against the rig
+  identified at 0 A (``evaluation/utfsm_rig_0A.toml``), displacement control, every candidate.
+* ``diagnose10sim``: ``sh.diagnose`` of the diagnosis evaluation's 10 s, 2 kHz runtime record
+  (evaluation/diagnose_eval/generate.py: 300 N of hidden Coulomb friction, SNR 30 dB, made by the
+  independent simulator) against its nominal rig.
+* ``sweep1A``: ``sh.diagnose`` of the whole ``sweep15Hz_1A`` (51.9 s) against the 0 A rig.
+
+For each: the wall time, the load average before and after (the machine is shared), the process' CPU
+time (user + system over its threads: half of it bounds the wall time on an idle 2-core machine from
+below, and it moves little with the others' load), the number of
+simulations (calls into the core's record runs: plain runs and sensitivity runs apart), of Jacobian
+evaluations and of least-squares calls, iterations (Jacobian evaluations inside them) and residual
+evaluations, the time spent inside the core's runs (summed over threads), and what the run found
+(NRMSE of the identified rig; the diagnosis' verdict, effects and gaps) so that a speed-up that
+changes a result shows.  ``--profile`` adds cProfile's top functions (the main thread's) per case.
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import io
+import json
+import os
+import platform
+import pstats
+import sys
+import tempfile
+import threading
+import time
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = Path(os.environ.get("SH_SHARED_DIR", ROOT.parent / "shared")) / "real-data" / "utfsm-mts-mrdamper"
+CASES = ("identify", "diagnose10", "diagnose10sim", "sweep1A")
+#: the targets of issue 25, item 6 [s]
+TARGETS = {"identify": 10.0, "diagnose10": 15.0, "diagnose10sim": 15.0, "sweep1A": 60.0}
+
+
+class Counters:
+    """Counts (thread-safe) the core's record runs and the least-squares work while installed."""
+
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.reset()
+
+    def reset(self) -> None:
+        self.sims = 0
+        self.sim_seconds = 0.0
+        self.sens = 0
+        self.sens_seconds = 0.0
+        self.lsq_calls = 0
+        self.lsq_nfev = 0
+        self.lsq_njev = 0
+        self.jacobians_outside = 0
+        work = _jacobian_work()
+        self.work0 = (work.columns_sensitivity, work.columns_difference, len(work.reasons)) if work else (0, 0, 0)
+
+    def as_dict(self) -> dict:
+        out = {"simulations": self.sims, "simulation_s": self.sim_seconds, "sensitivity_runs": self.sens,
+               "sensitivity_s": self.sens_seconds, "least_squares_calls": self.lsq_calls,
+               "least_squares_iterations": self.lsq_njev, "least_squares_residuals": self.lsq_nfev,
+               "jacobian_evaluations": self.lsq_njev + self.jacobians_outside}
+        work = _jacobian_work()
+        if work is not None:
+            out["jacobian_columns_sensitivity"] = work.columns_sensitivity - self.work0[0]
+            out["jacobian_columns_differenced"] = work.columns_difference - self.work0[1]
+            out["differenced_because"] = sorted(set(work.reasons[self.work0[2]:]))
+        return out
+
+
+def _jacobian_work():
+    """The shared Jacobian's running totals (identification/jacobian.py), None before it existed."""
+    try:
+        from servohydraulics.identification.jacobian import WORK
+    except ImportError:
+        return None
+    return WORK
+
+
+def _timed(counter: Counters, fn, what: str):
+    def wrapper(*a, **k):
+        t0 = time.perf_counter()
+        try:
+            return fn(*a, **k)
+        finally:
+            dt = time.perf_counter() - t0
+            with counter.lock:
+                if what == "sim":
+                    counter.sims += 1
+                    counter.sim_seconds += dt
+                else:
+                    counter.sens += 1
+                    counter.sens_seconds += dt
+    return wrapper
+
+
+@contextmanager
+def instrumented(counter: Counters):
+    """Wraps the core's record runs and every ``least_squares`` the fits call."""
+    from servohydraulics import _core
+    from servohydraulics.diagnosis import engine
+    from servohydraulics.identification import fit
+
+    saved = []
+
+    def patch(obj, name, new):
+        saved.append((obj, name, getattr(obj, name)))
+        setattr(obj, name, new)
+
+    patch(_core, "run_record", _timed(counter, _core.run_record, "sim"))
+    if hasattr(_core, "run_record_sensitivities"):
+        patch(_core, "run_record_sensitivities", _timed(counter, _core.run_record_sensitivities, "sens"))
+
+    def counting(lsq):
+        def wrapper(*a, **k):
+            res = lsq(*a, **k)
+            with counter.lock:
+                counter.lsq_calls += 1
+                counter.lsq_nfev += int(res.nfev)
+                counter.lsq_njev += int(res.njev or 0)
+            return res
+        return wrapper
+
+    mods = {m for m in (fit, engine) if hasattr(m, "least_squares")}
+    for mod in sys.modules.values():  # any module of the package that imported least_squares by name
+        if getattr(mod, "__name__", "").startswith("servohydraulics") and hasattr(mod, "least_squares"):
+            mods.add(mod)
+    for mod in mods:
+        patch(mod, "least_squares", counting(mod.least_squares))
+    if hasattr(fit, "jacobian_at"):
+        inner = fit.jacobian_at
+
+        def jacobian_at(*a, **k):
+            with counter.lock:
+                counter.jacobians_outside += 1
+            return inner(*a, **k)
+        patch(fit, "jacobian_at", jacobian_at)
+    try:
+        yield counter
+    finally:
+        for obj, name, old in reversed(saved):
+            setattr(obj, name, old)
+
+
+def _record(name: str, end: float | None = None):
+    from servohydraulics.records import Record, read_record
+
+    path = DATA / f"{name}.csv"
+    if not path.exists():
+        raise SystemExit(f"record {path} is absent: the UTFSM data live in ../shared/real-data (its README); "
+                         "set SH_SHARED_DIR to the folder that holds real-data/")
+    rec = read_record(path)
+    if end is None:
+        return rec
+    n = int(round(end / rec.dt)) + 1
+    return Record({k: np.asarray(v)[:n] for k, v in rec.channels.items()})
+
+
+def _simulated_record():
+    """The diagnosis evaluation's 10 s runtime record and its nominal rig (made here, as generate.py does)."""
+    sys.path.insert(0, str(ROOT / "evaluation" / "diagnose_eval"))
+    import generate as gen
+
+    from servohydraulics.records import Record
+
+    items = gen.plan("default", "all")
+    item = {"kind": "single", "effects": [("coulomb", 300.0)], "mode": "displacement", "cmd": "std",
+            "snr": 30, "duration": 10.0, "runtime_check": True}
+    rec, man, key = gen.make_record((len(items), item, 2003, 4.0))
+    rig = gen.nominal_rig(man["mode"], key["rig"])
+    return Record(rec), rig, man["mode"], key
+
+
+def _diagnosis_summary(d) -> dict:
+    js = d.to_dict()
+    return {"verdict": js["verdict"], "effects": {e["name"]: {k: p["value"] for k, p in e["parameters"].items()}
+                                                  for e in js["effects"]},
+            "gap_before": js["gap_before"], "gap_after": js["gap_after"], "summary": js["summary"]}
+
+
+def run_case(case: str) -> dict:
+    import servohydraulics as sh
+    from servohydraulics import cli
+
+    if case == "identify":
+        with tempfile.TemporaryDirectory() as tmp:
+            argv = ["identify", str(DATA / "chirp20Hz_0A.csv"), "--mode", "displacement", "--specimen",
+                    "mr_damper", "--out", tmp, "--quiet"]
+            t0 = time.perf_counter()
+            with _quiet():
+                code = cli.main(argv)
+            wall = time.perf_counter() - t0
+            if code != 0:
+                raise SystemExit(f"identify exited {code}")
+            js = json.loads((Path(tmp) / "identification.json").read_text())
+        return {"wall_s": wall, "result": {"values": {k: p["value"] for k, p in js["parameters"].items()},
+                                           "nrmse_after": js["records"][0]["after"], "kept": js["kept"],
+                                           "runtime_s": js["runtime_s"], "nfev": js["nfev"]}}
+    if case in ("diagnose10", "sweep1A"):
+        rec = _record("chirp20Hz_1A", 10.0) if case == "diagnose10" else _record("sweep15Hz_1A")
+        rig = sh.load_rig(ROOT / "evaluation" / "utfsm_rig_0A.toml")
+        t0 = time.perf_counter()
+        d = sh.diagnose([rec], rig, mode="displacement", progress=False)
+        return {"wall_s": time.perf_counter() - t0, "result": _diagnosis_summary(d)}
+    if case == "diagnose10sim":
+        rec, rig, mode, key = _simulated_record()
+        t0 = time.perf_counter()
+        d = sh.diagnose([rec], rig, mode=mode, progress=False)
+        out = _diagnosis_summary(d)
+        out["truth"] = key["answers"]
+        return {"wall_s": time.perf_counter() - t0, "result": out}
+    raise SystemExit(f"unknown case {case!r}: expected one of {CASES}")
+
+
+def _cpu_seconds() -> float:
+    """The process' CPU time so far [s], user and system, summed over its threads: on a shared machine
+    the wall time grows with the others' load, this much less (cache and frequency effects only)."""
+    import resource
+
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
+
+
+@contextmanager
+def _quiet():
+    old = sys.stdout
+    sys.stdout = io.StringIO()
+    try:
+        yield
+    finally:
+        sys.stdout = old
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--cases", default=",".join(CASES), help=f"comma-separated, of {', '.join(CASES)}")
+    p.add_argument("--json", help="write the results here (appended under --label)")
+    p.add_argument("--label", default="run", help="name of this run in the JSON (e.g. before, after)")
+    p.add_argument("--profile", action="store_true", help="cProfile's top functions per case (main thread)")
+    p.add_argument("--jacobian", choices=["sensitivities", "differences"], default=None,
+                   help="the Jacobian route of identification/jacobian.py (default: its own)")
+    a = p.parse_args()
+    import servohydraulics as sh
+
+    if a.jacobian is not None:
+        from servohydraulics.identification import jacobian
+
+        jacobian.ROUTE = a.jacobian
+
+    cases = [c.strip() for c in a.cases.split(",") if c.strip()]
+    out = {"label": a.label, "python": platform.python_version(), "cpus": os.cpu_count(),
+           "command": "python benchmarks/lab_speed.py " + " ".join(sys.argv[1:]), "cases": {}}
+    counter = Counters()
+    for case in cases:
+        counter.reset()
+        load0 = os.getloadavg()
+        cpu0 = _cpu_seconds()
+        prof = cProfile.Profile() if a.profile else None
+        with instrumented(counter):
+            if prof:
+                prof.enable()
+            res = run_case(case)
+            if prof:
+                prof.disable()
+        load1 = os.getloadavg()
+        res["cpu_s"] = _cpu_seconds() - cpu0
+        res.update(counter.as_dict())
+        res["load_before"], res["load_after"] = [round(v, 2) for v in load0], [round(v, 2) for v in load1]
+        res["target_s"] = TARGETS[case]
+        out["cases"][case] = res
+        print(f"{case}: {res['wall_s']:.1f} s (target {TARGETS[case]:g} s; load {load0[0]:.1f} -> {load1[0]:.1f}); "
+              f"CPU {res['cpu_s']:.1f} s (an idle 2-core machine: >= {res['cpu_s'] / 2:.1f} s); "
+              f"{res['simulations']} simulations ({res['simulation_s']:.1f} s summed over threads), "
+              f"{res['sensitivity_runs']} sensitivity runs ({res['sensitivity_s']:.1f} s), "
+              f"{res['jacobian_evaluations']} Jacobians, {res['least_squares_calls']} least-squares calls, "
+              f"{res['least_squares_iterations']} iterations, {res['least_squares_residuals']} residuals",
+              flush=True)
+        print("   ", json.dumps(res["result"], default=float)[:2000], flush=True)
+        if prof:
+            s = io.StringIO()
+            pstats.Stats(prof, stream=s).sort_stats("cumulative").print_stats(30)
+            res["profile"] = s.getvalue()
+            print(s.getvalue())
+    if a.json:
+        path = Path(a.json)
+        saved = json.loads(path.read_text()) if path.exists() else {}
+        saved[a.label] = out
+        path.write_text(json.dumps(saved, indent=1, default=float) + "\n")
+    del sh
+
+
+if __name__ == "__main__":
+    main()
