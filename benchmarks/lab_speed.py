@@ -19,7 +19,7 @@ The cases (records from ../shared/real-data/utfsm-mts-mrdamper, or $SH_SHARED_DI
 For each: the wall time, the load average before and after (the machine is shared), the process' CPU
 time (user + system over its threads: half of it bounds the wall time on an idle 2-core machine from
 below, and it moves little with the others' load), the number of
-simulations (calls into the core's record runs: plain runs and sensitivity runs apart), of Jacobian
+simulations (calls into the core's record runs: a segment of a record counts as one), of Jacobian
 evaluations and of least-squares calls, iterations (Jacobian evaluations inside them) and residual
 evaluations, the time spent inside the core's runs (summed over threads), and what the run found
 (NRMSE of the identified rig; the diagnosis' verdict, effects and gaps) so that a speed-up that
@@ -61,38 +61,18 @@ class Counters:
     def reset(self) -> None:
         self.sims = 0
         self.sim_seconds = 0.0
-        self.sens = 0
-        self.sens_seconds = 0.0
         self.lsq_calls = 0
         self.lsq_nfev = 0
         self.lsq_njev = 0
         self.jacobians_outside = 0
-        work = _jacobian_work()
-        self.work0 = (work.columns_sensitivity, work.columns_difference, len(work.reasons)) if work else (0, 0, 0)
 
     def as_dict(self) -> dict:
-        out = {"simulations": self.sims, "simulation_s": self.sim_seconds, "sensitivity_runs": self.sens,
-               "sensitivity_s": self.sens_seconds, "least_squares_calls": self.lsq_calls,
-               "least_squares_iterations": self.lsq_njev, "least_squares_residuals": self.lsq_nfev,
-               "jacobian_evaluations": self.lsq_njev + self.jacobians_outside}
-        work = _jacobian_work()
-        if work is not None:
-            out["jacobian_columns_sensitivity"] = work.columns_sensitivity - self.work0[0]
-            out["jacobian_columns_differenced"] = work.columns_difference - self.work0[1]
-            out["differenced_because"] = sorted(set(work.reasons[self.work0[2]:]))
-        return out
+        return {"simulations": self.sims, "simulation_s": self.sim_seconds, "least_squares_calls": self.lsq_calls,
+                "least_squares_iterations": self.lsq_njev, "least_squares_residuals": self.lsq_nfev,
+                "jacobian_evaluations": self.lsq_njev + self.jacobians_outside}
 
 
-def _jacobian_work():
-    """The shared Jacobian's running totals (identification/jacobian.py), None before it existed."""
-    try:
-        from servohydraulics.identification.jacobian import WORK
-    except ImportError:
-        return None
-    return WORK
-
-
-def _timed(counter: Counters, fn, what: str):
+def _timed(counter: Counters, fn):
     def wrapper(*a, **k):
         t0 = time.perf_counter()
         try:
@@ -100,12 +80,8 @@ def _timed(counter: Counters, fn, what: str):
         finally:
             dt = time.perf_counter() - t0
             with counter.lock:
-                if what == "sim":
-                    counter.sims += 1
-                    counter.sim_seconds += dt
-                else:
-                    counter.sens += 1
-                    counter.sens_seconds += dt
+                counter.sims += 1
+                counter.sim_seconds += dt
     return wrapper
 
 
@@ -122,9 +98,7 @@ def instrumented(counter: Counters):
         saved.append((obj, name, getattr(obj, name)))
         setattr(obj, name, new)
 
-    patch(_core, "run_record", _timed(counter, _core.run_record, "sim"))
-    if hasattr(_core, "run_record_sensitivities"):
-        patch(_core, "run_record_sensitivities", _timed(counter, _core.run_record_sensitivities, "sens"))
+    patch(_core, "run_record", _timed(counter, _core.run_record))
 
     def counting(lsq):
         def wrapper(*a, **k):
@@ -193,7 +167,20 @@ def _diagnosis_summary(d) -> dict:
             "gap_before": js["gap_before"], "gap_after": js["gap_after"], "summary": js["summary"]}
 
 
+class _Clock:
+    """Wall and process CPU time [s] of the timed part of a case."""
+
+    def __enter__(self):
+        self.t0, self.c0 = time.perf_counter(), _cpu_seconds()
+        return self
+
+    def __exit__(self, *exc):
+        self.wall, self.cpu = time.perf_counter() - self.t0, _cpu_seconds() - self.c0
+
+
 def run_case(case: str) -> dict:
+    """One case; ``wall_s`` and ``cpu_s`` time the identification or the diagnosis alone (not the
+    reading or the making of its record)."""
     import servohydraulics as sh
     from servohydraulics import cli
 
@@ -201,29 +188,28 @@ def run_case(case: str) -> dict:
         with tempfile.TemporaryDirectory() as tmp:
             argv = ["identify", str(DATA / "chirp20Hz_0A.csv"), "--mode", "displacement", "--specimen",
                     "mr_damper", "--out", tmp, "--quiet"]
-            t0 = time.perf_counter()
-            with _quiet():
+            with _Clock() as clock, _quiet():
                 code = cli.main(argv)
-            wall = time.perf_counter() - t0
             if code != 0:
                 raise SystemExit(f"identify exited {code}")
             js = json.loads((Path(tmp) / "identification.json").read_text())
-        return {"wall_s": wall, "result": {"values": {k: p["value"] for k, p in js["parameters"].items()},
-                                           "nrmse_after": js["records"][0]["after"], "kept": js["kept"],
-                                           "runtime_s": js["runtime_s"], "nfev": js["nfev"]}}
-    if case in ("diagnose10", "sweep1A"):
-        rec = _record("chirp20Hz_1A", 10.0) if case == "diagnose10" else _record("sweep15Hz_1A")
-        rig = sh.load_rig(ROOT / "evaluation" / "utfsm_rig_0A.toml")
-        t0 = time.perf_counter()
-        d = sh.diagnose([rec], rig, mode="displacement", progress=False)
-        return {"wall_s": time.perf_counter() - t0, "result": _diagnosis_summary(d)}
-    if case == "diagnose10sim":
-        rec, rig, mode, key = _simulated_record()
-        t0 = time.perf_counter()
-        d = sh.diagnose([rec], rig, mode=mode, progress=False)
+        return {"wall_s": clock.wall, "cpu_s": clock.cpu,
+                "result": {"values": {k: p["value"] for k, p in js["parameters"].items()},
+                           "std": {k: p["std"] for k, p in js["parameters"].items()},
+                           "nrmse_after": js["records"][0]["after"], "kept": js["kept"], "costs": js["costs"],
+                           "runtime_s": js["runtime_s"], "nfev": js["nfev"], "segments": js.get("segments")}}
+    if case in ("diagnose10", "sweep1A", "diagnose10sim"):
+        if case == "diagnose10sim":
+            rec, rig, mode, key = _simulated_record()
+        else:
+            rec = _record("chirp20Hz_1A", 10.0) if case == "diagnose10" else _record("sweep15Hz_1A")
+            rig, mode = sh.load_rig(ROOT / "evaluation" / "utfsm_rig_0A.toml"), "displacement"
+        with _Clock() as clock:
+            d = sh.diagnose([rec], rig, mode=mode, progress=False)
         out = _diagnosis_summary(d)
-        out["truth"] = key["answers"]
-        return {"wall_s": time.perf_counter() - t0, "result": out}
+        if case == "diagnose10sim":
+            out["truth"] = key["answers"]
+        return {"wall_s": clock.wall, "cpu_s": clock.cpu, "result": out}
     raise SystemExit(f"unknown case {case!r}: expected one of {CASES}")
 
 
@@ -252,15 +238,8 @@ def main() -> None:
     p.add_argument("--json", help="write the results here (appended under --label)")
     p.add_argument("--label", default="run", help="name of this run in the JSON (e.g. before, after)")
     p.add_argument("--profile", action="store_true", help="cProfile's top functions per case (main thread)")
-    p.add_argument("--jacobian", choices=["sensitivities", "differences"], default=None,
-                   help="the Jacobian route of identification/jacobian.py (default: its own)")
     a = p.parse_args()
     import servohydraulics as sh
-
-    if a.jacobian is not None:
-        from servohydraulics.identification import jacobian
-
-        jacobian.ROUTE = a.jacobian
 
     cases = [c.strip() for c in a.cases.split(",") if c.strip()]
     out = {"label": a.label, "python": platform.python_version(), "cpus": os.cpu_count(),
@@ -269,7 +248,6 @@ def main() -> None:
     for case in cases:
         counter.reset()
         load0 = os.getloadavg()
-        cpu0 = _cpu_seconds()
         prof = cProfile.Profile() if a.profile else None
         with instrumented(counter):
             if prof:
@@ -278,7 +256,6 @@ def main() -> None:
             if prof:
                 prof.disable()
         load1 = os.getloadavg()
-        res["cpu_s"] = _cpu_seconds() - cpu0
         res.update(counter.as_dict())
         res["load_before"], res["load_after"] = [round(v, 2) for v in load0], [round(v, 2) for v in load1]
         res["target_s"] = TARGETS[case]
@@ -286,7 +263,6 @@ def main() -> None:
         print(f"{case}: {res['wall_s']:.1f} s (target {TARGETS[case]:g} s; load {load0[0]:.1f} -> {load1[0]:.1f}); "
               f"CPU {res['cpu_s']:.1f} s (an idle 2-core machine: >= {res['cpu_s'] / 2:.1f} s); "
               f"{res['simulations']} simulations ({res['simulation_s']:.1f} s summed over threads), "
-              f"{res['sensitivity_runs']} sensitivity runs ({res['sensitivity_s']:.1f} s), "
               f"{res['jacobian_evaluations']} Jacobians, {res['least_squares_calls']} least-squares calls, "
               f"{res['least_squares_iterations']} iterations, {res['least_squares_residuals']} residuals",
               flush=True)

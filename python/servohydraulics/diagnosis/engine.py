@@ -108,7 +108,7 @@ def refine_x0(rig: Rig, cases: list[Case], tau: float) -> tuple[float, ...]:
         x0, sd = case.x0_data, max(case.x0_sd, 1e-8)
 
         def fun(z, case=case):
-            return residuals([simulate_case(rig, case, tau, float(z[0]))], [case])
+            return residuals([simulate_case(rig, case, tau, float(z[0]), search=True)], [case])
 
         try:
             res = least_squares(fun, [x0], bounds=([x0 - 4 * sd], [x0 + 4 * sd]), x_scale=[sd], diff_step=1e-3,
@@ -121,12 +121,25 @@ def refine_x0(rig: Rig, cases: list[Case], tau: float) -> tuple[float, ...]:
 
 # --- simulation ---------------------------------------------------------------------
 
-def simulate_case(rig: Rig, case: Case, tau: float, x0: float) -> Sim:
+def run_options(search: bool):
+    """The integrator of a diagnosis run.  The runs of the search (the least-squares fits'
+    residuals and difference columns, the screening's signatures, the fits' starts, the initial
+    displacements) use the time stage's tolerance of ``sh.identify`` (``identification.fit.FIT_RTOL``,
+    1e-6: its differences are clean, 1e-2 of a column at worst on the UTFSM chirp against rtol
+    1e-9); every run a decision reads (the channel statistics of the BIC, the held-out error, the
+    gaps) uses the core's default (rtol 1e-8).  A search run costs 1.5 (a friction rig) to 23 (the
+    UTFSM MR damper, whose default run turns stiff) times less."""
+    from ..identification.fit import FIT_RTOL
+
+    return solver_options(rtol=FIT_RTOL) if search else solver_options()
+
+
+def simulate_case(rig: Rig, case: Case, tau: float, x0: float, search: bool = False) -> Sim:
     """The model's channels for the record's command delayed by ``tau`` [s]
     from the initial displacement ``x0`` [m] (None if the run fails).
-    The default error-controlled pair (dopri5, CVODE for its stiff samples); CVODE alone if
-    that run fails."""
-    for opts in (solver_options(), solver_options(method="cvode")):
+    The default error-controlled pair (dopri5, CVODE for its stiff samples; ``search``: at the
+    search's tolerance, ``run_options``); CVODE alone if that run fails."""
+    for opts in (run_options(search), solver_options(method="cvode")):
         try:
             r = simulate_command(rig, case.mode, case.u, case.dt, float(x0), opts, dt=case.controller_dt, delay=tau)
         except (SimulationError, ValueError):
@@ -353,9 +366,30 @@ class JointSpace:
         return rig, tau
 
 
-def simulate_all(rig: Rig, cases: list[Case], tau: float, x0s) -> list[Sim]:
-    """``simulate_case`` of every record, each from its initial displacement in ``x0s`` [m]."""
-    return [simulate_case(rig, c, tau, x0) for c, x0 in zip(cases, x0s)]
+def simulate_all(rig: Rig, cases: list[Case], tau: float, x0s, search: bool = False) -> list[Sim]:
+    """``simulate_case`` of every record, each from its initial displacement in ``x0s`` [m]
+    (``search``: at the search's tolerance, ``run_options``)."""
+    return [simulate_case(rig, c, tau, x0, search) for c, x0 in zip(cases, x0s)]
+
+
+_POOL = None
+
+
+def workers():
+    """The map of the fits' difference columns: a thread pool of ``fit.default_workers()`` threads
+    (the core releases the GIL while it simulates; scipy's ``least_squares(workers=...)`` keeps the
+    columns, and so the fit, identical to the serial ones), None on one core."""
+    global _POOL
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ..identification.fit import default_workers
+
+    n = default_workers()
+    if n <= 1:
+        return None
+    if _POOL is None:
+        _POOL = ThreadPoolExecutor(max_workers=n, thread_name_prefix="diagnose")
+    return _POOL.map
 
 
 # --- screening ----------------------------------------------------------------------------
@@ -370,7 +404,7 @@ def secant_screen(space: Space, cases: list[Case], x0s, r0: np.ndarray, base_tau
         z = space.absent.copy()
         z[i] = space.probe[i]
         rig, tau = space.rig_and_tau(z, base_tau)
-        sims = simulate_all(rig, cases, tau, x0s)
+        sims = simulate_all(rig, cases, tau, x0s, search=True)
         if any(s is None for s in sims):
             return Screening(0.0, space.probe.copy(), None, failed=True)
         cols.append(-(residuals(sims, cases) - r0))  # change of the normalised simulation
@@ -438,10 +472,10 @@ def fit(space: Space, cases: list[Case], z0: np.ndarray, base_tau: float, which:
 
     def fun(z):
         rig, tau = space.rig_and_tau(z[:p], base_tau)
-        return residuals(simulate_all(rig, cases, tau, z[p:]), cases, which)
+        return residuals(simulate_all(rig, cases, tau, z[p:], search=True), cases, which)
 
     res = least_squares(fun, zs, bounds=(lo, hi), x_scale=np.concatenate([space.scale, sd]), diff_step=1e-3,
-                        max_nfev=max_nfev, method="trf", xtol=1e-6, ftol=1e-8)
+                        max_nfev=max_nfev, method="trf", xtol=1e-6, ftol=1e-8, workers=workers())
     return FitResult(z=res.x[:p].copy(), x0=res.x[p:].copy(), jac=res.jac, fun=res.fun, nuisance_scale=sd,
                      nfev=int(res.nfev))
 

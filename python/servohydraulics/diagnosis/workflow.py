@@ -315,9 +315,8 @@ def _screen_all(setup: _Setup, state: _State, ctx: Context, rnd: int) -> tuple[l
     r0 = engine.residuals(state.sims, cases)
     setup.bar.set_description_str(f"round {rnd}: screening")
     added = {e["name"] for e in state.effects}
-    screened, log = [], {}
+    log, spaces = {}, {}
     for nme in setup.names:
-        setup.bar.update(1)
         why = _not_screened(nme, added, setup.mode, ctx)
         if why:
             log[nme] = CandidateLog(nme, rnd, rejection=why)
@@ -326,14 +325,39 @@ def _screen_all(setup: _Setup, state: _State, ctx: Context, rnd: int) -> tuple[l
         inter = cand.interacts if setup.refit_interacting else ()
         inter = tuple((k, u) for k, u in inter if getattr(state.rig, k) > 0
                       and (k != "F_c" or state.rig.effects.coulomb_friction))
-        space = engine.Space(cand, ctx, inter)
+        spaces[nme] = engine.Space(cand, ctx, inter)
+
+    def screen(nme: str) -> _Screened:
+        space, cand = spaces[nme], LIBRARY[nme]
         sc = engine.secant_screen(space, cases, state.x0, r0, state.tau)
         bal = (engine.balance_screen(state.rig, cases, cand.structural_signature)
                if cand.structural_signature is not None else None)
-        log[nme] = CandidateLog(nme, rnd, screening_score=sc.score, balance_score=bal)
-        screened.append(_Screened(nme, space, sc, bal))
+        return _Screened(nme, space, sc, bal)
+
+    done = dict(zip(spaces, _each(screen, list(spaces))))
+    screened = []
+    for nme in setup.names:  # the log in library order
+        setup.bar.update(1)
+        if nme in done:
+            s = done[nme]
+            log[nme] = CandidateLog(nme, rnd, screening_score=s.screening.score, balance_score=s.balance)
+            screened.append(s)
     screened.sort(key=lambda s: -s.screening.score)
     return screened, log
+
+
+def _each(fn, items: list) -> list:
+    """``[fn(i) for i in items]``, the items on ``fit.default_workers()`` threads (the candidates of a
+    round are independent: each result is the one a serial loop gives)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ..identification.fit import default_workers
+
+    n = min(default_workers(), len(items))
+    if n <= 1:
+        return [fn(i) for i in items]
+    with ThreadPoolExecutor(max_workers=n, thread_name_prefix="diagnose-candidate") as pool:
+        return list(pool.map(fn, items))
 
 
 def _shortlist(screened: list[_Screened], keep: int) -> list[_Screened]:
@@ -361,18 +385,22 @@ def _confirm_all(setup: _Setup, state: _State, ctx: Context, survivors: list[_Sc
     """Fits each shortlisted candidate (``confirm.confirm``), logs its tests and
     returns those that pass them all."""
     base_test = engine.channel_stats(state.sims, setup.cases, "test")
-    passing = []
-    for s in survivors:
-        setup.bar.set_description_str(f"round {log[s.name].round}: fitting {s.name}")
-        setup.bar.update(1)
+    setup.bar.set_description_str(f"round {log[survivors[0].name].round}: fitting" if survivors else "")
+
+    def fit_one(s: _Screened):
         t_fit = time.time()
         fit = confirm(s.space, s.screening.z0, setup.cases, state.x0, stats, base_test, state.tau, ctx,
                       setup.refit_interacting)
+        return fit, time.time() - t_fit
+
+    passing = []
+    for s, (fit, seconds) in zip(survivors, _each(fit_one, survivors)):
+        setup.bar.update(1)
         reasons = _rejection(fit)
         log[s.name] = dataclasses.replace(
             log[s.name], score=fit.dbic, delta_bic=fit.dbic, heldout_improvement=fit.held,
             parameters=param_report(fit.space, fit.z, fit.lo, fit.hi), joint_p_absent=fit.joint_p, refit=fit.refit,
-            fit_seconds=time.time() - t_fit, heldout_lr=fit.held_lr, rejection="; ".join(reasons) or None)
+            fit_seconds=seconds, heldout_lr=fit.held_lr, rejection="; ".join(reasons) or None)
         if not reasons:
             passing.append(_Passing(s.name, fit, s.screening))
     return passing
