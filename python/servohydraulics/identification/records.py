@@ -39,6 +39,7 @@ from .checks import check_accept, gate
 from .compare import Comparison, channels_of, compare, save_figures, write_json
 from .coordinates import FORCE_KEYS, LOOP_KEYS, Coordinates, check_keys, specimen_keys, use_specimen
 from .fit import (
+    RK4_SUBSTEPS,
     StageResult,
     best,
     channel_weights,
@@ -48,6 +49,7 @@ from .fit import (
     fit_time,
     keep_best,
     not_improved_flags,
+    rk4_options,
     time_costs,
 )
 from .generic import generic_rig, record_scales, specimen_start
@@ -63,7 +65,7 @@ from .law import (
     with_fields,
 )
 from .run import check_record, controller_ratio, simulate_record
-from .segments import AGREEMENT, Target
+from .segments import AGREEMENT, Target, whole
 from .stats import LEVEL, ar1_coefficient, ar1_effective_n, covariance, quantile
 
 MAX_CORRELATION = 0.95  #: |corr| above which two keys are reported as not separable
@@ -99,8 +101,9 @@ class Identification:
     checks: list = field(default_factory=list)  #: ``checks.Check``: the records' plausibility, the runs' limits
     field_input: FieldInput | None = None  #: the MR damper's field per record (``currents=``/``voltages=``)
     law: str | None = None  #: the MR damper's field law fitted across the records (``law.py``)
-    #: segments per record of the time stage's runs (``segments.Target``; 1: whole runs)
-    segments: list = field(default_factory=list)
+    #: how the time stage ran the records (``segments.Target``): its integrator, the segments per
+    #: record (1: whole runs), whether the result was polished on the pair's whole runs
+    runs: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         units = _units()
@@ -113,7 +116,7 @@ class Identification:
             "correlation": {"keys": list(self.keys), "matrix": np.round(self.correlation, 4).tolist()},
             "derived": derived(self.rig, self.mode), "flags": self.flags, "channel_weights": self.weights,
             "integrator": self.integrator, "n_eff": self.n_eff, "rho1": self.rho1, "nfev": self.nfev,
-            "runtime_s": self.runtime_s, "segments": self.segments, "costs": self.costs, "kept": self.kept,
+            "runtime_s": self.runtime_s, "runs": self.runs, "costs": self.costs, "kept": self.kept,
             "checks": [c.to_dict() for c in self.checks],
             "field": None if self.field_input is None else {**self.field_input.to_dict(), "law": self.law},
             "records": [{"record": b.name, "before": {c: b.channels[c]["nrmse_pct"] for c in b.channels},
@@ -346,23 +349,38 @@ def _setup(records, rig, fit, mode: str, specimen: str | None, channels, dt: flo
     return recs, start, generic, keys, chans, extra
 
 
+def _fit_target(recs, start, coords, z1, mode, chans, options, dt, workers, before: list) -> Target:
+    """The runs of the time stage: the records in segments (``segments.Target``) through RK4 at the
+    fewest substeps of ``fit.RK4_SUBSTEPS`` whose run of the start agrees with the pair's whole runs
+    ``before`` (``Target.agrees``), else through the pair (``options``), else the pair's whole runs."""
+    rig1 = coords.apply(start, z1)
+    for n in RK4_SUBSTEPS:
+        target = Target.build(recs, mode, chans, rk4_options(n), dt, rig1, workers)
+        if target.agrees(start, before):
+            return target
+        target.close()
+    target = Target.build(recs, mode, chans, options, dt, rig1, workers)
+    if target.agrees(start, before):
+        return target
+    target.close()
+    return Target(recs, mode, chans, options, dt, [whole(r) for r in recs], workers)
+
+
 def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options, dt, max_nfev, progress, workers,
                  before: list):
     """Stage 2 from stage 1's z1 (again from the start when that ends worse than the start), then
-    ``fit.keep_best`` of the start and the stages, on segmented runs (``segments.Target``, checked
-    against the whole runs ``before`` of the start and against those of the result; whole runs
-    where they disagree); returns keep_best's result, the evaluations, the whole runs of the result
-    and the segments per record."""
+    ``fit.keep_best`` of the start and the stages, on the runs of ``_fit_target`` (checked against
+    the pair's whole runs ``before`` of the start, and against those of the result: where they
+    disagree the result is polished on the pair's whole runs); returns keep_best's result, the
+    evaluations, the whole runs of the result and how the time stage ran (``Identification.runs``)."""
     from tqdm.auto import tqdm
 
     workers = default_workers() if workers is None else max(1, int(workers))
-    targets = [Target.build(recs, mode, chans, options, dt, coords.apply(start, z1), workers)]
+    target = _fit_target(recs, start, coords, z1, mode, chans, options, dt, workers, before)
+    runs = {"integrator": _describe(target.options), "segments": [len(segs) for segs in target.segments],
+            "shift_sd": 0.0, "polished_on_whole_runs": False}
     with tqdm(desc="identify (simulations)", unit="sim", disable=not progress, leave=False) as bar:
         try:
-            target = targets[0]
-            if target.agrees(start, before) > AGREEMENT:
-                targets.append(target.whole_runs())
-                target = targets[-1]
             stages = {"start": np.zeros(len(coords.keys)), "frequency": z1} if frequency_stage else {"start": z1}
             stages["time"], nfev = _time_stage(target, start, coords, z1, mode, chans, max_nfev, bar)
             if frequency_stage and best(time_costs(target, start, coords, stages)) != "time":
@@ -370,17 +388,46 @@ def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options,
                 nfev += n
             kept = keep_best(target, start, coords, stages, bar)
             after = _whole_runs(coords.apply(start, kept[3].z), recs, mode, dt, options, workers)
-            if target.agrees(coords.apply(start, kept[3].z), after) > AGREEMENT:  # polish on whole runs
-                targets.append(target.whole_runs())
-                target = targets[-1]
+            runs["shift_sd"] = _shift(target, coords.apply(start, kept[3].z), after, kept[2], kept[3])
+            if not runs["shift_sd"] <= SHIFT_SD:  # polish on the pair's whole runs
+                target.close()
+                target = Target(recs, mode, chans, options, dt, [whole(r) for r in recs], workers)
+                runs["polished_on_whole_runs"] = True
                 stages["time"], n = _time_stage(target, start, coords, kept[3].z, mode, chans, max_nfev, bar)
                 nfev += n
                 kept = keep_best(target, start, coords, stages, bar)
                 after = _whole_runs(coords.apply(start, kept[3].z), recs, mode, dt, options, workers)
         finally:
-            for t in targets:
-                t.close()
-    return (*kept, nfev, after, [len(segs) for segs in target.segments])
+            target.close()
+    return (*kept, nfev, after, runs)
+
+
+#: the time stage's result stands when the pair's whole runs would move it by at most this fraction
+#: of each identified key's standard error (``_shift``); else it is polished on them
+SHIFT_SD = 0.1
+
+
+def _shift(target: Target, rig, after: list, weights: dict, final: StageResult) -> float:
+    """How far the pair's whole runs ``after`` of the result would move it, in standard errors: the
+    Gauss-Newton step from the target's residual to theirs, (J'J)^+ J' d with d the difference of the
+    two weighted residuals at the result and J the result's Jacobian, over each identified key's
+    standard error (``stats.covariance``, the rule of the reported intervals); the largest, inf when
+    a run failed or differs by more than 10 ``segments.AGREEMENT`` somewhere."""
+    d = target.residual(rig, weights) - target.of(after, weights)
+    if not np.all(np.isfinite(d)) or np.max(np.abs(d)) > 10 * AGREEMENT * max(weights.values()):
+        return float("inf")
+    step = np.linalg.lstsq(final.jac, d, rcond=None)[0]
+    sd = covariance(final.jac, final.fun, None, target.lengths).sd
+    ok = np.isfinite(sd) & (sd > 0)
+    return float(np.max(np.abs(step[ok]) / sd[ok])) if ok.any() else 0.0
+
+
+def _describe(options) -> str:
+    """The integrator of a set of solver options, as the report names it."""
+    name = options.method.name.lower()
+    if name == "rk4":
+        return f"rk4, {options.rk4_substeps} substeps per sample"
+    return f"{name}, rtol {options.rtol:g}"
 
 
 def _whole_runs(rig, recs, mode, dt, options, workers) -> list:
@@ -445,7 +492,7 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
     options = fit_options(coords.apply(start, z1), recs, mode)
     t0 = time.perf_counter()
     before_runs = _whole_runs(start, recs, mode, dt, options, default_workers() if workers is None else workers)
-    kept, costs, weights, final, nfev["time"], after_runs, segments = _time_stages(
+    kept, costs, weights, final, nfev["time"], after_runs, runs = _time_stages(
         recs, start, coords, z1, frequency_stage, mode, chans, options, dt, max_nfev, progress, workers, before_runs)
     runtime["time"] = time.perf_counter() - t0
     lengths = [r.time.size for r in recs for _ in chans]
@@ -468,7 +515,7 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
         before=before, after=after, generic_start=generic, weights=weights, integrator=options.method.name.lower(),
         n_eff=float(u["n_eff"]), rho1=float(u["rho1"]), nfev=nfev, runtime_s=runtime, status=u["status"],
         costs=costs, kept=kept, checks=found + [c for a in after for c in a.checks], field_input=extra["field"],
-        law=extra["law"], segments=segments)
+        law=extra["law"], runs=runs)
 
 
 __all__ = ["Comparison", "Identification", "as_records", "identify", "key_status", "separability_flags",

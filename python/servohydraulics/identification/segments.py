@@ -12,8 +12,7 @@ to e^-15 of its size by the first compared sample, so a segmented run agrees wit
 record's run to within the integrator's tolerance (the UTFSM chirp: 5e-7 of the displacement's and
 7e-5 of the force's standard deviation at worst, the difference between two runs of the pair at
 rtol 1e-6).  :meth:`Target.agrees` measures that agreement against whole runs; ``sh.identify``
-checks it on the start and on the result and falls back to whole runs where it fails
-(``AGREEMENT``).
+checks it on the start and on the result and falls back where it fails (``AGREEMENT``).
 
 The residual of a run (``w (sim - measured) / std(measured)`` per record and channel) is cached by
 the rig (its ``repr``: every field), so that the stages' comparisons and the final Jacobian's
@@ -39,9 +38,10 @@ FAILED = 10.0  #: normalised residual of a failed simulation
 WARMUP_DECAYS, MIN_WARMUP = 15.0, 0.5
 #: a record is cut into segments only if each is at least this many warm-ups long
 MIN_SEGMENT_WARMUPS = 4.0
-#: a segmented run must agree with the whole run to this fraction of each channel's standard
-#: deviation (largest difference): 1e-3 is far below any misfit a fit resolves (a 0.1 % NRMSE)
-AGREEMENT = 1e-3
+#: a target's run must agree with the whole run of the error-controlled pair to these fractions of
+#: each channel's standard deviation, largest difference and rms: far below any misfit a fit
+#: resolves (a 0.01 % NRMSE)
+AGREEMENT, AGREEMENT_RMS = 1e-3, 1e-4
 CACHE_SIZE = 8
 
 
@@ -234,18 +234,32 @@ class Target:
                  channels: tuple[str, ...] | None = None) -> np.ndarray:
         return self.residuals([rig], weights, channels)[0]
 
-    def agrees(self, rig: Rig, sims: list[Response]) -> float:
-        """The largest difference between this target's run of ``rig`` and the whole runs ``sims``
-        (one per record, ``run.simulate_record``) as a fraction of each channel's standard
-        deviation (0 when the target runs whole records; inf when a run failed)."""
-        if not self.segmented:
-            return 0.0
+    def of(self, sims: list[Response], weights: dict | None = None) -> np.ndarray:
+        """The residual (as ``residuals``) of the whole runs ``sims`` (one per record,
+        ``run.simulate_record``) over this target's compared samples."""
         ref = []
+        w = {ch: 1.0 if weights is None else weights[ch] for ch in self.channels}
         for segs, sim, meas, sd in zip(self.segments, sims, self.measured, self.std):
             ix = np.concatenate([np.arange(s.keep, s.stop) for s in segs])
-            ref += [(np.asarray(sim.channels[ch], dtype=float)[ix] - meas[ch]) / sd[ch] for ch in self.channels]
-        d = float(np.max(np.abs(self.residual(rig) - np.concatenate(ref))))
-        return d if math.isfinite(d) else math.inf
+            ref += [w[ch] * (np.asarray(sim.channels[ch], dtype=float)[ix] - meas[ch]) / sd[ch]
+                    for ch in self.channels]
+        return np.concatenate(ref)
+
+    def gap(self, rig: Rig, sims: list[Response]) -> tuple[float, float]:
+        """How far this target's run of ``rig`` is from the whole runs ``sims`` (one per record,
+        ``run.simulate_record``, e.g. by the error-controlled pair): (the largest difference, the
+        largest rms difference of a (record, channel) series), each as a fraction of the channel's
+        standard deviation; (inf, inf) when a run failed."""
+        d = self.residual(rig) - self.of(sims)
+        parts = np.split(d, np.cumsum(self.lengths)[:-1])
+        worst, rms = float(np.max(np.abs(d))), max(float(np.sqrt(np.mean(p ** 2))) for p in parts)
+        return (worst, rms) if math.isfinite(worst) and math.isfinite(rms) else (math.inf, math.inf)
+
+    def agrees(self, rig: Rig, sims: list[Response]) -> bool:
+        """Whether this target's run of ``rig`` stands for the whole runs ``sims``: its ``gap`` within
+        ``AGREEMENT`` (largest) and ``AGREEMENT_RMS`` (rms)."""
+        worst, rms = self.gap(rig, sims)
+        return worst <= AGREEMENT and rms <= AGREEMENT_RMS
 
 
-__all__ = ["AGREEMENT", "FAILED", "Segment", "Target", "split", "warmup_seconds", "whole"]
+__all__ = ["AGREEMENT", "AGREEMENT_RMS", "FAILED", "Segment", "Target", "split", "warmup_seconds", "whole"]

@@ -97,17 +97,22 @@ def long_run_covariance(scores: np.ndarray, r: np.ndarray, lengths: list[int]) -
     S_t = scores_t r_t up to each series' ``bartlett_bandwidth`` (symmetric)."""
     p = scores.shape[1]
     omega = np.zeros((p, p))
+    iu, ju = np.triu_indices(p)
     a = 0
     for m in lengths:
         S = scores[a:a + m] * r[a:a + m, None]
         L = bartlett_bandwidth(r[a:a + m])
         nfft = 1 << int(math.ceil(math.log2(2 * m)))
         F = np.fft.rfft(S, n=nfft, axis=0)
-        # C[l, i, j] = sum_t S[t + l, i] S[t, j], every lag at once
-        C = np.fft.irfft(F[:, :, None] * np.conj(F[:, None, :]), n=nfft, axis=0)[: L + 1]
+        # the circular cross-correlation of each pair i <= j, every lag at once: index l holds
+        # C[l, i, j] = sum_t S[t + l, i] S[t, j], index nfft - l holds C[l, j, i] (no wrap: nfft >= 2m)
+        c = np.fft.irfft(F[:, iu] * np.conj(F[:, ju]), n=nfft, axis=0)
         w = 1.0 - np.arange(1, L + 1) / (L + 1)
-        G = np.einsum("l,lij->ij", w, C[1:])
-        omega += C[0] + G + G.T
+        C0, G = np.zeros((p, p)), np.zeros((p, p))
+        C0[iu, ju] = C0[ju, iu] = c[0]
+        G[iu, ju] = w @ c[1:L + 1]
+        G[ju, iu] = w @ c[nfft - L:][::-1]
+        omega += C0 + G + G.T
         a += m
     return 0.5 * (omega + omega.T)
 
