@@ -499,7 +499,7 @@ MultiIntegrator make_integrator(const MultiRig& rig, double dt, const SolverOpti
   if (opt.method == M::CvodeBdf)
     return MultiIntegrator(std::in_place_type<detail::BasicCvodeIntegrator<MultiRig>>, rig, dt, opt, y0);
   if (opt.method == M::Rk4) return MultiIntegrator(std::in_place_type<detail::BasicRk4Integrator<MultiRig>>, rig, dt, opt);
-  return MultiIntegrator(std::in_place_type<detail::BasicDopri5Integrator<MultiRig>>, rig, dt, opt, y0);
+  return MultiIntegrator(std::in_place_type<detail::BasicDopri5Integrator<MultiRig>>, rig, dt, opt, y0, opt.stiff_check);
 }
 }  // namespace
 

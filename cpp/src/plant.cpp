@@ -77,7 +77,7 @@ Integrator make_integrator(const Dynamics& dyn, double dt, const SolverOptions& 
       return Integrator(std::in_place_type<detail::ArkodeIntegrator>, dyn, dt, opt, y0, opt.method == M::ArkodeDirk);
     case M::Dopri5: break;
   }
-  return Integrator(std::in_place_type<detail::Dopri5Integrator>, dyn, dt, opt, y0);
+  return Integrator(std::in_place_type<detail::Dopri5Integrator>, dyn, dt, opt, y0, opt.stiff_check);
 }
 }  // namespace
 

@@ -29,7 +29,8 @@ def solver_options(method: str = DEFAULT_METHOD, rtol: float | None = None, rest
                    rk4_substeps: int | None = None, max_steps_per_sample: int | None = None,
                    max_order: int | None = None, rk4_h_rho: float | None = None,
                    rk4_v_ref: float | None = None, atol_fraction: float | None = None,
-                   stiff_fallback: bool | None = None, stiff_steps: int | None = None,
+                   stiff_fallback: bool | None = None, stiff_check: bool | None = None,
+                   stiff_steps: int | None = None,
                    rk4_flag_rtol: float | None = None, rk4_max_refinements: int | None = None,
                    max_internal_step: float | None = None) -> _core.SolverOptions:
     """Builds solver options; see ``SolverOptions`` in solver_options.hpp (one keyword per row of
@@ -37,6 +38,7 @@ def solver_options(method: str = DEFAULT_METHOD, rtol: float | None = None, rest
 
     ``method``: ``"dopri5"`` (default: Dormand-Prince 5(4) with error control at ``rtol``, a sample
     where it turns stiff is redone by CVODE, or reported as status ``stiff`` if ``stiff_fallback`` is
+    False; a run that turned stiff is checked by a shadow run at rtol / 10 unless ``stiff_check`` is
     False), ``"rk4"`` (the real-time option: fixed cost, ``rk4_substeps`` per sample or automatic,
     checked by a companion run at twice the substeps that flags where the two differ by more than
     ``rk4_flag_rtol`` of the peaks (0: no check), the rest of the run at doubled substeps from a
@@ -53,7 +55,8 @@ def solver_options(method: str = DEFAULT_METHOD, rtol: float | None = None, rest
     _assign(o, restart=None if restart is None else RESTARTS[restart], rtol=rtol, rk4_substeps=rk4_substeps,
             max_steps_per_sample=max_steps_per_sample, max_order=max_order, rk4_h_rho=rk4_h_rho,
             rk4_v_ref=rk4_v_ref, atol_fraction=atol_fraction,
-            stiff_fallback=None if stiff_fallback is None else bool(stiff_fallback), stiff_steps=stiff_steps,
+            stiff_fallback=None if stiff_fallback is None else bool(stiff_fallback),
+            stiff_check=None if stiff_check is None else bool(stiff_check), stiff_steps=stiff_steps,
             rk4_flag_rtol=rk4_flag_rtol, rk4_max_refinements=rk4_max_refinements,
             max_internal_step=max_internal_step)
     o.validate()

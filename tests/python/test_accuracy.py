@@ -144,6 +144,19 @@ def test_stiff_samples_that_miss_the_stated_accuracy_are_flagged():
     assert not any(code == "run_accuracy" for code, _ in default.notes()) or default.work.error_estimate > 1
 
 
+def test_the_check_off_leaves_the_result_and_drops_the_flag():
+    """``stiff_check=False`` (the fits' search runs): the same run to the bit (the check's shadow
+    only flags), without its flags and for less work (the shadow's steps and right-hand sides)."""
+    rig, u = _high_gain_case(HIGH_GAIN, 0.00262353, 1.50547, -0.0148819)
+    checked, unchecked = _run(rig, u, rtol=1e-7), _run(rig, u, rtol=1e-7, stiff_check=False)
+    assert checked.work.inaccurate_samples > 0 and checked.work.error_estimate > 1
+    for ch in ("displacement", "force", "pressure", "spool", "velocity"):
+        np.testing.assert_array_equal(unchecked.channels[ch], checked.channels[ch])
+    assert unchecked.work.inaccurate_samples == 0 and unchecked.work.error_estimate == 0
+    assert unchecked.work.stiff_samples == checked.work.stiff_samples
+    assert not any(code == "run_accuracy" for code, _ in unchecked.notes())
+
+
 def test_stiff_samples_within_the_stated_accuracy_are_not_flagged():
     """The flag means something: on an equally stiff rig whose loop does not amplify the error,
     the default is within 1e-3 of the reference and flags nothing."""

@@ -46,6 +46,10 @@ struct SolverOptions {
   //! samples) that flags Status::inaccurate where the two differ by more than 5e-4 of the run's
   //! peak displacement or force (dopri5_integrator.hpp).
   bool stiff_fallback = true;
+  //! Dopri5 with the fallback: check a run that has turned stiff by the shadow run above (false: no
+  //! shadow, no Status::inaccurate flag, no work for it; the result itself is the same to the bit).
+  //! For runs whose flags nobody reads (the search of a fit: identification, diagnosis).
+  bool stiff_check = true;
   //! Rk4: substeps per sample; 0 = automatic (rk4_automatic_substeps in plant.hpp): the fewest with
   //! h * rho(J) <= rk4_h_rho, rho the largest spectral radius of the Jacobian over the operating
   //! states the loop can reach (rest, pressure up to 0.9 p_s, spool at its stops, sliding), chosen at
@@ -115,6 +119,8 @@ inline constexpr SolverOptionField kSolverOptionFields[] = {
     {"max_internal_step", &SolverOptions::max_internal_step, "s", "CVODE/ARKODE maximum step (0 = no limit)"},
     {"stiff_steps", &SolverOptions::stiff_steps, "", "dopri5: steps in one sample beyond which it is stiff"},
     {"stiff_fallback", &SolverOptions::stiff_fallback, "", "dopri5: redo a stiff sample with CVODE"},
+    {"stiff_check", &SolverOptions::stiff_check, "",
+     "dopri5: check a run that turned stiff by a shadow run at rtol / 10 (flags inaccurate samples)"},
     {"rk4_substeps", &SolverOptions::rk4_substeps, "", "RK4 substeps per sample (0 = automatic)"},
     {"rk4_h_rho", &SolverOptions::rk4_h_rho, "", "RK4 automatic substeps: bound on h * rho(J)"},
     {"rk4_v_ref", &SolverOptions::rk4_v_ref, "m/s",

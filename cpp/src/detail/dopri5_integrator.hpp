@@ -30,8 +30,8 @@ class BasicDopri5Integrator {
   using Input = typename Sys::Input;
 
   //! Creates the CVODE fallback (if options.stiff_fallback) primed from y_prime, and with it (if
-  //! `checked`) the check below: a second BasicDopri5Integrator at rtol / kShadowTighten, unchecked;
-  //! may throw Error.
+  //! `checked`: the plants pass options.stiff_check) the check below: a second BasicDopri5Integrator
+  //! at rtol / kShadowTighten, unchecked; may throw Error.
   BasicDopri5Integrator(const System& sys, double dt, const SolverOptions& options, const State& y_prime,
                         bool checked = true);
 
