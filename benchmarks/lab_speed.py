@@ -197,7 +197,7 @@ def run_case(case: str) -> dict:
                 "result": {"values": {k: p["value"] for k, p in js["parameters"].items()},
                            "std": {k: p["std"] for k, p in js["parameters"].items()},
                            "nrmse_after": js["records"][0]["after"], "kept": js["kept"], "costs": js["costs"],
-                           "runtime_s": js["runtime_s"], "nfev": js["nfev"], "segments": js.get("segments")}}
+                           "runtime_s": js["runtime_s"], "nfev": js["nfev"], "runs": js.get("runs")}}
     if case in ("diagnose10", "sweep1A", "diagnose10sim"):
         if case == "diagnose10sim":
             rec, rig, mode, key = _simulated_record()
