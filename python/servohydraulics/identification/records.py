@@ -199,11 +199,11 @@ def key_status(coords: Coordinates, z: np.ndarray, identified: np.ndarray) -> li
     return ["at bound" if a else ("identified" if ok else "not identified") for a, ok in zip(at, identified)]
 
 
-def uncertainty(stage: StageResult, coords: Coordinates, lengths: list[int]) -> dict[str, Any]:
-    """The HAC covariance (``stats.covariance``) of the fit in its coordinates and, per key, its
-    status, standard error and 95 % interval in the key's unit; plus the correlation matrix and
-    the AR(1) summary of the residual (lag-1 rho, effective samples)."""
-    cov = covariance(stage.jac, stage.fun, None, lengths)
+def uncertainty(stage: StageResult, coords: Coordinates, lengths: list[int], cov=None) -> dict[str, Any]:
+    """The HAC covariance (``stats.covariance``; ``cov`` when already computed) of the fit in its
+    coordinates and, per key, its status, standard error and 95 % interval in the key's unit; plus
+    the correlation matrix and the AR(1) summary of the residual (lag-1 rho, effective samples)."""
+    cov = covariance(stage.jac, stage.fun, None, lengths) if cov is None else cov
     status = key_status(coords, stage.z, cov.identified)
     zq, sd_z = quantile(LEVEL), cov.sd
     intervals, std = {}, {}
@@ -381,7 +381,8 @@ def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options,
     ``fit.keep_best`` of the start and the stages, on the runs of ``_fit_target`` (checked against
     the pair's whole runs ``before`` of the start, and against those of the result: where they
     disagree the result is polished on the pair's whole runs); returns keep_best's result, the
-    evaluations, the whole runs of the result and how the time stage ran (``Identification.runs``)."""
+    evaluations, the whole runs of the result, how the time stage ran (``Identification.runs``) and the
+    result's ``stats.covariance``."""
     from tqdm.auto import tqdm
 
     workers = default_workers() if workers is None else max(1, int(workers))
@@ -397,7 +398,8 @@ def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options,
                 nfev += n
             kept = keep_best(target, start, coords, stages, bar)
             after = _whole_runs(coords.apply(start, kept[3].z), recs, mode, dt, options, workers)
-            runs["shift_sd"] = _shift(target, coords.apply(start, kept[3].z), after, kept[2], kept[3])
+            cov = covariance(kept[3].jac, kept[3].fun, None, target.lengths)
+            runs["shift_sd"] = _shift(target, coords.apply(start, kept[3].z), after, kept[2], kept[3], cov)
             if not runs["shift_sd"] <= SHIFT_SD:  # polish on the pair's whole runs
                 target.close()
                 target = Target(recs, mode, chans, _unchecked(options), dt, [whole(r) for r in recs], workers)
@@ -406,9 +408,10 @@ def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options,
                 nfev += n
                 kept = keep_best(target, start, coords, stages, bar)
                 after = _whole_runs(coords.apply(start, kept[3].z), recs, mode, dt, options, workers)
+                cov = covariance(kept[3].jac, kept[3].fun, None, target.lengths)
         finally:
             target.close()
-    return (*kept, nfev, after, runs)
+    return (*kept, nfev, after, runs, cov)
 
 
 #: the time stage's result stands when the pair's whole runs would move it by at most this fraction
@@ -416,17 +419,18 @@ def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options,
 SHIFT_SD = 0.1
 
 
-def _shift(target: Target, rig, after: list, weights: dict, final: StageResult) -> float:
+def _shift(target: Target, rig, after: list, weights: dict, final: StageResult, cov) -> float:
     """How far the pair's whole runs ``after`` of the result would move it, in standard errors: the
     Gauss-Newton step from the target's residual to theirs, (J'J)^+ J' d with d the difference of the
     two weighted residuals at the result and J the result's Jacobian, over each identified key's
     standard error (``stats.covariance``, the rule of the reported intervals); the largest, inf when
-    a run failed or differs by more than 10 ``segments.AGREEMENT`` somewhere."""
+    a run failed or differs by more than 10 ``segments.AGREEMENT`` somewhere.  ``cov``: the
+    result's ``stats.covariance``."""
     d = target.residual(rig, weights) - target.of(after, weights)
     if not np.all(np.isfinite(d)) or np.max(np.abs(d)) > 10 * AGREEMENT * max(weights.values()):
         return float("inf")
     step = np.linalg.lstsq(final.jac, d, rcond=None)[0]
-    sd = covariance(final.jac, final.fun, None, target.lengths).sd
+    sd = cov.sd
     ok = np.isfinite(sd) & (sd > 0)
     return float(np.max(np.abs(step[ok]) / sd[ok])) if ok.any() else 0.0
 
@@ -501,11 +505,11 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
     options = fit_options(coords.apply(start, z1), recs, mode)
     t0 = time.perf_counter()
     before_runs = _whole_runs(start, recs, mode, dt, options, default_workers() if workers is None else workers)
-    kept, costs, weights, final, nfev["time"], after_runs, runs = _time_stages(
+    kept, costs, weights, final, nfev["time"], after_runs, runs, cov = _time_stages(
         recs, start, coords, z1, frequency_stage, mode, chans, options, dt, max_nfev, progress, workers, before_runs)
     runtime["time"] = time.perf_counter() - t0
     lengths = [r.time.size for r in recs for _ in chans]
-    u = uncertainty(final, coords, lengths)
+    u = uncertainty(final, coords, lengths, cov)
     values = {k: float(v) for k, v in zip(keys, coords.values(final.z))}
     s1_vals = coords.values(z1)
     out_rig = coords.apply(start, final.z)
