@@ -22,6 +22,7 @@ from ..identification.records import as_records
 from ..identification.run import controller_ratio
 from ..rig import Rig, rig_to_dict
 from ..simulate import MODES
+from ..workers import single_blas_thread
 from . import engine
 from .confirm import confirm, param_report
 from .effects import LIBRARY, Context, check_names, nested, separating_experiment
@@ -186,6 +187,7 @@ class _Passing:
     screening: Screening
 
 
+@single_blas_thread  # the simulations' threads need the cores (workers.blas_threads)
 def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = True,
              keep: int = KEEP, max_effects: int = MAX_EFFECTS, candidates: Sequence[str] | None = None,
              refit_interacting: bool = True, joint_refit: bool = True, dt: float | None = None, layout=None,

@@ -7,13 +7,15 @@
   weighted by the coherence.  Keys that do not change the linear model
   (friction, hysteresis) are left for stage 2.
 * :func:`fit_time` (stage 2): the records' commands simulated through the
-  nonlinear model (the fast integrator, :func:`fit_options`), the residual
-  (sim - measured) / std(measured) of every channel (optionally weighted per
-  channel), minimised by ``scipy.optimize.least_squares`` (trust region
-  reflective, Jacobian by forward differences of 0.1 % steps in the fitting
-  coordinates, its columns on two threads) over the active keys.
-  ``records.py`` runs it block by block (loop keys on the
-  displacement, force keys on the force) in displacement control.
+  nonlinear model (a ``segments.Target``: the records in segments on the threads,
+  RK4 at a fixed number of substeps, :data:`RK4_SUBSTEPS`, or the error-controlled
+  pair, :func:`fit_options`), the residual (sim - measured) / std(measured) of every
+  channel (optionally weighted per channel), minimised by
+  ``scipy.optimize.least_squares`` (trust region reflective, Jacobian by forward
+  differences of 0.1 % steps in the fitting coordinates, its columns' runs together
+  on the threads) over the active keys.  ``records.py`` runs it block by block
+  (loop keys on the displacement, force keys on the force) in displacement control,
+  and checks the result against the pair's whole runs.
 * :func:`keep_best`: the start and the stages compared by the time-domain cost
   (:func:`time_costs`), the best kept, so that identification never ends worse
   than it starts (``sh.diagnose`` keeps the same invariant for its candidate

@@ -35,6 +35,7 @@ from ..atomic import FileSet, check_folder
 from ..records import read_record
 from ..response import Response
 from ..rig import Rig, load_rig, save_rig
+from ..workers import single_blas_thread
 from .checks import check_accept, gate
 from .compare import Comparison, channels_of, compare, save_figures, write_json
 from .coordinates import FORCE_KEYS, LOOP_KEYS, Coordinates, check_keys, specimen_keys, use_specimen
@@ -453,6 +454,7 @@ def _whole_runs(rig, recs, mode, dt, options, workers) -> list:
         return list(pool.map(lambda r: simulate_record(rig, r, mode, dt=dt, options=options), recs))
 
 
+@single_blas_thread  # the simulations' threads need the cores (workers.blas_threads)
 def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | None = None,
              mode: str = "displacement", specimen: str | None = None, channels: Sequence[str] | None = None,
              dt: float | None = None, frequency_stage: bool = True, max_nfev: int = 60,
