@@ -2,6 +2,7 @@
 
     python benchmarks/lab_speed.py [--cases identify,diagnose10,diagnose10sim,sweep1A] [--json FILE]
                                    [--profile] [--label NAME]
+    python benchmarks/lab_speed.py --table benchmarks/lab_speed.json
 
 The cases (records from ../shared/real-data/utfsm-mts-mrdamper, or $SH_SHARED_DIR/real-data/...):
 
@@ -232,13 +233,44 @@ def _quiet():
         sys.stdout = old
 
 
+def _summary(case: str, res: dict) -> str:
+    """What the case found, for the table: the identified NRMSE, or the verdict and effects."""
+    r = res["result"]
+    if case == "identify":
+        n = r["nrmse_after"]
+        return f"NRMSE x {n['displacement']:.4f} %, F {n['force']:.4f} %"
+    names = ", ".join(r["effects"]) or "-"
+    return f"{r['verdict']}: {names}"
+
+
+def table(path: Path, labels: list[str] | None = None) -> str:
+    """The saved runs (``--json``) as a markdown table, one row per label and case."""
+    saved = json.loads(path.read_text())
+    rows = ["| case | run | wall [s] | load (1 min) | CPU [s] | simulations | least-squares iterations / residuals "
+            "| result |", "|---|---|---|---|---|---|---|---|"]
+    for case in CASES:
+        for label in labels or list(saved):
+            res = saved.get(label, {}).get("cases", {}).get(case)
+            if res is None:
+                continue
+            load = f"{res['load_before'][0]:.1f} -> {res['load_after'][0]:.1f}"
+            rows.append(f"| {case} | {label} | {res['wall_s']:.1f} | {load} | {res['cpu_s']:.1f} "
+                        f"| {res['simulations']} | {res['least_squares_iterations']} / "
+                        f"{res['least_squares_residuals']} | {_summary(case, res)} |")
+    return "\n".join(rows)
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--cases", default=",".join(CASES), help=f"comma-separated, of {', '.join(CASES)}")
     p.add_argument("--json", help="write the results here (appended under --label)")
     p.add_argument("--label", default="run", help="name of this run in the JSON (e.g. before, after)")
     p.add_argument("--profile", action="store_true", help="cProfile's top functions per case (main thread)")
+    p.add_argument("--table", metavar="FILE", help="print the runs saved in FILE (--json) as a markdown table")
     a = p.parse_args()
+    if a.table:
+        print(table(Path(a.table)))
+        return
     import servohydraulics as sh
 
     cases = [c.strip() for c in a.cases.split(",") if c.strip()]

@@ -22,8 +22,9 @@
    regenerated wholesale except the sections between the markers
    <!-- BEGIN soak --> and <!-- END soak --> (written by the soak benchmark)
    and <!-- BEGIN accuracy-26 --> and <!-- END accuracy-26 --> (the tables of
-   evaluation/accuracy_tables.py), which are kept as they are; the random-rig accuracy counts come from
-   evaluation/accuracy_random_rigs.json (and _before.json), written by
+   evaluation/accuracy_tables.py) and <!-- BEGIN lab-speed --> and <!-- END lab-speed -->
+   (benchmarks/lab_speed.py's timings of identify and diagnose), which are kept as they are; the
+   random-rig accuracy counts come from evaluation/accuracy_random_rigs.json (and _before.json), written by
    evaluation/accuracy_random_rigs.py.
 """
 
@@ -127,6 +128,8 @@ def python_runs(sh) -> dict:
 SOAK_BEGIN, SOAK_END = "<!-- BEGIN soak -->", "<!-- END soak -->"
 #: The issue-26 accuracy section (evaluation/accuracy_tables.py's tables and their commands), kept too.
 ACC26_BEGIN, ACC26_END = "<!-- BEGIN accuracy-26 -->", "<!-- END accuracy-26 -->"
+#: The lab-record timings (benchmarks/lab_speed.py's tables and their commands), kept too.
+LAB_BEGIN, LAB_END = "<!-- BEGIN lab-speed -->", "<!-- END lab-speed -->"
 
 
 def kept_section(md_path: Path, begin: str = SOAK_BEGIN, end: str = SOAK_END) -> str:
@@ -143,8 +146,8 @@ def kept_section(md_path: Path, begin: str = SOAK_BEGIN, end: str = SOAK_END) ->
 
 
 def write_markdown(report: dict, md_path: Path) -> None:
-    """Writes the page (to a temporary file, then renamed: never half-written), keeping the soak and
-    issue-26 accuracy sections."""
+    """Writes the page (to a temporary file, then renamed: never half-written), keeping the soak,
+    issue-26 accuracy and lab-speed sections."""
     md_path = Path(md_path)
     accuracy = {}
     for key in ("after", "before"):
@@ -152,7 +155,8 @@ def write_markdown(report: dict, md_path: Path) -> None:
         f = ROOT / "evaluation" / name
         if f.exists():
             accuracy[key] = json.loads(f.read_text())
-    text = markdown(report, accuracy, kept_section(md_path), kept_section(md_path, ACC26_BEGIN, ACC26_END))
+    text = markdown(report, accuracy, kept_section(md_path), kept_section(md_path, ACC26_BEGIN, ACC26_END),
+                    kept_section(md_path, LAB_BEGIN, LAB_END))
     tmp = md_path.with_suffix(".md.tmp")
     tmp.write_text(text)
     tmp.replace(md_path)
@@ -366,7 +370,7 @@ def _fmt(v: float, nd: int = 2) -> str:
 
 
 def markdown(r: dict, accuracy: dict | None = None, soak: str = f"{SOAK_BEGIN}\n{SOAK_END}",
-             accuracy_26: str = f"{ACC26_BEGIN}\n{ACC26_END}") -> str:
+             accuracy_26: str = f"{ACC26_BEGIN}\n{ACC26_END}", lab: str = f"{LAB_BEGIN}\n{LAB_END}") -> str:
     cpp = r["cpp"]
     m = r["machine"]
     rec = r["record"]
@@ -534,7 +538,7 @@ def markdown(r: dict, accuracy: dict | None = None, soak: str = f"{SOAK_BEGIN}\n
                  if m in rows else "-" for m in ("dopri5", "rk4", "cvode_bdf")]
         lines.append(f"| {label}: median <= 5 us, p99.9 <= 25 us | " + " | ".join(cells) + " |")
     lines += ["", "Wall-time maxima and p99.9 tails include the OS preempting the benchmark on the shared machine "
-              "(compare the CPU-time column of the per-step table).", "", soak, ""]
+              "(compare the CPU-time column of the per-step table).", "", soak, "", lab, ""]
     return "\n".join(lines) + "\n"
 
 
