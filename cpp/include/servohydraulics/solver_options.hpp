@@ -46,6 +46,10 @@ struct SolverOptions {
   //! samples) that flags Status::inaccurate where the two differ by more than 5e-4 of the run's
   //! peak displacement or force (dopri5_integrator.hpp).
   bool stiff_fallback = true;
+  //! Dopri5 with stiff_fallback: check a run that turned stiff (the shadow above, and for a whole
+  //! record run_record's caller may run check_record: record.hpp).  false: no check (the second run
+  //! of check_record itself; a caller that pays for neither).
+  bool stiff_check = true;
   //! Rk4: substeps per sample; 0 = automatic (rk4_automatic_substeps in plant.hpp): the fewest with
   //! h * rho(J) <= rk4_h_rho, rho the largest spectral radius of the Jacobian over the operating
   //! states the loop can reach (rest, pressure up to 0.9 p_s, spool at its stops, sliding), chosen at
@@ -115,6 +119,8 @@ inline constexpr SolverOptionField kSolverOptionFields[] = {
     {"max_internal_step", &SolverOptions::max_internal_step, "s", "CVODE/ARKODE maximum step (0 = no limit)"},
     {"stiff_steps", &SolverOptions::stiff_steps, "", "dopri5: steps in one sample beyond which it is stiff"},
     {"stiff_fallback", &SolverOptions::stiff_fallback, "", "dopri5: redo a stiff sample with CVODE"},
+    {"stiff_check", &SolverOptions::stiff_check, "",
+     "dopri5: check a run that turned stiff against a run at rtol / 10 (flags where it may miss 1e-3)"},
     {"rk4_substeps", &SolverOptions::rk4_substeps, "", "RK4 substeps per sample (0 = automatic)"},
     {"rk4_h_rho", &SolverOptions::rk4_h_rho, "", "RK4 automatic substeps: bound on h * rho(J)"},
     {"rk4_v_ref", &SolverOptions::rk4_v_ref, "m/s",
