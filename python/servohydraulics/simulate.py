@@ -30,7 +30,8 @@ def solver_options(method: str = DEFAULT_METHOD, rtol: float | None = None, rest
                    max_order: int | None = None, rk4_h_rho: float | None = None,
                    rk4_v_ref: float | None = None, atol_fraction: float | None = None,
                    stiff_fallback: bool | None = None, stiff_steps: int | None = None,
-                   stiff_check: bool | None = None, rk4_flag_rtol: float | None = None, rk4_max_refinements: int | None = None,
+                   stiff_check: bool | None = None, rk4_flag_rtol: float | None = None,
+                   rk4_max_refinements: int | None = None,
                    max_internal_step: float | None = None) -> _core.SolverOptions:
     """Builds solver options; see ``SolverOptions`` in solver_options.hpp (one keyword per row of
     its field table, ``_core.SOLVER_OPTION_FIELDS``).
@@ -55,7 +56,8 @@ def solver_options(method: str = DEFAULT_METHOD, rtol: float | None = None, rest
             max_steps_per_sample=max_steps_per_sample, max_order=max_order, rk4_h_rho=rk4_h_rho,
             rk4_v_ref=rk4_v_ref, atol_fraction=atol_fraction,
             stiff_fallback=None if stiff_fallback is None else bool(stiff_fallback), stiff_steps=stiff_steps,
-            stiff_check=None if stiff_check is None else bool(stiff_check), rk4_flag_rtol=rk4_flag_rtol, rk4_max_refinements=rk4_max_refinements,
+            stiff_check=None if stiff_check is None else bool(stiff_check), rk4_flag_rtol=rk4_flag_rtol,
+            rk4_max_refinements=rk4_max_refinements,
             max_internal_step=max_internal_step)
     o.validate()
     return o
