@@ -42,6 +42,7 @@ from .fit import (
     StageResult,
     best,
     channel_weights,
+    checked_options,
     fit_frequency,
     fit_options,
     fit_time,
@@ -403,7 +404,8 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
     t0 = time.perf_counter()
     before = [compare(r, start, mode, simulated=simulate_record(start, r, mode, dt=dt, options=options), check=False)
               for r in recs]
-    after = [compare(r, out_rig, mode, simulated=simulate_record(out_rig, r, mode, dt=dt, options=options),
+    after = [compare(r, out_rig, mode, simulated=simulate_record(out_rig, r, mode, dt=dt,
+                                                                 options=checked_options(options)),
                      accept=accept, check=False) for r in recs]
     runtime["compare"] = time.perf_counter() - t0
     runtime["total"] = time.perf_counter() - t_start
