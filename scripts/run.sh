@@ -133,7 +133,8 @@ case "${1:-}" in
     # Run pytest from the tests directory so that the installed package is the one imported;
     # one worker process per core (pytest-xdist): the diagnosis tests dominate and are independent.
     # Tests marked slow (diagnosis runs of a minute or more each) are left to `test-all`.
-    PATH="$venv/bin:$PATH" "$venv/bin/python" -m pytest "$root/tests/python" -q -p no:cacheprovider -n auto -m "not slow"
+    PATH="$venv/bin:$PATH" "$venv/bin/python" -m pytest "$root/tests/python" -q -p no:cacheprovider -n auto -m "not slow" \
+      --durations=15
     ;;
   test-all)
     system_deps; python_env tests
