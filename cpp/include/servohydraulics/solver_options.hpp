@@ -44,7 +44,8 @@ struct SolverOptions {
   //! Dopri5: redo a stiff sample with CVODE (Status::stiff set).  A run that has turned stiff is
   //! checked from then to its end by a second run at rtol / 10 (dopri5, CVODE for its stiff
   //! samples) that flags Status::inaccurate where the two differ by more than 5e-4 of the run's
-  //! peak displacement or force (dopri5_integrator.hpp).
+  //! peak displacement or force (dopri5_integrator.hpp); a whole record can be checked from its
+  //! start as well (check_record, record.hpp).
   bool stiff_fallback = true;
   //! Dopri5 with stiff_fallback: check a run that turned stiff (the shadow above, and for a whole
   //! record run_record's caller may run check_record: record.hpp).  false: no check (the second run
