@@ -32,10 +32,10 @@ import time
 from pathlib import Path
 
 import numpy as np
-from doc_tables import write_between  # evaluation/ (the script's own folder)
+from doc_tables import UTFSM_DATA, utfsm_start, write_between  # evaluation/ (the script's own folder)
 
 ROOT = Path(__file__).resolve().parents[1]
-DATA = Path(os.environ.get("SH_SHARED_DIR", ROOT.parent / "shared")) / "real-data" / "utfsm-mts-mrdamper"
+DATA = UTFSM_DATA
 SWEEPS = {"sweep15Hz_0A": 0.0, "sweep15Hz_0p5A": 0.5, "sweep15Hz_1A": 1.0}
 CHIRPS = {"chirp20Hz_0A": 0.0, "chirp20Hz_1A": 1.0}
 #: training set -> (records, the records predicted)
@@ -262,18 +262,12 @@ def main(argv=None) -> int:
                    help="training sets: may (a), june (b); \"\": only the tables, from an earlier run into --out")
     p.add_argument("--no-docs", action="store_true", help="do not rewrite docs/lab-records.md or the figure")
     args = p.parse_args(argv)
-    sys.path.insert(0, str(ROOT / "python"))
-    import servohydraulics as sh
-
-    data = Path(args.data)
-    if not data.is_dir():
-        print(f"UTFSM records not found in {data}: see docs/lab-records.md", file=sys.stderr)
+    start = utfsm_start(args.data, CURRENT, args.out)
+    if start is None:
         return 2
+    sh, records, out = start
     laws = [x.strip() for x in args.laws.split(",") if x.strip()]
     sets = [x.strip() for x in args.sets.split(",") if x.strip()]
-    records = {n: sh.read_record(data / f"{n}.csv") for n in CURRENT}
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     saved = out / "utfsm_current_law.json"
     # the sets and laws of an earlier run into the same --out are kept (one table from both runs)
     earlier = json.loads(saved.read_text()) if saved.exists() else {}

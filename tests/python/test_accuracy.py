@@ -69,13 +69,18 @@ def test_the_flags_do_not_fire_on_clearly_accurate_runs(survey):
 def test_never_silently_off_on_the_wide_and_high_gain_families(family):
     """Issue 26, defect 4: the families where the default missed silently (masses, areas, gains and
     compressibility over decades; loop gains to 500 with stiff oil), drawn at a seed of their own:
-    no silent miss of either method, and the flags fire on no run within a fifth of the tolerance."""
+    no silent miss of either method, and the default's flag fires on no run within a fifth of its
+    tolerance.  RK4's may, rarely: it flags a sample whose load-cell force would jump (a velocity
+    reversal at a near-Coulomb friction) within the band of states its error spans, also when the
+    run happened to land on the right side (wide rig 0 at this seed: 2.5e-4 off, flagged); at most
+    one in twenty of the runs."""
     res = ar.survey(sh, 40, seed=2026, duration=0.4, progress=False, family=family,
                     methods=("default", "rk4") if family == "wide" else ("default",))
     for which in res["methods"]:
         c = res["counts"][which]
         assert c["silent"] == 0, f"{family}, {which}: silent wrong answers {c['silent_cases']}"
-        assert not [e for e, f in _runs(res, which) if f and e <= 0.2 * ar.TOLERANCE[which]]
+        clear = [e for e, f in _runs(res, which) if f and e <= 0.2 * ar.TOLERANCE[which]]
+        assert len(clear) <= (0.05 * len(_runs(res, which)) if which == "rk4" else 0), clear
 
 
 def test_the_default_is_accurate_not_merely_flagged(survey):
@@ -191,3 +196,48 @@ def test_the_cli_warns_when_the_default_misses(tmp_path, capsys):
                   np.max(np.abs(rec.force - ref.force)) / np.max(np.abs(ref.force)))
         assert bool(gap > ar.TOLERANCE["default"]) is misses, gap
         assert ("warning: the run turned stiff and its check" in err) is misses, err
+
+
+def _family_case(family: str, seed: int, index: int, duration: float = 1.0, dt: float = 5e-4):
+    """Case `index` of evaluation/accuracy_random_rigs.py's draw of `family` at `seed`."""
+    rng = np.random.default_rng(seed)
+    for _ in range(index + 1):
+        rig, mode, u = ar.family_case(sh, rng, duration, dt, family)
+    return rig, mode, u
+
+
+def _reference(rig, mode, u):
+    return sh.simulate(rig, mode, u, options=ar._options(sh, "reference"))
+
+
+def test_a_run_that_turned_stiff_is_checked_from_its_start():
+    """Issue 26, defect 4, the last silent miss of the default (random family, seed 17, rig 41: a
+    force loop that rings at the end of the record): the error of the explicit samples before the
+    first stiff one is amplified later, in the result and in the shadow that starts there alike
+    (the shadow's gap read 0.39 of its bound).  The whole-record check, a second run at rtol / 10
+    from the start, sees it: the run is 1.03e-3 off the explicit reference at rtol 1e-10 and says
+    so; with that check off only the shadow's verdict is left, under its bound."""
+    rig, mode, u = _family_case("random", 17, 41)
+    ref = _reference(rig, mode, u)
+    run = sh.simulate(rig, mode, u)
+    assert run.work.stiff_samples > 0
+    assert ar._error(run, ref) > ar.TOLERANCE["default"]
+    assert run.work.error_estimate > 1
+    assert any(code == "run_accuracy" for code, _ in run.notes())
+    # the same run with the checks off: bit-identical, and nothing says it misses
+    unchecked = sh.simulate(rig, mode, u, options=sh.solver_options(stiff_check=False))
+    assert np.array_equal(unchecked.force, run.force) and unchecked.work.error_estimate == 0
+
+
+def test_rk4_flags_a_force_that_jumps_at_a_friction_reversal():
+    """Issue 26, defect 4, the last silent miss of RK4 (high-gain family, seed 17, rig 61: 1.4 kg
+    moving, 914 N of near-Coulomb friction, force loop gain 315): at the sample where the velocity
+    reverses, RK4 and its companion at twice the substeps both land on the wrong side of zero, so
+    the load-cell force is 2 F_c off (10 % of the peak) in both and their gap is small.  The check
+    also measures how much a checked value bends over the band of states the run's error spans:
+    the friction's sign flips inside it, and the run is flagged."""
+    rig, mode, u = _family_case("high_gain", 17, 61)
+    ref = _reference(rig, mode, u)
+    rk4 = sh.simulate(rig, mode, u, options=sh.solver_options(method="rk4"))
+    assert ar._error(rk4, ref) > ar.TOLERANCE["rk4"]
+    assert rk4.work.error_estimate > 1 and rk4.work.inaccurate_samples > 0

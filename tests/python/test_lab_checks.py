@@ -144,6 +144,21 @@ def test_the_simulated_runs_limits_are_checks(files, tmp_path):
     assert "[run_spool]" in err
 
 
+def test_diagnose_reports_the_nominal_runs_limits(files, tmp_path):
+    """Issue 25, item 4, for ``diagnose``: the same small-spool rig's nominal run saturates the
+    spool on this record, and the diagnosis says so (``run_spool`` in its checks, with the time),
+    as ``compare`` does; the preset's own run hits nothing."""
+    rig = sh.zhao2003()
+    rig.x_v_max = 0.003
+    rig.effects.spool_saturation = True
+    d = sh.diagnose([files["m"]], rig, "displacement", progress=False, max_effects=1, candidates=["leakage"])
+    spool = [c for c in d.checks if c.code == "run_spool"]
+    assert spool and "servovalve spool saturated" in spool[0].message, d.checks
+    clean = sh.diagnose([files["m"]], sh.zhao2003(), "displacement", progress=False, max_effects=1,
+                        candidates=["leakage"])
+    assert not [c for c in clean.checks if c.code.startswith("run_")], clean.checks
+
+
 @pytest.mark.parametrize("accept, words", [
     ("bogus", ["invalid accept = 'bogus'", "not a check"]),
     ("displacement_outside_stroke", ["invalid accept = 'displacement_outside_stroke'", "cannot be acknowledged"]),

@@ -8,6 +8,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "servohydraulics/channels.hpp"
@@ -66,6 +67,27 @@ struct RunSummary {
 //! Runs n samples from the plant's current state.  No allocation, no throw:
 //! stops at the first failed sample and reports it.
 RunSummary run_record(Plant& plant, const double* command, std::size_t n, const Channels& out) noexcept;
+
+//! The default's check of a whole record.  Dopri5's shadow follows a run from its first stiff
+//! sample, so an error made before it that the loop amplifies later is in the result and in the
+//! shadow alike (a high-gain force loop ringing at the end of a record: 1.03e-3 off while the
+//! shadow's gap read 0.39 of its bound; docs/benchmarks.md).  When the whole record is at hand,
+//! a run that turned stiff is checked from its start: a second run of the same set-up at
+//! rtol / 10 (its own check off), started where the run started, over the same commands.
+//!
+//! record_check_options: the second run's options, or nothing when the run needs no such check
+//! (not Dopri5 with stiff_fallback and stiff_check, no stiff sample, or a failed run).
+std::optional<SolverOptions> record_check_options(const SolverOptions& run, const RunSummary& summary) noexcept;
+
+//! Runs `companion` (a plant set up as the run's with record_check_options, reset to the run's
+//! start) over command[0..n) and compares its displacement and load-cell force with the run's
+//! (x, F: the result's rows, `rows` of them, rows <= n) relative to the run's peaks (the floors
+//! of the shadow's measure, detail/output_gap.hpp): summary.error_estimate becomes the larger of
+//! its own and that gap over the shadow's bound (5e-4 of the peaks), so > 1 says the run may miss
+//! the default's 1e-3.  A companion that fails is compared over the rows it ran.  Allocates (its
+//! rows): not for a real-time step.
+void check_record(Plant& companion, const double* command, std::size_t n, const double* x, const double* F,
+                  std::size_t rows, RunSummary& summary);
 
 //! Every channel as vectors, for C++ users who want a convenient result.
 //! Row k holds the sensors at t_k, before command[k] (the convention above).

@@ -44,11 +44,12 @@ struct SolverOptions {
   //! Dopri5: redo a stiff sample with CVODE (Status::stiff set).  A run that has turned stiff is
   //! checked from then to its end by a second run at rtol / 10 (dopri5, CVODE for its stiff
   //! samples) that flags Status::inaccurate where the two differ by more than 5e-4 of the run's
-  //! peak displacement or force (dopri5_integrator.hpp).
+  //! peak displacement or force (dopri5_integrator.hpp); a whole record can be checked from its
+  //! start as well (check_record, record.hpp).
   bool stiff_fallback = true;
-  //! Dopri5 with the fallback: check a run that has turned stiff by the shadow run above (false: no
-  //! shadow, no Status::inaccurate flag, no work for it; the result itself is the same to the bit).
-  //! For runs whose flags nobody reads (the search of a fit: identification, diagnosis).
+  //! Dopri5 with stiff_fallback: check a run that turned stiff (the shadow above, and for a whole
+  //! record run_record's caller may run check_record: record.hpp).  false: no check (the second run
+  //! of check_record itself; a caller that pays for neither).
   bool stiff_check = true;
   //! Rk4: substeps per sample; 0 = automatic (rk4_automatic_substeps in plant.hpp): the fewest with
   //! h * rho(J) <= rk4_h_rho, rho the largest spectral radius of the Jacobian over the operating
@@ -120,7 +121,7 @@ inline constexpr SolverOptionField kSolverOptionFields[] = {
     {"stiff_steps", &SolverOptions::stiff_steps, "", "dopri5: steps in one sample beyond which it is stiff"},
     {"stiff_fallback", &SolverOptions::stiff_fallback, "", "dopri5: redo a stiff sample with CVODE"},
     {"stiff_check", &SolverOptions::stiff_check, "",
-     "dopri5: check a run that turned stiff by a shadow run at rtol / 10 (flags inaccurate samples)"},
+     "dopri5: check a run that turned stiff against a run at rtol / 10 (flags where it may miss 1e-3)"},
     {"rk4_substeps", &SolverOptions::rk4_substeps, "", "RK4 substeps per sample (0 = automatic)"},
     {"rk4_h_rho", &SolverOptions::rk4_h_rho, "", "RK4 automatic substeps: bound on h * rho(J)"},
     {"rk4_v_ref", &SolverOptions::rk4_v_ref, "m/s",

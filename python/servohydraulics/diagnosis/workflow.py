@@ -17,11 +17,11 @@ from typing import Any
 
 import numpy as np
 
-from ..identification.checks import gate
+from ..identification.checks import gate, run_checks, settle
 from ..identification.records import as_records
-from ..identification.run import controller_ratio
+from ..identification.run import controller_ratio, simulate_command
 from ..rig import Rig, rig_to_dict
-from ..simulate import MODES
+from ..simulate import MODES, SimulationError
 from ..workers import single_blas_thread
 from . import engine
 from .confirm import confirm, param_report
@@ -235,6 +235,7 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
     sims0 = engine.simulate_all(current, setup.cases, 0.0, x0)
     if any(s is None for s in sims0):
         raise ValueError("the nominal rig's simulation fails on this record: check the rig and --mode")
+    checks += _nominal_run_checks(current, setup.cases, x0, accept)
     setup = dataclasses.replace(setup, bar=_progress(max_effects * (len(setup.names) + keep), progress, "diagnose"))
     state = _State(rig=current, tau=0.0, x0=x0, sims=sims0, history=[("nominal", engine.gap(sims0, setup.cases))])
     last = None
@@ -249,6 +250,19 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
     d = _result(setup, state, sims0, last, time.time() - t_start)
     d.checks, d.dt = checks, dt
     return d
+
+
+def _nominal_run_checks(rig: Rig, cases: list[Case], x0s, accept) -> list:
+    """The nominal rig's run of each record as ``compare`` reports it (issue 25, item 4): the
+    stroke, capacity, supply, spool and drive limits it hit and its solver notes, as checks."""
+    out = []
+    for case, x0 in zip(cases, x0s):
+        try:
+            sim = simulate_command(rig, case.mode, case.u, case.dt, float(x0), None, dt=case.controller_dt)
+        except (SimulationError, ValueError):
+            continue  # the engine's own run (CVODE as the fallback) went through: nothing to add here
+        out += settle(run_checks(sim, rig, case.name), accept)
+    return out
 
 
 def _prepare(records, rig: Rig, mode: str, candidates: Sequence[str] | None, keep: int, refit_interacting: bool,

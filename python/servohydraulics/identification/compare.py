@@ -69,7 +69,7 @@ class Comparison:
     warnings: list = field(default_factory=list)  #: the simulated run's limits and solver notes (``Response.warnings``)
     checks: list = field(default_factory=list)  #: ``checks.Check``: the record's plausibility and the run's limits
     command: np.ndarray | None = field(default=None, repr=False)  #: the record's command (for the zoom windows)
-    field: dict | None = None  #: the MR damper's field input the record ran at (input, value, unit, law), else None
+    field_input: dict | None = None  #: the MR damper field input of the record (input, value, unit, law), or None
 
     def nrmse(self, channel: str) -> float:
         return self.channels[channel]["nrmse_pct"]
@@ -79,7 +79,7 @@ class Comparison:
                 "dt_s": float(self.time[1] - self.time[0]), "command_band_hz": self.f_max,
                 "definition": "nrmse_pct = 100 rms(sim - measured) / std(measured); nrmse_demeaned_pct: the "
                               "error's mean removed; frf: H1 = S_uy/S_uu (Welch, Hann, nperseg) of channel/command",
-                "warnings": self.warnings, "checks": [c.to_dict() for c in self.checks], "field": self.field,
+                "warnings": self.warnings, "checks": [c.to_dict() for c in self.checks], "field": self.field_input,
                 "channels": self.channels}
 
     def figure_names(self) -> list[str]:
@@ -193,7 +193,7 @@ def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, opti
                                                       str(record.path or record_name(record))), accept))
     if rig.effects.mr_damper:
         kind, value = rig_field(rig)
-        out.field = {"input": kind, "value": value, "unit": FIELD_INPUTS[kind][1],
+        out.field_input = {"input": kind, "value": value, "unit": FIELD_INPUTS[kind][1],
                      "law": choice_name(rig, "mr_law"), "given": current is not None or voltage is not None}
     for ch in chans:
         m, s = np.asarray(record.channels[ch], dtype=float), np.asarray(sim.channels[ch], dtype=float)

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
+from .. import _core
 from ..response import Response
 from ..rig import Error, Rig
 from ..simulate import make_plant, solver_options
@@ -151,9 +152,11 @@ def fit_options(rig: Rig, records: list[Response], mode: str, method: str = "dop
     fixed at ``margin`` times the automatic count of the start (a hysteretic specimen's
     rate bounded with ``V_REF_MARGIN`` times the records' peak velocity; a fixed count keeps
     the residual a smooth function of the keys), CVODE when that count would exceed
-    ``MAX_RK4_SUBSTEPS``."""
+    ``MAX_RK4_SUBSTEPS``.  Without the integrators' accuracy checks (the default's check of a run
+    that turned stiff, RK4's companion): they never change a result, and a fit's thousands of runs
+    would pay for them (up to 2.5x per run); ``compare`` of the fitted rig runs them."""
     if method == "dopri5":
-        return solver_options(method="dopri5", rtol=FIT_RTOL)
+        return solver_options(method="dopri5", rtol=FIT_RTOL, stiff_check=False)
     if method != "rk4":
         raise ValueError(f"invalid method = {method!r}: expected 'dopri5' or 'rk4'")
     dt = min(r.dt for r in records)
@@ -165,7 +168,18 @@ def fit_options(rig: Rig, records: list[Response], mode: str, method: str = "dop
         n = MAX_RK4_SUBSTEPS + 1
     if margin * n > MAX_RK4_SUBSTEPS:
         return solver_options(method="cvode")
-    return solver_options(method="rk4", rk4_substeps=max(1, int(np.ceil(margin * n))))
+    return solver_options(method="rk4", rk4_substeps=max(1, int(np.ceil(margin * n))), rk4_flag_rtol=0.0)
+
+
+def checked_options(options):
+    """``options`` with the integrators' accuracy checks back on (the core's defaults of
+    ``stiff_check`` and ``rk4_flag_rtol``): for the fitted rig's reported runs."""
+    default = _core.SolverOptions()
+    out = _core.SolverOptions()
+    for f in _core.SOLVER_OPTION_FIELDS:
+        setattr(out, f["name"], getattr(options, f["name"]))
+    out.stiff_check, out.rk4_flag_rtol = default.stiff_check, default.rk4_flag_rtol
+    return out
 
 
 #: the time stage's runs: classical RK4 at a fixed number of substeps per sample (a residual that
@@ -339,6 +353,7 @@ def not_improved_flags(kept: str, costs: dict) -> list[str]:
 
 
 __all__ = ["DIFF_STEP", "MAX_RK4_SUBSTEPS", "MIN_COHERENCE", "StageResult", "channel_weights", "default_workers",
-           "fit_frequency", "fit_options", "fit_time", "forward_jacobian", "frequency_targets", "jacobian_at",
+           "checked_options", "fit_frequency", "fit_options", "fit_time", "forward_jacobian", "frequency_targets",
+           "jacobian_at",
            "best", "keep_best", "not_improved_flags", "time_costs",
            "linear_response", "records_peak_velocity", "time_residual"]

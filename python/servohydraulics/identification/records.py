@@ -44,6 +44,7 @@ from .fit import (
     StageResult,
     best,
     channel_weights,
+    checked_options,
     default_workers,
     fit_frequency,
     fit_options,
@@ -398,7 +399,7 @@ def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options,
                 stages["time"], n = _time_stage(target, start, coords, stages["start"], mode, chans, max_nfev, bar)
                 nfev += n
             kept = keep_best(target, start, coords, stages, bar)
-            after = _whole_runs(coords.apply(start, kept[3].z), recs, mode, dt, options, workers)
+            after = _whole_runs(coords.apply(start, kept[3].z), recs, mode, dt, checked_options(options), workers)
             cov = covariance(kept[3].jac, kept[3].fun, None, target.lengths)
             runs["shift_sd"] = _shift(target, coords.apply(start, kept[3].z), after, kept[2], kept[3], cov)
             if not runs["shift_sd"] <= SHIFT_SD:  # polish on the pair's whole runs
@@ -408,7 +409,7 @@ def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options,
                 stages["time"], n = _time_stage(target, start, coords, kept[3].z, mode, chans, max_nfev, bar)
                 nfev += n
                 kept = keep_best(target, start, coords, stages, bar)
-                after = _whole_runs(coords.apply(start, kept[3].z), recs, mode, dt, options, workers)
+                after = _whole_runs(coords.apply(start, kept[3].z), recs, mode, dt, checked_options(options), workers)
                 cov = covariance(kept[3].jac, kept[3].fun, None, target.lengths)
         finally:
             target.close()
