@@ -60,3 +60,29 @@ def write_command_csv(path, command: np.ndarray, ground_accel: np.ndarray, dt: f
     t = np.arange(command.size) * dt
     np.savetxt(path, np.column_stack([t, command, ground_accel]), delimiter=",", header="time,command,ground_accel",
                comments="", fmt="%.17g")
+
+
+def main(argv=None) -> int:
+    """Writes the benchmark's command record (the preset rig, seed 2003) for sh_bench_step_time:
+
+        python3 benchmarks/ground_motion.py --out command.csv
+    """
+    import argparse
+    import sys
+    from pathlib import Path
+
+    ap = argparse.ArgumentParser(description=main.__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--out", required=True, help="the CSV to write")
+    ap.add_argument("--duration", type=float, default=60.0, help="record length [s]")
+    ap.add_argument("--dt", type=float, default=5e-4, help="controller sample [s]")
+    args = ap.parse_args(argv)
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "python"))
+    import servohydraulics as sh
+
+    ag, u = displacement_command(sh.zhao2003(), duration=args.duration, dt=args.dt)
+    write_command_csv(args.out, u, ag, args.dt)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

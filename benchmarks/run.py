@@ -19,10 +19,12 @@
    speed ratio at equal or better accuracy;
 6. sh.sweep speed-up from 1 to 2 worker processes;
 7. writes benchmarks/results.json and docs/benchmarks.md: the page is
-   regenerated wholesale except the section between the markers
-   <!-- BEGIN soak --> and <!-- END soak --> (written by the soak benchmark),
-   which is kept as it is; the random-rig accuracy counts come from
-   evaluation/accuracy_random_rigs.json (and _before.json), written by
+   regenerated wholesale except the sections between the markers
+   <!-- BEGIN soak --> and <!-- END soak --> (written by the soak benchmark)
+   and <!-- BEGIN accuracy-26 --> and <!-- END accuracy-26 --> (the tables of
+   evaluation/accuracy_tables.py) and <!-- BEGIN lab-speed --> and <!-- END lab-speed -->
+   (benchmarks/lab_speed.py's timings of identify and diagnose), which are kept as they are; the
+   random-rig accuracy counts come from evaluation/accuracy_random_rigs.json (and _before.json), written by
    evaluation/accuracy_random_rigs.py.
 """
 
@@ -124,23 +126,28 @@ def python_runs(sh) -> dict:
 
 
 SOAK_BEGIN, SOAK_END = "<!-- BEGIN soak -->", "<!-- END soak -->"
+#: The issue-26 accuracy section (evaluation/accuracy_tables.py's tables and their commands), kept too.
+ACC26_BEGIN, ACC26_END = "<!-- BEGIN accuracy-26 -->", "<!-- END accuracy-26 -->"
+#: The lab-record timings (benchmarks/lab_speed.py's tables and their commands), kept too.
+LAB_BEGIN, LAB_END = "<!-- BEGIN lab-speed -->", "<!-- END lab-speed -->"
 
 
-def kept_soak_section(md_path: Path) -> str:
-    """The soak benchmark's section of the existing page (between the markers, markers included),
-    or the empty markers: run.py regenerates everything else."""
+def kept_section(md_path: Path, begin: str = SOAK_BEGIN, end: str = SOAK_END) -> str:
+    """A section of the existing page written by another command (between the markers, markers
+    included), or the empty markers: run.py regenerates everything else."""
     try:
         text = md_path.read_text()
     except OSError:
         text = ""
-    i, j = text.find(SOAK_BEGIN), text.find(SOAK_END)
+    i, j = text.find(begin), text.find(end)
     if i >= 0 and j > i:
-        return text[i:j + len(SOAK_END)]
-    return f"{SOAK_BEGIN}\n{SOAK_END}"
+        return text[i:j + len(end)]
+    return f"{begin}\n{end}"
 
 
 def write_markdown(report: dict, md_path: Path) -> None:
-    """Writes the page (to a temporary file, then renamed: never half-written), keeping the soak section."""
+    """Writes the page (to a temporary file, then renamed: never half-written), keeping the soak,
+    issue-26 accuracy and lab-speed sections."""
     md_path = Path(md_path)
     accuracy = {}
     for key in ("after", "before"):
@@ -148,7 +155,8 @@ def write_markdown(report: dict, md_path: Path) -> None:
         f = ROOT / "evaluation" / name
         if f.exists():
             accuracy[key] = json.loads(f.read_text())
-    text = markdown(report, accuracy, kept_soak_section(md_path))
+    text = markdown(report, accuracy, kept_section(md_path), kept_section(md_path, ACC26_BEGIN, ACC26_END),
+                    kept_section(md_path, LAB_BEGIN, LAB_END))
     tmp = md_path.with_suffix(".md.tmp")
     tmp.write_text(text)
     tmp.replace(md_path)
@@ -361,7 +369,8 @@ def _fmt(v: float, nd: int = 2) -> str:
     return f"{v:.{nd}f}"
 
 
-def markdown(r: dict, accuracy: dict | None = None, soak: str = f"{SOAK_BEGIN}\n{SOAK_END}") -> str:
+def markdown(r: dict, accuracy: dict | None = None, soak: str = f"{SOAK_BEGIN}\n{SOAK_END}",
+             accuracy_26: str = f"{ACC26_BEGIN}\n{ACC26_END}", lab: str = f"{LAB_BEGIN}\n{LAB_END}") -> str:
     cpp = r["cpp"]
     m = r["machine"]
     rec = r["record"]
@@ -383,6 +392,7 @@ def markdown(r: dict, accuracy: dict | None = None, soak: str = f"{SOAK_BEGIN}\n
         "",
         *speed_table(r),
         *accuracy_section(accuracy or {}),
+        accuracy_26, "",
         "## Per-step wall time in C++ (the plant in displacement control)",
         "",
         "Budget 500 us (2 kHz). Error: max |x - x_ref| / max |x_ref| and the same for the load-cell "
@@ -481,8 +491,10 @@ def markdown(r: dict, accuracy: dict | None = None, soak: str = f"{SOAK_BEGIN}\n
                   "`stiff_fallback = False`. ARKODE's ARKStep with the same Dormand-Prince table does the same "
                   "work per sample but its per-step overhead keeps it short of the 5 us median (table), so it "
                   "stays a reference, with its SDIRK table and CVODE. RK4 with its automatic substeps stays the "
-                  "real-time option (fixed cost): its embedded 3rd-order estimate (one extra right-hand side per "
-                  "sample) flags a sample whose error exceeds `rk4_flag_rtol` (`RunSummary.inaccurate_samples`)."]
+                  "real-time option (fixed cost): a companion run at twice the substeps (8 more right-hand sides "
+                  "per substep) flags a sample where the two differ by more than `rk4_flag_rtol` of the peak "
+                  "displacement or force (`RunSummary.inaccurate_samples`, `RunSummary.error_estimate`); "
+                  "`rk4_flag_rtol = 0` drops the check for the cheapest step."]
     sw = r["sweep"]
     lines += ["", "## Sweeps: 1 to 2 worker processes", "",
               f"`sh.sweep` over {sw['runs']} runs of {sw['duration_s']:g} s (the default method, displacement sine): "
@@ -526,7 +538,7 @@ def markdown(r: dict, accuracy: dict | None = None, soak: str = f"{SOAK_BEGIN}\n
                  if m in rows else "-" for m in ("dopri5", "rk4", "cvode_bdf")]
         lines.append(f"| {label}: median <= 5 us, p99.9 <= 25 us | " + " | ".join(cells) + " |")
     lines += ["", "Wall-time maxima and p99.9 tails include the OS preempting the benchmark on the shared machine "
-              "(compare the CPU-time column of the per-step table).", "", soak, ""]
+              "(compare the CPU-time column of the per-step table).", "", soak, "", lab, ""]
     return "\n".join(lines) + "\n"
 
 

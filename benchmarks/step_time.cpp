@@ -385,6 +385,12 @@ sh::SolverOptions rk4(int substeps) {
   return o;
 }
 
+sh::SolverOptions rk4_no_check() {
+  sh::SolverOptions o = with_method(sh::SolverOptions::Method::Rk4);
+  o.rk4_flag_rtol = 0.0;
+  return o;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -407,7 +413,9 @@ int main(int argc, char** argv) {
     std::vector<Case> cases = {
         {"dopri5_default", "plant", "Dormand-Prince 5(4) rtol 1e-8, CVODE for stiff samples (default)",
          sh::SolverOptions{}},
-        {"rk4_auto", "plant", "RK4, automatic substeps, error flag (real-time option)", with_method(M::Rk4)},
+        {"rk4_auto", "plant", "RK4, automatic substeps, checked by a companion at twice the substeps (real-time option)",
+         with_method(M::Rk4)},
+        {"rk4_auto_no_check", "plant", "RK4, automatic substeps, no check (rk4_flag_rtol = 0)", rk4_no_check()},
         {"arkode_erk", "plant", "ARKODE ARKStep ERK Dormand-Prince rtol 1e-8", with_method(M::ArkodeErk)},
         {"arkode_dirk", "plant", "ARKODE ARKStep SDIRK 5(3)4 rtol 1e-8", with_method(M::ArkodeDirk)},
         {"cvode_default_rtol", "plant", "CVODE BDF rtol 1e-8 (the default rtol), restart on input change, max order 5",

@@ -147,6 +147,7 @@ void expose_plant(py::module_& m) {
       .def_readonly("stiff", &Status::stiff)
       .def_readonly("inaccurate", &Status::inaccurate)
       .def_readonly("error_estimate", &Status::error_estimate)
+      .def_readonly("run_error_estimate", &Status::run_error_estimate)
       .def("ok", &Status::ok)
       .def_property_readonly("message", &Status::message);
 

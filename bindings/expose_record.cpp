@@ -1,5 +1,8 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
 
 #include "busy.hpp"
 #include "channels_py.hpp"
@@ -25,7 +28,9 @@ void expose_record(py::module_& m) {
       .def_readonly("failure_time", &RunSummary::failure_time)
       .def_readonly("first_capacity_time", &RunSummary::first_capacity_time)
       .def_readonly("stiff_samples", &RunSummary::stiff_samples)
-      .def_readonly("inaccurate_samples", &RunSummary::inaccurate_samples);
+      .def_readonly("inaccurate_samples", &RunSummary::inaccurate_samples)
+      .def_readonly("error_estimate", &RunSummary::error_estimate)
+      .def_readonly("max_sample_error_estimate", &RunSummary::max_sample_error_estimate);
 
   m.def(
       "run_record",
@@ -53,4 +58,30 @@ void expose_record(py::module_& m) {
       "last command is not applied (its effect is past the record): n commands make n - 1 steps.\n"
       "Chunks of one record therefore overlap by one element: pass each chunk with the next chunk's\n"
       "first command appended and drop the first row of every chunk after the first. Releases the GIL.");
+
+  m.def("record_check_options", &record_check_options, py::arg("options"), py::arg("summary"),
+        "The options of the default's whole-record check of a run (record.hpp): rtol / 10, its own\n"
+        "check off; None when the run needs none (not dopri5 with its stiff fallback and check, never\n"
+        "stiff, or failed).");
+  m.def(
+      "check_record",
+      [](Plant& companion, py::array_t<double, py::array::c_style | py::array::forcecast> command,
+         py::array_t<double, py::array::c_style | py::array::forcecast> displacement,
+         py::array_t<double, py::array::c_style | py::array::forcecast> force, RunSummary summary) {
+        if (command.ndim() != 1 || displacement.ndim() != 1 || force.ndim() != 1)
+          throw Error("command, displacement and force must be 1-D arrays");
+        const std::size_t rows = static_cast<std::size_t>(std::min(displacement.shape(0), force.shape(0)));
+        const std::size_t n = static_cast<std::size_t>(command.shape(0));
+        {
+          bindings::BusyGuard busy({&companion}, "check_record");
+          py::gil_scoped_release release;
+          check_record(companion, command.data(), n, displacement.data(), force.data(), rows, summary);
+        }
+        return summary;
+      },
+      py::arg("companion"), py::arg("command"), py::arg("displacement"), py::arg("force"), py::arg("summary"),
+      "The default's whole-record check (record.hpp): runs the companion plant (set up as the run's with\n"
+      "record_check_options, at the run's start) over the command and returns the summary with\n"
+      "error_estimate raised to the gap between the run's displacement and force and the companion's\n"
+      "over the check's bound (> 1: the run may miss 1e-3 of its peaks). Releases the GIL.");
 }

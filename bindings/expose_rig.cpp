@@ -6,6 +6,7 @@
 
 #include "enums_py.hpp"
 #include "protocol.hpp"
+#include "servohydraulics/elements/mr_damper.hpp"
 #include "servohydraulics/parameters.hpp"
 #include "servohydraulics/rig.hpp"
 #include "servohydraulics/zhao2003.hpp"
@@ -32,6 +33,20 @@ py::list rig_parameters() {
     out.append(row);
   }
   return out;
+}
+
+// _core.RIG_CHOICES: the rig-file keys whose value is a name (parameters.hpp: ChoiceInfo), with
+// their (name, value) pairs (the enum's table) and the default's name.
+template <class E, std::size_t N>
+py::dict choice_row(const ChoiceInfo& c, const EnumName<E> (&table)[N], E def) {
+  py::dict row;
+  row["section"] = c.section;
+  row["key"] = c.key;
+  row["doc"] = c.doc;
+  row["source"] = c.source;
+  row["names"] = sh_py::enum_names(table);  // ((name, value), ...)
+  row["default"] = name_of(table, def);
+  return row;
 }
 
 py::list effects_table() {
@@ -82,13 +97,44 @@ void expose_rig(py::module_& m) {
     rig.def_readwrite(p.key, p.member, p.doc);
     rig_names.emplace_back(p.key);
   }
+  sh_py::bind_enum(m, "MrInput", kMrInputNames);
+  sh_py::bind_enum(m, "MrLaw", kMrLawNames);
+  m.attr("MR_INPUT_NAMES") = sh_py::enum_names(kMrInputNames);
+  m.attr("MR_LAW_NAMES") = sh_py::enum_names(kMrLawNames);
   rig.def_readwrite("flow_curve", &Rig::flow_curve)
       .def_readwrite("effects", &Rig::effects)
+      .def_readwrite(kMrInputChoice.key, &Rig::mr_input, kMrInputChoice.doc)
+      .def_readwrite(kMrLawChoice.key, &Rig::mr_law, kMrLawChoice.doc)
       .def("validate", &Rig::validate);
   rig_names.emplace_back("flow_curve");
   rig_names.emplace_back("effects");
+  rig_names.emplace_back(kMrInputChoice.key);
+  rig_names.emplace_back(kMrLawChoice.key);
   add_protocol(rig, rig_names);
   m.attr("RIG_PARAMETERS") = rig_parameters();
+  {
+    const Rig d;
+    py::list choices;
+    choices.append(choice_row(kMrInputChoice, kMrInputNames, d.mr_input));
+    choices.append(choice_row(kMrLawChoice, kMrLawNames, d.mr_law));
+    m.attr("RIG_CHOICES") = choices;
+  }
+  m.def(
+      "mr_damper_law",
+      [](const Rig& r) {
+        const MrLawValues v = mr_damper_law(r);
+        py::dict out;
+        out["u"] = v.u;
+        out["alpha"] = v.alpha;
+        out["c0"] = v.c0;
+        out["c1"] = v.c1;
+        out["beta"] = v.beta;
+        out["gamma"] = v.gamma;
+        return out;
+      },
+      py::arg("rig"),
+      "The MR damper's alpha [N/m], c0, c1 [N s/m], beta, gamma [1/m^n] at the rig's field input u "
+      "[V or A] by its law (mr_input, mr_law; elements/mr_damper.hpp)");
 
   py::enum_<Zhao2003Variant>(m, "Zhao2003Variant")
       .value("Calibrated", Zhao2003Variant::Calibrated)

@@ -329,7 +329,7 @@ void expose_rths(py::module_& m) {
       .def_property_readonly("displacement", &LinearSubstructure::displacement)
       .def_property_readonly("velocity", &LinearSubstructure::velocity)
       .def("acceleration", &LinearSubstructure::acceleration, py::arg("dof"), py::arg("ag"), py::arg("f_in"));
-  py::class_<GroundMotion>(r, "GroundMotion")
+  py::class_<GroundMotion>(m, "GroundMotion", "a ground-motion record, linearly interpolated and scaled (ground_motion.hpp)")
       .def(py::init([](const Arr& t, const Arr& a, double s) {
              return GroundMotion(to_vector(t, "time"), to_vector(a, "acceleration"), s);
            }),
@@ -337,6 +337,7 @@ void expose_rths(py::module_& m) {
       .def("__call__", &GroundMotion::operator(), py::arg("t"))
       .def_property_readonly("end_time", &GroundMotion::end_time)
       .def_property_readonly("scale", &GroundMotion::scale);
+  r.attr("GroundMotion") = m.attr("GroundMotion");
 
   // --- controllers --------------------------------------------------------------------------------------
   py::class_<PiGains>(r, "PiGains").def(py::init<>())

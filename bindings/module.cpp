@@ -13,8 +13,10 @@ void expose_linearize(py::module_& m);
 void expose_compensators(py::module_& m);
 void expose_loops(py::module_& m);
 void expose_rths(py::module_& m);
+void expose_marths(py::module_& m);
 void expose_fmu(py::module_& m);
 void expose_realtime(py::module_& m);
+void expose_multi_rig(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "C++ core of servohydraulics (SUNDIALS CVODE, Eigen)";
@@ -29,6 +31,8 @@ PYBIND11_MODULE(_core, m) {
   expose_compensators(m);
   expose_loops(m);
   expose_rths(m);
+  expose_marths(m);  // registers the MultiActuatorSystem seam, before expose_multi_rig binds a subclass
   expose_fmu(m);
   expose_realtime(m);
+  expose_multi_rig(m);
 }

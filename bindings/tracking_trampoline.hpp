@@ -24,10 +24,13 @@
 #include <Python.h>
 
 #include <cmath>
+#include <cstddef>
+#include <initializer_list>
 #include <limits>
 #include <string>
 #include <utility>
 
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include "servohydraulics/rths/tracking.hpp"
@@ -98,6 +101,19 @@ struct CommandSignature {
   }
 };
 
+//! The names of the callable methods (written "name()") and the attributes (written "name") that obj lacks,
+//! comma-separated ("" when it has them all): the check of every Python object that stands in for a C++ one.
+inline std::string missing_members(const py::handle& obj, std::initializer_list<const char*> methods,
+                                   std::initializer_list<const char*> attributes = {}) {
+  std::string missing;
+  for (const char* name : methods)
+    if (!py::hasattr(obj, name) || !PyCallable_Check(obj.attr(name).ptr()))
+      missing += std::string(missing.empty() ? "" : ", ") + name + "()";
+  for (const char* name : attributes)
+    if (!py::hasattr(obj, name)) missing += std::string(missing.empty() ? "" : ", ") + name;
+  return missing;
+}
+
 //! The call discipline shared by the two Python controllers: GIL, error capture, sample count.
 class PythonControllerCalls {
  public:
@@ -153,8 +169,31 @@ class PythonControllerCalls {
     ++samples_;
     return failed_ ? std::numeric_limits<double>::quiet_NaN() : u;
   }
+  //! A multi-actuator command() through f, which returns the Python result: n floats written to u; NaN in
+  //! every u[i] once anything failed (multi_trampoline.hpp).
+  template <class F>
+  void command_into(F&& f, double* u, std::size_t n) noexcept {
+    for (std::size_t i = 0; i < n; ++i) u[i] = std::numeric_limits<double>::quiet_NaN();
+    if (failed_) return;
+    py::gil_scoped_acquire gil;
+    guarded("command", [&] { to_commands(f(), u, n); });
+    ++samples_;
+    if (failed_)
+      for (std::size_t i = 0; i < n; ++i) u[i] = std::numeric_limits<double>::quiet_NaN();
+  }
 
  private:
+  static void to_commands(const py::handle& r, double* u, std::size_t n) {
+    using Arr = py::array_t<double, py::array::c_style | py::array::forcecast>;
+    const bool numeric = py::isinstance<py::sequence>(r) || py::isinstance<py::array>(r);
+    Arr a = numeric ? Arr::ensure(r) : Arr();
+    if (!a || a.ndim() != 1 || static_cast<std::size_t>(a.size()) != n) {
+      PyErr_Clear();
+      throw py::type_error("command() returned " + py::repr(r).cast<std::string>().substr(0, 200) + ": expected " +
+                           std::to_string(n) + " floats, the actuator commands [m]");
+    }
+    for (std::size_t i = 0; i < n; ++i) u[i] = a.data()[i];
+  }
   static double to_command(const py::handle& r) {
     const double u = PyFloat_AsDouble(r.ptr());
     if (u == -1.0 && PyErr_Occurred()) {
@@ -243,10 +282,7 @@ class PyTrackingController : public rths::TrackingController, public PythonContr
 class PythonTrackingController final : public rths::TrackingController, public PythonControllerCalls {
  public:
   explicit PythonTrackingController(py::object obj) : obj_(std::move(obj)) {
-    std::string missing;
-    for (const char* name : {"reset", "command"})
-      if (!py::hasattr(obj_, name) || !PyCallable_Check(obj_.attr(name).ptr()))
-        missing += std::string(missing.empty() ? "" : ", ") + name + "()";
+    const std::string missing = missing_members(obj_, {"reset", "command"});
     if (!missing.empty())
       throw py::type_error("invalid controller = " + py::repr(obj_).cast<std::string>() +
                            ": not a tracking controller, it lacks " + missing +

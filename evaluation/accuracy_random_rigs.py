@@ -21,12 +21,16 @@ Jacobian: independent of the default's CVODE fallback; ``--reference cvode`` for
 max |x - x_ref| / max |x_ref| and the same for the load-cell force.  A run is
 
 - ``within``: error <= the method's stated tolerance (TOLERANCE);
-- ``flagged``: not within, but the run says so: a non-ok status, or samples flagged inaccurate
-  (RK4's error estimate; the default's check of its stiff samples);
+- ``flagged``: not within, but the run says so: a non-ok status, or the run's accuracy check over
+  its bound (``work.error_estimate`` > 1: RK4's companion at twice the substeps, the default's
+  shadow at rtol / 10 of a run that turned stiff; measured against the run's peaks; a core
+  without it: any sample flagged inaccurate);
 - ``silent``: not within and nothing said: a silent wrong answer (must be 0).
 
 ``flagged_within`` counts the false alarms (within, yet flagged); the flag's precision is
-flagged / (flagged + flagged_within), its recall flagged / (flagged + silent).  Each reference is
+flagged / (flagged + flagged_within), its recall flagged / (flagged + silent).  The per-sample
+flags (``work.inaccurate_samples``, each against the peak up to its sample) are counted too:
+``sample_flagged_within`` is the accurate runs with a flagged sample.  Each reference is
 confirmed by the other one (CVODE at the same tolerances): a rig where they differ by more than
 REFERENCE_AGREEMENT is counted under ``reference_uncertain`` and skipped, as are rigs whose
 reference run fails; RK4 is skipped on a rig whose automatic rule needs
@@ -35,9 +39,11 @@ docs/benchmarks.md come from running this script against the core of the startin
 
     SERVOHYDRAULICS_CORE_DIR=<old core> python3 evaluation/accuracy_random_rigs.py --family wide ...
 
-``--rk4-flag-rtols 5e-5,2e-4`` reruns RK4 at each flag tolerance (same states, only its flag
-differs) and counts the flag's precision and recall at each (``rk4_flag_sweep``): how the default
-``rk4_flag_rtol`` was calibrated (docs/benchmarks.md).
+``--flag-scales 0.5,1,2`` counts each method's flag as if its bound were that many times the
+configured one (the check's gap scales with the bound, so no rerun: flagged iff
+``work.error_estimate`` > scale; ``flag_sweep``): how the bounds were calibrated (docs/benchmarks.md).
+``--cache DIR`` keeps each case's references in DIR (keyed by family, seed, index, duration, dt,
+reference, checked against a digest of the case), so a run against another core reuses them.
 
 tests/python/test_accuracy.py runs the same check on fewer, shorter runs, and an oracle test on
 two high-gain rigs.
@@ -46,6 +52,7 @@ two high-gain rigs.
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import math
 import sys
@@ -158,15 +165,14 @@ REFERENCE_AGREEMENT = 0.1 * min(TOLERANCE.values())
 RK4_MAX_SUBSTEPS = 4000
 
 
-def _options(sh, which: str, rtol: float | None = None, reference: str = "arkode_erk",
-             flag_rtol: float | None = None):
+def _options(sh, which: str, rtol: float | None = None, reference: str = "arkode_erk"):
     methods = sh.simulate.__globals__["METHODS"]
     if which == "reference":
         return sh.solver_options(method=reference, rtol=1e-10, atol_fraction=1e-3, max_steps_per_sample=1000000)
     kw = {} if rtol is None else {"rtol": rtol}
     if which == "default":
         return sh.solver_options(**kw) if "dopri5" in methods else sh.solver_options(method="cvode", **kw)
-    return sh.solver_options(method="rk4", **({} if flag_rtol is None else {"rk4_flag_rtol": flag_rtol}))
+    return sh.solver_options(method="rk4")
 
 
 def _error(r, ref) -> float:
@@ -182,54 +188,91 @@ def _rk4_substeps(sh, rig, mode: str, dt: float) -> int:
                                            sh.solver_options(method="rk4")))
 
 
-def run_case(sh, rig, mode: str, u: np.ndarray, dt: float, rtol: float | None = None,
-             reference: str = "arkode_erk", methods: tuple = ("default", "rk4"), flag_rtols: tuple = ()) -> dict:
-    """The reference and each method on one case: error, status, flags, time; RK4 is also run at each
-    of `flag_rtols` (its flag's tolerance: same states, only the flag differs) to calibrate it."""
+def _flag_measure(r) -> float:
+    """The run's verdict on itself: inf for a failed run, its accuracy check over the bound
+    (work.error_estimate: > 1 flagged; a NaN counts as flagged), or for a core without it 2.0 if any
+    sample was flagged inaccurate, else 0."""
+    if not r.success:
+        return math.inf
+    est = getattr(r.work, "error_estimate", None)
+    if est is None:
+        return 2.0 if r.work.inaccurate_samples > 0 else 0.0
+    return math.inf if math.isnan(est) else float(est)
+
+
+def _references(sh, rig, mode: str, u: np.ndarray, dt: float, reference: str, cache: Path | None, key: str):
+    """(status, x_ref, F_ref): the reference's displacement and force if it ran and its check agrees."""
+    digest = hashlib.sha256((repr(rig) + mode + str(dt) + reference).encode() + u.tobytes()).hexdigest()[:16]
+    f = cache / f"{key}.npz" if cache else None
+    if f is not None and f.exists():
+        z = np.load(f)
+        if str(z["digest"]) == digest:
+            return str(z["status"]), z["x"], z["F"]
+    x = F = np.zeros(0)
     try:
         ref = sh.simulate(rig, mode, u, dt=dt, options=_options(sh, "reference", reference=reference),
                           raise_on_failure=False)
         other = next(r for r in REFERENCES if r != reference)
         check = sh.simulate(rig, mode, u, dt=dt, options=_options(sh, "reference", reference=other),
                             raise_on_failure=False)
+        if not ref.success or not check.success:
+            status = ref.status if not ref.success else f"{other}: {check.status}"
+        else:
+            # The two references must agree to a tenth of the tightest tolerance: where they do not (a
+            # rig that amplifies even a 1e-10 tolerance's error past 1e-4), no run can be judged against them.
+            gap = _error(check, ref)
+            status = "ok" if gap <= REFERENCE_AGREEMENT else f"uncertain: {other} departs from {reference} by {gap:.2e}"
+            x, F = ref.displacement, ref.force
     except ValueError as e:  # an invalid rig: setup, not a wrong answer
-        return {"reference": f"error: {e}"}
-    if not ref.success or not check.success:
-        return {"reference": ref.status if not ref.success else f"{other}: {check.status}"}
-    # The two references must agree to a tenth of the tightest tolerance: where they do not (a rig
-    # that amplifies even a 1e-10 tolerance's error past 1e-4), no run can be judged against them.
-    gap = _error(check, ref)
-    if not gap <= REFERENCE_AGREEMENT:
-        return {"reference": f"uncertain: {other} departs from {reference} by {gap:.2e}"}
+        status = f"error: {e}"
+    if f is not None:
+        f.parent.mkdir(parents=True, exist_ok=True)
+        tmp = f.with_name(f.stem + ".tmp.npz")
+        np.savez(tmp, digest=digest, status=status, x=x, F=F)
+        tmp.replace(f)
+    return status, x, F
+
+
+def run_case(sh, rig, mode: str, u: np.ndarray, dt: float, rtol: float | None = None,
+             reference: str = "arkode_erk", methods: tuple = ("default", "rk4"), cache: Path | None = None,
+             key: str = "") -> dict:
+    """The reference and each method on one case: error, status, flags, the run's accuracy check
+    (flag_measure: flagged iff > 1), time."""
+    status, x_ref, F_ref = _references(sh, rig, mode, u, dt, reference, cache, key)
+    if status != "ok":
+        return {"reference": status}
     out: dict = {"reference": "ok"}
     for which in methods:
         try:
             if which == "rk4" and _rk4_substeps(sh, rig, mode, dt) > RK4_MAX_SUBSTEPS:
                 out[which] = {"skipped": True}
                 continue
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             r = sh.simulate(rig, mode, u, dt=dt, options=_options(sh, which, rtol), raise_on_failure=False)
-            wall = time.perf_counter() - t0
+            wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         except ValueError as e:  # refused at construction: a clear error is a status, not a wrong answer
-            out[which] = {"error": math.nan, "status": f"refused: {e}", "flagged": True, "within": False}
+            out[which] = {"error": math.nan, "status": f"refused: {e}", "flagged": True, "within": False,
+                          "flag_measure": math.inf, "sample_flagged": True}
             continue
-        err = _error(r, ref) if r.success else math.nan
-        flagged = (not r.success) or getattr(r.work, "inaccurate_samples", 0) > 0
-        out[which] = {"error": err, "status": r.status, "flagged": bool(flagged),
-                      "within": bool(r.success and err <= TOLERANCE[which]),
+        if r.success:
+            ex = np.max(np.abs(r.displacement - x_ref)) / max(np.max(np.abs(x_ref)), 1e-12)
+            ef = np.max(np.abs(r.force - F_ref)) / max(np.max(np.abs(F_ref)), 1e-12)
+            err = float(max(ex, ef))
+        else:
+            err = math.nan
+        measure = _flag_measure(r)
+        out[which] = {"error": err, "status": r.status, "flagged": not measure <= 1.0,
+                      "within": bool(r.success and err <= TOLERANCE[which]), "flag_measure": measure,
+                      "sample_flagged": bool(not r.success or r.work.inaccurate_samples > 0),
                       "stiff_samples": int(getattr(r.work, "stiff_samples", 0)),
-                      "inaccurate_samples": int(getattr(r.work, "inaccurate_samples", 0)), "wall_s": wall}
-        if which == "rk4":
-            out[which]["flag_sweep"] = {}
-            for fr in flag_rtols:
-                rf = sh.simulate(rig, mode, u, dt=dt, options=_options(sh, which, flag_rtol=fr), raise_on_failure=False)
-                out[which]["flag_sweep"][fr] = bool((not rf.success) or rf.work.inaccurate_samples > 0)
+                      "inaccurate_samples": int(getattr(r.work, "inaccurate_samples", 0)), "wall_s": wall,
+                      "cpu_s": cpu}
     return out
 
 
 def _new_counts() -> dict:
     return {"within": 0, "flagged": 0, "silent": 0, "worst_silent": 0.0, "worst": 0.0, "silent_cases": [],
-            "flagged_within": 0, "skipped": 0, "wall_s": 0.0}
+            "flagged_within": 0, "sample_flagged_within": 0, "skipped": 0, "wall_s": 0.0, "cpu_s": 0.0}
 
 
 def _finish_counts(c: dict) -> None:
@@ -242,36 +285,39 @@ def _finish_counts(c: dict) -> None:
 
 def survey(sh, rigs: int, seed: int = 16, duration: float = 1.0, dt: float = 5e-4, progress: bool = True,
            rtol: float | None = None, family: str = "random", reference: str = "arkode_erk",
-           methods: tuple = ("default", "rk4"), flag_rtols: tuple = ()) -> dict:
+           methods: tuple = ("default", "rk4"), flag_scales: tuple = (), cache: Path | None = None) -> dict:
     """Runs `rigs` random cases of a family and counts within / flagged / silent per method, the
-    flag's false alarms (flagged_within) and its precision and recall; for RK4 also at each of
-    `flag_rtols` (rk4_flag_sweep)."""
+    flag's false alarms (flagged_within) and its precision and recall; also as if each method's
+    flag bound were each of `flag_scales` times the configured one (flag_sweep)."""
     from tqdm import tqdm
 
     rng = np.random.default_rng(seed)
     counts = {w: _new_counts() for w in methods}
-    sweep = {fr: _new_counts() for fr in flag_rtols}
+    sweep = {w: {sc: _new_counts() for sc in flag_scales} for w in methods}
     skipped, uncertain, cases = 0, 0, []
     for i in tqdm(range(rigs), disable=not progress, desc=f"{family} rigs"):
         rig, mode, u = family_case(sh, rng, duration, dt, family)
-        res = run_case(sh, rig, mode, u, dt, rtol, reference, methods, flag_rtols)
+        key = f"{family}_s{seed}_d{duration:g}_dt{dt:g}_{reference}_{i}"
+        res = run_case(sh, rig, mode, u, dt, rtol, reference, methods, cache, key)
         if res["reference"] != "ok":
             skipped += 1
             uncertain += res["reference"].startswith("uncertain")
             continue
-        cases.append([i, mode] + [[res[w].get("error"), res[w].get("flagged"), res[w].get("stiff_samples")]
-                                  for w in methods])
+        cases.append([i, mode] + [[res[w].get("error"), res[w].get("flagged"), res[w].get("stiff_samples"),
+                                   res[w].get("flag_measure"), res[w].get("inaccurate_samples")] for w in methods])
         for which in methods:
             r, c = res[which], counts[which]
             if r.get("skipped"):
                 c["skipped"] += 1
                 continue
             c["wall_s"] += r.get("wall_s", 0.0)
+            c["cpu_s"] += r.get("cpu_s", 0.0)
             if math.isfinite(r["error"]):
                 c["worst"] = max(c["worst"], r["error"])
             if r["within"]:
                 c["within"] += 1
                 c["flagged_within"] += int(r["flagged"])
+                c["sample_flagged_within"] += int(r["sample_flagged"])
             elif r["flagged"]:
                 c["flagged"] += 1
             else:
@@ -279,21 +325,24 @@ def survey(sh, rigs: int, seed: int = 16, duration: float = 1.0, dt: float = 5e-
                 c["worst_silent"] = max(c["worst_silent"], r["error"])
                 c["silent_cases"].append({"index": i, "mode": mode, "error": r["error"],
                                           "stiff_samples": r["stiff_samples"]})
-            for fr, flagged in r.get("flag_sweep", {}).items():
-                s = sweep[fr]
-                key = ("flagged_within" if flagged else "") if r["within"] else ("flagged" if flagged else "silent")
+            for sc, s in sweep[which].items():
+                flagged = not r["flag_measure"] <= sc
                 s["within"] += int(r["within"])
-                if key:
-                    s[key] += 1
-    for c in list(counts.values()) + list(sweep.values()):
+                if r["within"]:
+                    s["flagged_within"] += int(flagged)
+                else:
+                    s["flagged" if flagged else "silent"] += 1
+    for c in list(counts.values()) + [s for w in sweep.values() for s in w.values()]:
         _finish_counts(c)
     return {"family": family, "rigs": rigs, "seed": seed, "duration_s": duration, "dt_s": dt,
-            "tolerance": TOLERANCE, "rtol": rtol, "reference": reference, "reference_failed": skipped,
+            "methods": list(methods), "tolerance": TOLERANCE, "rtol": rtol, "reference": reference,
+            "reference_failed": skipped,
             "reference_uncertain": uncertain, "counts": counts,
-            "rk4_flag_sweep": {str(fr): {k: s[k] for k in ("within", "flagged", "silent", "flagged_within",
-                                                           "flag_precision", "flag_recall", "flag_rate_within")}
-                               for fr, s in sweep.items()},
-            "cases": {"columns": ["index", "mode"] + [f"{w}: [error, flagged, stiff samples]" for w in methods],
+            "flag_sweep": {w: {str(sc): {k: s[k] for k in ("within", "flagged", "silent", "flagged_within",
+                                                            "flag_precision", "flag_recall", "flag_rate_within")}
+                               for sc, s in sweep[w].items()} for w in methods if flag_scales},
+            "cases": {"columns": ["index", "mode"] + [f"{w}: [error, flagged, stiff samples, flag measure, "
+                                                      "flagged samples]" for w in methods],
                       "rows": cases}}
 
 
@@ -306,8 +355,10 @@ def main(argv=None) -> int:
     ap.add_argument("--family", choices=sorted(FAMILIES), default="random", help="the rigs drawn")
     ap.add_argument("--reference", choices=REFERENCES, default="arkode_erk")
     ap.add_argument("--methods", default="default,rk4", help="comma-separated: default, rk4")
-    ap.add_argument("--rk4-flag-rtols", default="",
-                    help="comma-separated rk4_flag_rtol values: RK4's flag counted at each (calibration)")
+    ap.add_argument("--flag-scales", default="",
+                    help="comma-separated factors: each method's flag counted as if its bound were that many "
+                         "times the configured one (calibration)")
+    ap.add_argument("--cache", default="", help="keep the references in this folder (reused when they match)")
     ap.add_argument("--json", default="", help="write the counts here")
     ap.add_argument("--no-progress", action="store_true")
     args = ap.parse_args(argv)
@@ -321,7 +372,8 @@ def main(argv=None) -> int:
         ap.error(f"invalid --methods = {args.methods!r}: expected a comma-separated subset of {sorted(TOLERANCE)}")
     res = survey(sh, args.rigs, args.seed, args.duration, progress=not args.no_progress, rtol=args.rtol,
                  family=args.family, reference=args.reference, methods=methods,
-                 flag_rtols=tuple(float(v) for v in args.rk4_flag_rtols.split(",") if v))
+                 flag_scales=tuple(float(v) for v in args.flag_scales.split(",") if v),
+                 cache=Path(args.cache) if args.cache else None)
     print(json.dumps(res, indent=1))
     if args.json:
         Path(args.json).write_text(json.dumps(res, indent=1) + "\n")

@@ -22,8 +22,10 @@ import sys
 import time
 from pathlib import Path
 
+from doc_tables import UTFSM_DATA, utfsm_start, write_between  # evaluation/ (the script's own folder)
+
 ROOT = Path(__file__).resolve().parents[1]
-DATA = Path(os.environ.get("SH_SHARED_DIR", ROOT.parent / "shared")) / "real-data" / "utfsm-mts-mrdamper"
+DATA = UTFSM_DATA
 RECORDS = {"chirp20Hz_0A": 0.0, "chirp20Hz_1A": 1.0, "sweep15Hz_0A": 0.0, "sweep15Hz_0p5A": 0.5,
            "sweep15Hz_1A": 1.0}
 PAIRS = (("chirp20Hz_0A", "sweep15Hz_0A"), ("sweep15Hz_0A", "chirp20Hz_0A"),
@@ -110,16 +112,10 @@ def main(argv=None) -> int:
     p.add_argument("--out", default="utfsm_out")
     p.add_argument("--no-docs", action="store_true", help="do not rewrite docs/lab-records.md")
     args = p.parse_args(argv)
-    sys.path.insert(0, str(ROOT / "python"))
-    import servohydraulics as sh
-
-    data = Path(args.data)
-    if not data.is_dir():
-        print(f"UTFSM records not found in {data}: see docs/lab-records.md", file=sys.stderr)
+    start = utfsm_start(args.data, RECORDS, args.out)
+    if start is None:
         return 2
-    records = {n: sh.read_record(data / f"{n}.csv") for n in RECORDS}
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    sh, records, out = start
     t0 = time.perf_counter()
     base = baselines(records)
     rows, times = identify_and_predict(records, out)
@@ -129,9 +125,7 @@ def main(argv=None) -> int:
     print(text)
     if not args.no_docs:
         doc = ROOT / "docs" / "lab-records.md"
-        s = doc.read_text()
-        i, j = s.index(START) + len(START), s.index(END)
-        doc.write_text(s[:i] + "\n" + text + "\n" + s[j:])
+        write_between(doc, START, END, text)
         print(f"wrote the table into {doc}")
     print(f"total {time.perf_counter() - t0:.0f} s")
     return 0

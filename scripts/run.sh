@@ -48,7 +48,11 @@ source_digest() {
 # builds the C++ core: minutes on two cores) runs only when the sources differ from the last
 # successful install, recorded in $venv/.servohydraulics-sources, so `demo` then `test` build
 # the package once.  SH_REINSTALL=1 forces it.
+# `python_env tests` (the test commands) builds the package in build/ctest with the C++ tests
+# (SH_BUILD_TESTS) and without pip's build isolation, so that cxx_tests finds that tree built and
+# the core is compiled once, not twice (CI time).
 python_env() {
+  local with_tests=${1:-}
   [ -x "$venv/bin/python" ] || "$py" -m venv "$venv"
   local stamp="$venv/.servohydraulics-sources" digest
   digest=$(source_digest)
@@ -61,7 +65,14 @@ python_env() {
   "$venv/bin/python" -m pip install -q --upgrade pip
   # Build tools for the C++ tests, then the package itself with its test extras.
   "$venv/bin/python" -m pip install -q cmake ninja "pybind11>=2.12"
-  "$venv/bin/python" -m pip install -q "$root[test]"
+  if [ -n "$with_tests" ]; then
+    # The build requirements of pyproject.toml's [build-system], in the venv (no isolation).
+    "$venv/bin/python" -m pip install -q "scikit-build-core>=0.10" "fmpy>=0.3.20"
+    PATH="$venv/bin:$PATH" "$venv/bin/python" -m pip install -q --no-build-isolation \
+      -C build-dir="$root/build/ctest" -C cmake.define.SH_BUILD_TESTS=ON "$root[test]"
+  else
+    "$venv/bin/python" -m pip install -q "$root[test]"
+  fi
   echo "$digest" > "$stamp"
 }
 
@@ -72,6 +83,8 @@ lint() {
 }
 
 cxx_tests() {
+  # The tree `python_env tests` built (configured again with the same settings: nothing to rebuild),
+  # or a new one when the package was installed by `demo`.
   local b="$root/build/ctest"
   # SH_BUILD_FMU: the FMU binary and its C-ABI test (the FMI headers come from the venv's fmpy)
   "$venv/bin/cmake" -S "$root" -B "$b" -G Ninja -DSH_BUILD_TESTS=ON -DCMAKE_BUILD_TYPE=Release \
@@ -114,16 +127,17 @@ case "${1:-}" in
     fi
     ;;
   test)
-    system_deps; python_env
+    system_deps; python_env tests
     lint
     cxx_tests
     # Run pytest from the tests directory so that the installed package is the one imported;
     # one worker process per core (pytest-xdist): the diagnosis tests dominate and are independent.
     # Tests marked slow (diagnosis runs of a minute or more each) are left to `test-all`.
-    PATH="$venv/bin:$PATH" "$venv/bin/python" -m pytest "$root/tests/python" -q -p no:cacheprovider -n auto -m "not slow"
+    PATH="$venv/bin:$PATH" "$venv/bin/python" -m pytest "$root/tests/python" -q -p no:cacheprovider -n auto -m "not slow" \
+      --durations=15
     ;;
   test-all)
-    system_deps; python_env
+    system_deps; python_env tests
     lint
     cxx_tests
     PATH="$venv/bin:$PATH" "$venv/bin/python" -m pytest "$root/tests/python" -q -p no:cacheprovider -n auto

@@ -177,6 +177,15 @@ void add_rig(std::vector<Variable>& out, Kind kind) {
     x.in_rig = true;
     out.push_back(std::move(x));
   }
+  // The rig keys whose value is a name (parameters.hpp: ChoiceInfo) as Enumeration parameters.
+  for (auto x : {enumeration<MrInput>(std::string(kMrInputChoice.section) + "." + kMrInputChoice.key, "MrInput",
+                                      kMrInputNames, kMrInputChoice.doc,
+                                      [](Values& v) -> MrInput& { return v.settings.rig.mr_input; }),
+                 enumeration<MrLaw>(std::string(kMrLawChoice.section) + "." + kMrLawChoice.key, "MrLaw", kMrLawNames,
+                                    kMrLawChoice.doc, [](Values& v) -> MrLaw& { return v.settings.rig.mr_law; })}) {
+    x.in_rig = true;
+    out.push_back(std::move(x));
+  }
   for (const EffectInfo& e : kEffects) {
     const auto member = e.member;
     Variable x = boolean(std::string("effects.") + e.key, e.doc,

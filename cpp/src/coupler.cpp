@@ -46,6 +46,10 @@ double Coupler::d2stroke_dtheta2(std::size_t i, double theta) const noexcept {
   return -d_[i] * std::cos(theta + alpha_[i]);
 }
 
+double Coupler::d3stroke_dtheta3(std::size_t i, double theta) const noexcept {
+  return d_[i] * std::sin(theta + alpha_[i]);
+}
+
 void Coupler::node_load(double theta, const double* F, double* Fx, double* M) const noexcept {
   double fx = 0.0, m = 0.0;
   for (std::size_t i = 0; i < n_; ++i) {

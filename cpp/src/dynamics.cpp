@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "detail/math.hpp"
 
@@ -186,13 +187,13 @@ void Dynamics::structure(const double* y, const Input& in, Algebra& g) const noe
     laws.dF_dv += f.dF_dv;
     laws.dF_dz += f.dF_dz;
   });
+  if (specimen_on_) specimen<W>(y, g);
+  g.a = specimen_on_ ? (net - g.Fsp) / M_ : net / M_;
+  if constexpr (W == 0) return;  // the values alone (rhs)
   if (!specimen_on_) {
-    g.a = net / M_;
     g.da[kX] = -laws.dF_dx / M_;
     g.da[kV] = -laws.dF_dv / M_;
   } else {
-    specimen<W>(y, g);
-    g.a = (net - g.Fsp) / M_;
     for (int j = 0; j < W; ++j) g.da[j] = -g.dFsp[j] / M_;
     g.da[kX] = -(laws.dF_dx + g.dFsp[kX]) / M_;
     g.da[kV] = -(laws.dF_dv + g.dFsp[kV]) / M_;
@@ -212,13 +213,15 @@ bool Dynamics::servo_controller(const double* y, const Input& in, Algebra& g) co
   std::fill(draw, draw + W, 0.0);
   if (mode_ == ControlMode::Displacement) {
     raw = CF_ * (r.G_p * (in.u - y[kX]) + r.G_d * (in.u_rate - y[kV]));
-    draw[kX] = -CF_ * r.G_p;
-    draw[kV] = -CF_ * r.G_d;
-    draw[ku_] = CF_ * r.G_p;
+    if constexpr (W > 0) {
+      draw[kX] = -CF_ * r.G_p;
+      draw[kV] = -CF_ * r.G_d;
+      draw[ku_] = CF_ * r.G_p;
+    }
   } else {
     raw = CF_ * r.G_p * (in.u - g.F);
     for (int j = 0; j < W; ++j) draw[j] = -CF_ * r.G_p * g.dF[j];
-    draw[ku_] += CF_ * r.G_p;
+    if constexpr (W > 0) draw[ku_] += CF_ * r.G_p;
   }
   g.drive_sat = r.effects.drive_saturation && std::fabs(raw) >= r.v_max;
   g.drive = g.drive_sat ? std::copysign(r.v_max, raw) : raw;
@@ -238,12 +241,14 @@ void Dynamics::valve(const double* y, double vdrive, const double* dvdrive, Alge
   std::fill(dxv, dxv + W, 0.0);
   if (r.effects.servovalve_dynamics) {
     xv = y[kXv];
-    dxv[kXv] = 1.0;
     const double w2 = wv_ * wv_;
     g.xvdd = w2 * (r.K_s * vdrive - y[kXv]) - 2.0 * r.zeta_v * wv_ * y[kXvDot];
-    for (int j = 0; j < W; ++j) g.dxvdd[j] = w2 * r.K_s * dvdrive[j];
-    g.dxvdd[kXv] -= w2;
-    g.dxvdd[kXvDot] -= 2.0 * r.zeta_v * wv_;
+    if constexpr (W > 0) {
+      dxv[kXv] = 1.0;
+      for (int j = 0; j < W; ++j) g.dxvdd[j] = w2 * r.K_s * dvdrive[j];
+      g.dxvdd[kXv] -= w2;
+      g.dxvdd[kXvDot] -= 2.0 * r.zeta_v * wv_;
+    }
   } else {
     xv = r.K_s * vdrive;
     for (int j = 0; j < W; ++j) dxv[j] = r.K_s * dvdrive[j];
@@ -255,12 +260,12 @@ void Dynamics::valve(const double* y, double vdrive, const double* dvdrive, Alge
   // Valve flow, Eq (3).
   const double gs = flow_gain(g.s), R = pressure_factor(g.s, p);
   g.Q = r.K_v * gs * R;
+  // Actuator continuity, Eq (4): K_a p' = Q - C_l p - A x'.
+  g.pdot = (g.Q - r.C_l * p - r.A * v) / r.K_a;
+  if constexpr (W == 0) return;  // the values alone (rhs)
   const double dQds = r.K_v * flow_gain_slope(g.s) * R;
   for (int j = 0; j < W; ++j) g.dQ[j] = dQds * g.ds[j];
   g.dQ[kP] += r.K_v * gs * pressure_factor_dp(g.s, p);
-
-  // Actuator continuity, Eq (4): K_a p' = Q - C_l p - A x'.
-  g.pdot = (g.Q - r.C_l * p - r.A * v) / r.K_a;
   for (int j = 0; j < W; ++j) g.dpdot[j] = g.dQ[j] / r.K_a;
   g.dpdot[kP] -= r.C_l / r.K_a;
   g.dpdot[kV] -= r.A / r.K_a;
@@ -271,41 +276,77 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
   g.zero<W>();
   structure<W>(y, in, g);
   if (mode_ == ControlMode::Free) {
-    g.dF[ku_] = 1.0;
+    if constexpr (W > 0) g.dF[ku_] = 1.0;
     g.F = in.u;
     return;
   }
   // Load cell between piston and structure: F = pA - m_p a.
   g.F = y[kP] * rig_.A - mp_ * g.a;
-  for (int j = 0; j < W; ++j) g.dF[j] = -mp_ * g.da[j];
-  g.dF[kP] += rig_.A;
+  if constexpr (W > 0) {
+    for (int j = 0; j < W; ++j) g.dF[j] = -mp_ * g.da[j];
+    g.dF[kP] += rig_.A;
+  }
   const bool delayed = servo_controller<W>(y, in, g);
   valve<W>(y, delayed ? g.vdrive : g.drive, delayed ? g.dvdrive : g.ddrive, g);
 }
 
 // Dispatch on the gradient width num_states() + 1, a compile-time constant in each case.
-void Dynamics::evaluate_any(const double* y, const Input& in, Algebra& g) const noexcept {
+template <class F>
+decltype(auto) Dynamics::at_width(F&& f) const noexcept {
   static_assert(kCap == 17, "one case per width from kNumStates + 1 to kMaxStates + 1");
   switch (ng_) {
-    case 7: return evaluate<7>(y, in, g);
-    case 8: return evaluate<8>(y, in, g);
-    case 9: return evaluate<9>(y, in, g);
-    case 10: return evaluate<10>(y, in, g);
-    case 11: return evaluate<11>(y, in, g);
-    case 12: return evaluate<12>(y, in, g);
-    case 13: return evaluate<13>(y, in, g);
-    case 14: return evaluate<14>(y, in, g);
-    case 15: return evaluate<15>(y, in, g);
-    case 16: return evaluate<16>(y, in, g);
-    default: return evaluate<kCap>(y, in, g);
+    case 7: return f(std::integral_constant<int, 7>{});
+    case 8: return f(std::integral_constant<int, 8>{});
+    case 9: return f(std::integral_constant<int, 9>{});
+    case 10: return f(std::integral_constant<int, 10>{});
+    case 11: return f(std::integral_constant<int, 11>{});
+    case 12: return f(std::integral_constant<int, 12>{});
+    case 13: return f(std::integral_constant<int, 13>{});
+    case 14: return f(std::integral_constant<int, 14>{});
+    case 15: return f(std::integral_constant<int, 15>{});
+    case 16: return f(std::integral_constant<int, 16>{});
+    default: return f(std::integral_constant<int, kCap>{});
   }
+}
+
+void Dynamics::evaluate_any(const double* y, const Input& in, Algebra& g) const noexcept {
+  at_width([&](auto w) { evaluate<decltype(w)::value>(y, in, g); });
+}
+
+// The actuator without the structure (Dynamics::actuator): the friction laws along the stroke, then
+// the servo controller (Eq 1) and the valve (Eqs 2-4), as evaluate does them.
+template <int W>
+LawForce Dynamics::evaluate_actuator(const double* y, const Input& in, Algebra& g) const noexcept {
+  g.zero<W>();
+  LawForce f;
+  each_law([&](const auto& law) {
+    using L = std::decay_t<decltype(law)>;
+    if constexpr (std::is_same_v<L, TanhFriction> || std::is_same_v<L, LuGreFriction>) {
+      const LawForce l = law.eval(y, g);
+      f.F += l.F;
+      f.dF_dx += l.dF_dx;
+      f.dF_dv += l.dF_dv;
+      f.dF_dz += l.dF_dz;
+    }
+  });
+  const bool delayed = servo_controller<W>(y, in, g);
+  valve<W>(y, delayed ? g.vdrive : g.drive, delayed ? g.dvdrive : g.ddrive, g);
+  return f;
+}
+
+LawForce Dynamics::actuator(const double* y, const Input& in, Algebra& g) const noexcept {
+  return at_width([&](auto w) { return evaluate_actuator<decltype(w)::value>(y, in, g); });
 }
 
 void Dynamics::rhs(const double* y, const Input& in, double* ydot) const noexcept {
   Algebra g;
-  evaluate_any(y, in, g);
+  evaluate<0>(y, in, g);  // the values alone: no gradient (the same values as every width computes)
   ydot[kX] = y[kV];
   ydot[kV] = g.a;
+  actuator_rates(y, g, ydot);
+}
+
+void Dynamics::actuator_rates(const double* y, const Algebra& g, double* ydot) const noexcept {
   const bool actuator = mode_ != ControlMode::Free;
   ydot[kP] = actuator ? g.pdot : 0.0;
   const bool valve = actuator && rig_.effects.servovalve_dynamics;
@@ -324,6 +365,11 @@ void Dynamics::jacobian(const double* y, const Input& in, Jacobian& J, State* B)
   J[kX][kV] = 1.0;
   for (int j = 0; j < n; ++j) J[kV][j] = g.da[j];
   if (B) (*B)[kV] = g.da[ku_];
+  actuator_jacobian(g, J, B);
+}
+
+void Dynamics::actuator_jacobian(const Algebra& g, Jacobian& J, State* B) const noexcept {
+  const int n = layout_.num_states;
   for (int j = 0; j < n; ++j) J[kZ][j] = g.dzdot[j];
   jacobian_appended(g, J, B);
   if (mode_ == ControlMode::Free) return;
@@ -371,15 +417,20 @@ void Dynamics::outputs(const double* y, const Input& in, Output& out, OutputGrad
   out.drive = actuator ? g.drive : 0.0;
   out.flow = actuator ? g.Q : 0.0;
   out.specimen_force = g.Fsp;
+  out.flags = flags(y, g.spool_sat, g.drive_sat, out.force);
+}
+
+std::uint32_t Dynamics::flags(const double* y, bool spool_saturated, bool drive_saturated, double force) const
+    noexcept {
   std::uint32_t f = 0;
-  if (std::fabs(out.force) > rig_.F_cap) f |= kCapacityExceeded;
-  if (actuator) {
+  if (std::fabs(force) > rig_.F_cap) f |= kCapacityExceeded;
+  if (mode_ != ControlMode::Free) {
     if (std::fabs(y[kP]) >= 0.98 * rig_.p_s) f |= kSupplyLimited;
-    if (g.spool_sat) f |= kSpoolSaturated;
-    if (g.drive_sat) f |= kDriveSaturated;
+    if (spool_saturated) f |= kSpoolSaturated;
+    if (drive_saturated) f |= kDriveSaturated;
     if (std::fabs(y[kX]) > rig_.stroke) f |= kStrokeExceeded;
   }
-  out.flags = f;
+  return f;
 }
 
 State Dynamics::equilibrium(double x0) const noexcept {
@@ -441,8 +492,7 @@ void Dynamics::specimen_forces(const double* x, const double* v, std::size_t n, 
     at[kX] = xt;
     at[kV] = vt;
     Algebra g;
-    g.zero<kCap>();
-    specimen<kCap>(at.data(), g);
+    specimen<0>(at.data(), g);  // the values alone
     for (int i = 0; i < m; ++i) r[i] = g.rate[idx[i]];
     return g.Fsp;
   };

@@ -19,9 +19,8 @@
 namespace servohydraulics {
 
 namespace {
-// The divergence guard: a state beyond these is a failed run, not a result.
-constexpr double kMaxDisplacement = 100.0;  // [m]
-constexpr double kMaxPressureRatio = 100.0; // [p_s]
+using detail::kMaxDisplacement;   // the divergence guard (detail/ode_system.hpp)
+using detail::kMaxPressureRatio;
 
 using Integrator = std::variant<detail::Dopri5Integrator, detail::CvodeIntegrator, detail::Rk4Integrator,
                                 detail::ArkodeIntegrator>;
@@ -78,7 +77,7 @@ Integrator make_integrator(const Dynamics& dyn, double dt, const SolverOptions& 
       return Integrator(std::in_place_type<detail::ArkodeIntegrator>, dyn, dt, opt, y0, opt.method == M::ArkodeDirk);
     case M::Dopri5: break;
   }
-  return Integrator(std::in_place_type<detail::Dopri5Integrator>, dyn, dt, opt, y0);
+  return Integrator(std::in_place_type<detail::Dopri5Integrator>, dyn, dt, opt, y0, opt.stiff_check);
 }
 }  // namespace
 

@@ -1,7 +1,11 @@
 #include "servohydraulics/record.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
+
+#include "detail/dopri5_integrator.hpp"
+#include "detail/output_gap.hpp"
 
 namespace servohydraulics {
 
@@ -16,6 +20,9 @@ bool RunSummary::count(const Status& st, double t) noexcept {
   if (st.internal_steps > max_internal_steps) max_internal_steps = st.internal_steps;
   stiff_samples += st.stiff ? 1 : 0;
   inaccurate_samples += st.inaccurate ? 1 : 0;
+  if (!std::isnan(max_sample_error_estimate) && !(st.error_estimate <= max_sample_error_estimate))
+    max_sample_error_estimate = st.error_estimate;  // a NaN estimate sticks
+  error_estimate = st.run_error_estimate;
   if (!st.ok()) {
     status = st;
     failure_time = t;
@@ -53,6 +60,34 @@ RunSummary run_record(Plant& plant, const double* command, std::size_t n, const 
   sum.rhs_evals = plant.total_rhs_evals() - nf0;
   sum.restarts = plant.total_restarts() - nr0;
   return sum;
+}
+
+std::optional<SolverOptions> record_check_options(const SolverOptions& run, const RunSummary& summary) noexcept {
+  if (run.method != SolverOptions::Method::Dopri5 || !run.stiff_fallback || !run.stiff_check) return std::nullopt;
+  if (summary.stiff_samples == 0 || !summary.ok()) return std::nullopt;
+  SolverOptions tight = run;
+  tight.rtol = run.rtol / detail::Dopri5Integrator::kShadowTighten;  // the absolute tolerances follow rtol
+  tight.stiff_check = false;
+  return tight;
+}
+
+void check_record(Plant& companion, const double* command, std::size_t n, const double* x, const double* F,
+                  std::size_t rows, RunSummary& summary) {
+  using Integrator = detail::Dopri5Integrator;
+  rows = std::min(rows, n);
+  std::vector<double> xc(rows), Fc(rows);
+  Channels ch;
+  ch[Channel::Displacement] = xc.data();
+  ch[Channel::Force] = Fc.data();
+  const RunSummary second = run_record(companion, command, rows, ch);
+  detail::OutputGap<Dynamics> gap(companion.dynamics());
+  for (std::size_t k = 0; k < second.rows; ++k) {
+    const double v[2] = {x[k], F[k]}, vc[2] = {xc[k], Fc[k]};
+    gap.gap_values(v, vc);
+  }
+  const double estimate = gap.run_gap() / (Integrator::kShadowGap * Integrator::kVerifyTolerance);
+  if (!(estimate <= summary.error_estimate) && !std::isnan(summary.error_estimate))
+    summary.error_estimate = estimate;  // a NaN sticks
 }
 
 Trace simulate(Plant& plant, const std::vector<double>& command) {

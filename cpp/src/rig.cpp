@@ -6,6 +6,7 @@
 #include <sstream>
 #include <string>
 
+#include "servohydraulics/elements/mr_damper.hpp"
 #include "servohydraulics/parameters.hpp"
 #include "servohydraulics/state.hpp"
 
@@ -103,6 +104,7 @@ const char* bound_text(Bound b) noexcept {
     case Bound::NonNegative: return "finite and >= 0";
     case Bound::AtLeastOne: return "finite and >= 1";
     case Bound::PadeOrder: return "an integer in 1..6";
+    case Bound::Finite: return "finite";
   }
   return "";
 }
@@ -113,6 +115,7 @@ bool within(Bound b, double v) noexcept {
     case Bound::NonNegative: return finite_nonneg(v);
     case Bound::AtLeastOne: return std::isfinite(v) && v >= 1.0;
     case Bound::PadeOrder: return std::isfinite(v) && v >= 1.0 && v <= kMaxPadeOrder && v == std::floor(v);
+    case Bound::Finite: return std::isfinite(v);
   }
   return false;
 }
@@ -124,6 +127,7 @@ void Rig::validate() const {
     const std::string requirement = std::string(p.doc) + " must be " + bound_text(p.bound) + " [" + p.unit + "]";
     require(false, p.key, v, requirement.c_str());
   }
+  validate_mr_law(*this);
   flow_curve.validate();
 }
 

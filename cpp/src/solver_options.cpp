@@ -30,10 +30,10 @@ void SolverOptions::validate() const {
           "must be in (0, 2.5] (RK4 is unstable past |h lambda| ~ 2.8)");
   require(std::isfinite(rk4_v_ref) && rk4_v_ref >= 0.0, "rk4_v_ref", rk4_v_ref,
           "must be finite and >= 0 [m/s] (0 = the no-load actuator speed)");
-  require(std::isfinite(rk4_flag_rtol) && rk4_flag_rtol > 0.0 && rk4_flag_rtol < 1.0, "rk4_flag_rtol",
-          rk4_flag_rtol, "must be in (0, 1)");
+  require(std::isfinite(rk4_flag_rtol) && rk4_flag_rtol >= 0.0 && rk4_flag_rtol < 1.0, "rk4_flag_rtol",
+          rk4_flag_rtol, "must be in [0, 1) (a fraction of the run's peaks; 0 = no check)");
   require(rk4_max_refinements >= 0 && rk4_max_refinements <= 16, "rk4_max_refinements", rk4_max_refinements,
-          "must be in 0..16 (each doubles the substeps of a flagged sample)");
+          "must be in 0..16 (each doubles the substeps of the rest of the run)");
 }
 
 double state_scale(const Dynamics& dyn, int i) noexcept {

@@ -66,6 +66,13 @@ _LAZY = {
     "Diagnosis": (".diagnosis", "Diagnosis"),
     "reproduce": (".paper.reproduce", "reproduce"),
     "export_fmu": (".fmu", "export_fmu"),
+    "MultiActuatorRig": (".multi_rig", "MultiActuatorRig"),
+    "load_multi_rig": (".multi_rig", "load_multi_rig"),
+    "save_multi_rig": (".multi_rig", "save_multi_rig"),
+    "simulate_multi": (".multi_rig", "simulate_multi"),
+    "marths_rig": (".multi_rig", "marths_rig"),
+    "marths_frame": (".multi_rig", "marths_frame"),
+    "node_specimen": (".multi_rig", "node_specimen"),
 }
 
 #: Deprecated names, kept for one release: name -> (replacement, object).
@@ -139,4 +146,11 @@ __all__ = [
     "zhao2003",
     "loop_converters",
     "sensor_channel",
+    "MultiActuatorRig",
+    "load_multi_rig",
+    "marths_frame",
+    "marths_rig",
+    "node_specimen",
+    "save_multi_rig",
+    "simulate_multi",
 ]

@@ -192,6 +192,19 @@ def write_text(path: str | Path, text: str) -> Path:
     return Path(path)
 
 
+def replace_marked(path: str | Path, name: str, text: str) -> Path:
+    """Replaces the section of a text file (a page of ``docs/``) between the lines ``<!-- name -->`` and
+    ``<!-- /name -->`` with ``text``, the rest as it is, atomically; ValueError if the markers are absent."""
+    import re
+
+    path = Path(path)
+    pat = re.compile(rf"(<!-- {re.escape(name)} -->\n)(.*?)(<!-- /{re.escape(name)} -->)", re.S)
+    old = path.read_text(encoding="utf-8")
+    if not pat.search(old):
+        raise ValueError(f"marker <!-- {name} --> ... <!-- /{name} --> not found in {path}")
+    return write_text(path, pat.sub(lambda m: m.group(1) + text.rstrip("\n") + "\n" + m.group(3), old))
+
+
 def write_with(path: str | Path, writer: Callable[[Path], object]) -> Path:
     """Calls ``writer(tmp)`` and renames ``tmp`` over ``path`` (e.g. ``lambda p: fig.savefig(p)``)."""
     with atomic_path(path) as tmp:
@@ -199,4 +212,4 @@ def write_with(path: str | Path, writer: Callable[[Path], object]) -> Path:
     return Path(path)
 
 
-__all__ = ["FileSet", "WriteError", "atomic_path", "check_folder", "write_text", "write_with"]
+__all__ = ["FileSet", "WriteError", "atomic_path", "check_folder", "replace_marked", "write_text", "write_with"]

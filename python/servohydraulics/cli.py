@@ -46,12 +46,19 @@ def _reproduce(args: argparse.Namespace) -> int:
 
 
 def _diagnose(args: argparse.Namespace) -> int:
+    from .commands.compare import print_checks
     from .diagnosis import diagnose
+    from .identification.checks import check_accept
+    from .readers import layout_of
     from .rig import load_rig
 
+    accept = check_accept(args.accept)
+    layout = layout_of(args)
     names = [c.strip() for c in args.candidates.split(",") if c.strip()] if args.candidates else None
-    d = diagnose(args.records, load_rig(args.rig), mode=args.mode, progress=not args.quiet, candidates=names)
+    d = diagnose(args.records, load_rig(args.rig), mode=args.mode, progress=not args.quiet, candidates=names,
+                 dt=args.dt, layout=layout, accept=accept)
     d.write(args.out)
+    print_checks(d.checks)
     print(f"{d.verdict}: {d.summary}")
     for e in d.effects:
         pars = ", ".join(f"{k} = {v['value']:.4g} {v['unit']}" for k, v in e["parameters"].items()
@@ -90,13 +97,21 @@ def build_parser() -> argparse.ArgumentParser:
                    help="parallel processes for the sections, 1 .. the processors (default: 2)")
     r.set_defaults(func=_reproduce)
     g = sub.add_parser("diagnose", help="name the effect the model is missing in lab records, fit it, show the gap")
-    g.add_argument("records", nargs="+", help="record CSV file(s) of the same rig (time, command, displacement, force)")
+    g.add_argument("records", nargs="+", help="record file(s) of the same rig (time, command, displacement, force): "
+                                          "CSV or other text, a DAQ export (--layout), .mat")
     g.add_argument("--rig", required=True, help="the nominal rig TOML file")
     g.add_argument("--mode", required=True, choices=list(MODES),
                    help="control mode of the records")
     g.add_argument("--out", required=True, help="output directory (diagnosis.json, rig_updated.toml, report.md)")
     g.add_argument("--candidates", help="restrict the library to these candidates (comma-separated names)")
     g.add_argument("--quiet", action="store_true", help="no progress bar")
+    g.add_argument("--dt", type=float, default=None,
+                   help="controller sample time [s] (default: the record's; a 1 kHz record of a 2 kHz rig: 0.0005)")
+    from .commands.compare import add_accept
+    from .readers import add_arguments
+
+    add_accept(g)
+    add_arguments(g)
     g.set_defaults(func=_diagnose)
 
     from .commands import register_all  # commands that live in their own module (commands/*.py)

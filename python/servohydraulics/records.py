@@ -8,10 +8,10 @@ channel of a run (``channel_units("record")``: ``velocity`` [m/s],
 ``flags``...).  Time must be uniform and increasing.  The old column name
 ``ground_accel`` is read as ``ground_acceleration`` for one release.
 
-Lab files that name their columns with the unit appended (``time_s``,
-``command_m``, ``command_N``, ``displacement_m``, ``force_N``: the UTFSM
-records of docs/lab-records.md) are read under the project's names
-(``UNIT_SUFFIXED_COLUMNS``); the suffix must be the channel's SI unit.
+Lab files that name their columns with a unit (``time_s``, ``command_m``,
+``displacement_mm``, ``force_kN``, ``Force [kN]``) are read under the project's
+names and converted to SI; other units, scales, column names, delimiters, header
+blocks and MATLAB files: ``servohydraulics.readers`` (docs/lab-records.md).
 
 A record is a :class:`~servohydraulics.response.Response` of kind ``"record"``;
 ``write_record(path, r)`` is ``r.to_csv(path)``.
@@ -19,77 +19,50 @@ A record is a :class:`~servohydraulics.response.Response` of kind ``"record"``;
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Mapping
 from pathlib import Path
 
-import numpy as np
 from numpy.typing import ArrayLike
 
-from .response import DEPRECATED_COLUMNS, REQUIRED, Response, channel_units, uniform_dt
+from .response import Response
 
 #: Deprecated name of a record: records are Responses of kind "record".
 Record = Response
 
 
-#: Unit-suffixed column names read as the project's channel names (SI units only).
+#: Unit-suffixed column names read as the project's channel names (any unit of the channel's
+#: dimension is read now, ``readers.record``: ``displacement_mm``, ``force_kN``, ``Force [kN]``).
 UNIT_SUFFIXED_COLUMNS = {"time_s": "time", "command_m": "command", "command_N": "command",
                          "displacement_m": "displacement", "force_N": "force"}
 
 
-def _columns(path: Path, header: str) -> list[str]:
-    names = [UNIT_SUFFIXED_COLUMNS.get(h.strip(), h.strip()) for h in header.split(",")]
-    seen: set[str] = set()
-    for i, n in enumerate(names):
-        if n in seen:
-            raise ValueError(f"{path}: column {n!r} appears twice in the header (columns {i + 1} and "
-                             f"{names.index(n) + 1})")
-        seen.add(n)
-        if n in DEPRECATED_COLUMNS:
-            warnings.warn(f"{path}: column {n!r} is deprecated; name it {DEPRECATED_COLUMNS[n]!r}",
-                          DeprecationWarning, stacklevel=3)
-            names[i] = DEPRECATED_COLUMNS[n]
-    missing = [c for c in REQUIRED if c not in names]
-    if missing:
-        raise ValueError(f"{path}: missing column(s) {missing}; the header must have {list(REQUIRED)}")
-    allowed = channel_units("record")
-    unknown = [c for c in names if c not in allowed]
-    if unknown:
-        raise ValueError(f"{path}: unknown column(s) {unknown}; allowed: {list(allowed)}")
-    return names
+def read_record(path: str | Path, layout=None, *, columns: Mapping[str, str] | None = None,
+                units: Mapping[str, str] | None = None, scale: Mapping[str, float] | None = None,
+                delimiter: str | None = None, decimal: str | None = None, header_lines: int | None = None,
+                offset_first_s: float | None = None) -> Response:
+    """Reads a record file into a Response of kind ``"record"`` (SI units).
 
+    Text (CSV, semicolon, tab or whitespace separated, a data-acquisition export with a
+    header block) or MATLAB ``.mat`` (by the suffix); see docs/lab-records.md, "Record files".
 
-def read_record(path: str | Path) -> Response:
-    """Reads a record CSV into a Response of kind ``"record"``; errors name the file, column and row."""
-    path = Path(path)
-    if not path.exists():
-        raise FileNotFoundError(f"record file not found: {path}")
-    if path.is_dir():
-        raise ValueError(f"record file {path} is a directory")
-    try:  # utf-8-sig: a byte-order mark (spreadsheet export) is not part of the first column's name
-        lines = path.read_text(encoding="utf-8-sig").splitlines()
-    except UnicodeDecodeError as e:
-        raise ValueError(f"{path}: not a UTF-8 text file ({e.reason} at byte {e.start})") from None
-    names = _columns(path, lines[0].strip() if lines else "")
-    rows = [ln for ln in lines[1:] if ln.strip()]
-    if not rows:
-        raise ValueError(f"{path}: no data rows after the header")
-    try:
-        data = np.loadtxt(rows, delimiter=",", ndmin=2)
-    except ValueError as e:
-        raise ValueError(f"{path}: could not parse numbers: {e}") from None
-    if data.shape[1] != len(names):
-        raise ValueError(f"{path}: {data.shape[1]} values per row but {len(names)} header columns")
-    channels = {n: data[:, i].copy() for i, n in enumerate(names)}
-    for n, v in channels.items():
-        bad = np.flatnonzero(~np.isfinite(v))
-        if bad.size:
-            raise ValueError(f"{path}: column {n!r} row {bad[0] + 2} is {v[bad[0]]} (must be finite)")
-    uniform_dt(channels["time"], str(path))
-    for n in ("flags", "internal_steps", "rhs_evals"):
-        if n in channels:
-            channels[n] = channels[n].astype(np.uint32 if n == "flags" else np.int64)
-    return Response(channels, kind="record", path=path)
+    Args:
+        path: the file.
+        layout: a :class:`~servohydraulics.readers.Layout`, a layout TOML file or a dict of its fields.
+        columns: channel -> the file's column (``{"command": "CHANNEL2"}``; .mat: a variable
+            ``"u"``, ``"rec.u"``, ``"M.u"`` or ``"M(:,2)"``).
+        units: channel -> unit of the file's values (``{"displacement": "mm", "time": "ms"}``).
+        scale: channel -> factor (volts to the unit: ``{"force": 980.665}``).
+        delimiter, decimal, header_lines: text files (default: found from the file).
+        offset_first_s: subtract each channel's mean over the first seconds [s].
+
+    ``Response.metadata`` says what was read (columns, units, scales, offsets, the header block).
+    Errors name the file, the column (with the header read and the mapping tried) or the
+    field, and the value.
+    """
+    from .readers import read
+
+    return read(path, layout, columns=columns, units=units, scale=scale, delimiter=delimiter, decimal=decimal,
+                header_lines=header_lines, offset_first_s=offset_first_s)
 
 
 def write_record(path: str | Path, record: Response | Mapping[str, ArrayLike]) -> Path:

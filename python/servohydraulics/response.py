@@ -34,7 +34,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from .rig import Rig
 
-KINDS = ("plant", "eft", "rpsd", "tracking", "record", "rths")
+KINDS = ("plant", "eft", "rpsd", "tracking", "record", "rths", "marths", "multi")
 
 #: Columns a record file must have (the diagnosis needs them).
 REQUIRED = ("time", "command", "displacement", "force")
@@ -64,12 +64,19 @@ def channel_units(kind: str = "record", mode: str | None = None) -> dict[str, st
     channels, the flags and the method's channels.  ``"record"``: the union of
     all of them (what a record file may hold).  ``"rths"``: the RTHS loop's
     channels (``_core.rths.RTHS_CHANNELS``) and its optional ``step_seconds``
-    (the per-DOF channels of a trial carry their units with them: ``rths.Trial``).
+    (the per-DOF channels of a trial carry their units with them: ``rths.Trial``); ``"marths"``:
+    the maRTHS loop's (``_core.marths.MARTHS_CHANNELS``) and ``step_seconds``.
+    ``"multi"``: the coupled multi-actuator rig's node channels (``node.<name>``) and the counts (the
+    actuators' ``actuator<i>.<name>`` carry their units with the response: ``multi_rig.MultiResponse``).
     """
     if kind not in KINDS:
         raise ValueError(f"invalid kind = {kind!r}: expected one of {list(KINDS)}")
     if kind == "rths":
         return {**dict(map(tuple, _core.rths.RTHS_CHANNELS)), "step_seconds": "s"}
+    if kind == "marths":
+        return {**dict(map(tuple, _core.marths.MARTHS_CHANNELS)), "step_seconds": "s"}
+    if kind == "multi":  # the node's; the actuators' (actuator<i>.<name>) come with the response (multi_rig.py)
+        return {"time": "s", **{f"node.{n}": u for n, u in _core.NODE_CHANNELS}, **_COUNTS}
     plant, eft, rpsd = _core_tables()
     out = dict(plant)
     if kind in ("plant", "tracking", "record"):
@@ -122,49 +129,90 @@ def _first_time(time: np.ndarray, flags: np.ndarray, bit: int) -> float:
     return float(time[np.argmax((flags & bit) > 0)])
 
 
-def solver_warnings(work: Any) -> list[str]:
-    """Notes on how the integrator coped: samples flagged as inaccurate (by the real-time option's
-    (RK4) error estimate, or the default's check of its stiff samples), samples the default pair
-    found stiff (CVODE took them)."""
-    out = []
-    n_bad = getattr(work, "inaccurate_samples", 0) if work is not None else 0
-    n_stiff = getattr(work, "stiff_samples", 0) if work is not None else 0
-    if n_bad and n_stiff:
-        out.append(f"{n_bad} stiff sample(s) flagged inaccurate: a looser run departs from the result by more "
-                   "than the default's 1e-3 of the peak displacement or force allows (a high-gain loop that "
-                   "amplifies the integration error); use a smaller rtol")
-    elif n_bad:
-        out.append(f"{n_bad} sample(s) flagged inaccurate by the RK4 error estimate: use the default "
-                   "method (dopri5), more rk4_substeps or rk4_max_refinements")
+def solver_notes(work: Any) -> list[tuple[str, str]]:
+    """(code, note) of how the integrator coped: ``run_accuracy`` for a run whose accuracy check
+    says it probably misses the method's stated accuracy (``work.error_estimate`` > 1: the
+    real-time option's (RK4) companion at twice the substeps, or the default's check of a run that
+    turned stiff, a second run at rtol / 10; measured against the run's peak displacement and
+    force), ``run_solver`` for the samples the default pair found stiff (CVODE took them)."""
+    out: list[tuple[str, str]] = []
+    if work is None:
+        return out
+    est = getattr(work, "error_estimate", 0.0)
+    n_bad = getattr(work, "inaccurate_samples", 0)
+    n_stiff = getattr(work, "stiff_samples", 0)
+    if not est <= 1.0:  # NaN too: the check itself went non-finite
+        where = f"; {n_bad} sample(s) flagged" if n_bad else ""
+        if n_stiff:
+            out.append(("run_accuracy",
+                        f"the run turned stiff and its check (a second run at rtol / 10) departs from it by "
+                        f"{est:.3g}x the bound: it may miss the default's stated 1e-3 of the peak displacement or "
+                        f"force (a high-gain or supply-limited loop that amplifies the integration error{where}); "
+                        "use a smaller rtol"))
+        else:
+            out.append(("run_accuracy",
+                        f"a run at twice the RK4 substeps departs from this one by {est:.3g}x rk4_flag_rtol of "
+                        f"the peak displacement or force: it probably misses RK4's stated 1e-2{where}; use the "
+                        "default method (dopri5), more rk4_substeps or rk4_max_refinements"))
     if n_stiff:
-        out.append(f"{n_stiff} sample(s) were stiff for the explicit pair and integrated by CVODE")
+        out.append(("run_solver", f"{n_stiff} sample(s) were stiff for the explicit pair and integrated by CVODE"))
+    return out
+
+
+def solver_warnings(work: Any) -> list[str]:
+    """The notes of :func:`solver_notes`."""
+    return [text for _, text in solver_notes(work)]
+
+
+def limit_notes(flags: np.ndarray, time: np.ndarray, peak_force: float, rig: Rig | None = None
+                ) -> list[tuple[str, str, float]]:
+    """(code, note, first time [s]) of each physical limit a run hit, from its per-row
+    OutputFlag bits (``rig`` adds the limit values to the notes).  Codes: ``run_capacity``,
+    ``run_supply``, ``run_stroke``, ``run_spool``, ``run_drive``."""
+    out = []
+    if np.any(flags & _core.FLAG_CAPACITY_EXCEEDED):
+        cap = f" > {rig.F_cap / 1e3:.0f} kN" if rig is not None else ""
+        t = _first_time(time, flags, _core.FLAG_CAPACITY_EXCEEDED)
+        out.append(("run_capacity", f"actuator capacity exceeded: peak force {peak_force / 1e3:.1f} kN{cap}, "
+                                    f"first at t = {t:.3f} s", t))
+    if np.any(flags & _core.FLAG_SUPPLY_LIMITED):
+        lim = f" (p_s A = {rig.p_s * rig.A / 1e3:.1f} kN)" if rig is not None else ""
+        t = _first_time(time, flags, _core.FLAG_SUPPLY_LIMITED)
+        out.append(("run_supply", f"load pressure reached the supply pressure{lim}, force limited, "
+                                  f"first at t = {t:.3f} s", t))
+    if np.any(flags & _core.FLAG_STROKE_EXCEEDED):
+        lim = f" (+-{rig.stroke * 1e3:.0f} mm)" if rig is not None else ""
+        t = _first_time(time, flags, _core.FLAG_STROKE_EXCEEDED)
+        out.append(("run_stroke", f"displacement beyond the actuator stroke{lim} first at t = {t:.3f} s: a real "
+                                  "actuator would hit its end stop", t))
+    if np.any(flags & _core.FLAG_SPOOL_SATURATED):
+        t = _first_time(time, flags, _core.FLAG_SPOOL_SATURATED)
+        out.append(("run_spool", f"servovalve spool saturated (fully open) first at t = {t:.3f} s", t))
+    if np.any(flags & _core.FLAG_DRIVE_SATURATED):
+        t = _first_time(time, flags, _core.FLAG_DRIVE_SATURATED)
+        out.append(("run_drive", f"servovalve drive saturated first at t = {t:.3f} s", t))
     return out
 
 
 def limit_warnings(flags: np.ndarray, time: np.ndarray, peak_force: float, rig: Rig | None = None) -> list[str]:
     """Notes on the physical limits a run hit, from its per-row OutputFlag bits
-    (``rig`` adds the limit values)."""
-    out = []
-    if np.any(flags & _core.FLAG_CAPACITY_EXCEEDED):
-        cap = f" > {rig.F_cap / 1e3:.0f} kN" if rig is not None else ""
-        out.append(f"actuator capacity exceeded: peak force {peak_force / 1e3:.1f} kN{cap}, "
-                   f"first at t = {_first_time(time, flags, _core.FLAG_CAPACITY_EXCEEDED):.3f} s")
-    if np.any(flags & _core.FLAG_SUPPLY_LIMITED):
-        lim = f" (p_s A = {rig.p_s * rig.A / 1e3:.1f} kN)" if rig is not None else ""
-        out.append(f"load pressure reached the supply pressure{lim}, force limited, "
-                   f"first at t = {_first_time(time, flags, _core.FLAG_SUPPLY_LIMITED):.3f} s")
-    if np.any(flags & _core.FLAG_STROKE_EXCEEDED):
-        lim = f" (+-{rig.stroke * 1e3:.0f} mm)" if rig is not None else ""
-        out.append(f"displacement beyond the actuator stroke{lim} first at t = "
-                   f"{_first_time(time, flags, _core.FLAG_STROKE_EXCEEDED):.3f} s: a real actuator would hit "
-                   "its end stop")
-    if np.any(flags & _core.FLAG_SPOOL_SATURATED):
-        out.append("servovalve spool saturated (fully open) first at t = "
-                   f"{_first_time(time, flags, _core.FLAG_SPOOL_SATURATED):.3f} s")
-    if np.any(flags & _core.FLAG_DRIVE_SATURATED):
-        out.append(f"servovalve drive saturated first at t = "
-                   f"{_first_time(time, flags, _core.FLAG_DRIVE_SATURATED):.3f} s")
-    return out
+    (``rig`` adds the limit values): the notes of :func:`limit_notes`."""
+    return [note for _, note, _ in limit_notes(flags, time, peak_force, rig)]
+
+
+def mr_law_warnings(rig: Rig | None) -> list[str]:
+    """A note when the rig's MR damper runs at a field input outside the range its law was
+    identified on (``mr_law_min`` ... ``mr_law_max``): the run extrapolates the law."""
+    if rig is None or not rig.effects.mr_damper:
+        return []
+    current = rig.mr_input == _core.MrInput.Current
+    u = float(rig.mr_current if current else rig.mr_voltage)
+    lo, hi = float(rig.mr_law_min), float(rig.mr_law_max)
+    if lo <= u <= hi:
+        return []
+    kind, unit = ("current", "A") if current else ("voltage", "V")
+    return [f"MR damper {kind} {u:g} {unit} is outside the range its law was identified on ({lo:g} ... {hi:g} {unit}, "
+            "specimen.mr_law_min/mr_law_max): the run extrapolates the law"]
 
 
 class Channels(Mapping):
@@ -208,8 +256,9 @@ class Response:
         channels: read-only mapping name -> array (also attributes:
             ``res.displacement``); it includes ``time``.
         units: name -> SI unit of each channel.
-        kind: ``"plant"`` (simulate), ``"eft"``, ``"rpsd"``, ``"tracking"``, ``"record"`` or
-            ``"rths"`` (``rths.run_trial``: the RTHS benchmark loop).
+        kind: ``"plant"`` (simulate), ``"eft"``, ``"rpsd"``, ``"tracking"``, ``"record"``,
+            ``"rths"`` (``rths.run_trial``: the RTHS benchmark loop) or ``"multi"``
+            (``simulate_multi``: the coupled multi-actuator rig, a ``MultiResponse``).
         mode: control mode (``"displacement"``, ``"force"``, ``"free"``), None if unknown.
         dt: controller sample time [s].
         rig: the rig the run used (RPsD: the physical rig), None for a record.
@@ -220,16 +269,23 @@ class Response:
             ``RunSummary``: rows, internal steps, rhs evaluations, restarts,
             peak force, displacement and velocity, failure time, status); None for a record.
         path: the file of a record, else None.
+        metadata: how a record was read (``read_record``: columns, units, scales, offsets, the
+            file's header block); empty for a run.
+        settings: rig keys the record was made at, which its simulation uses over any rig's
+            (e.g. ``{"mr_current": 0.5}``: an MR damper's coil current; ``identification.run``);
+            empty unless given (:meth:`with_settings`).
     """
 
     def __init__(self, channels: Mapping[str, ArrayLike], *, kind: str = "record", mode: str | None = None,
                  dt: float | None = None, rig: Rig | None = None, work: _core.RunSummary | Work | None = None,
-                 units: Mapping[str, str] | None = None, path: str | Path | None = None):
+                 units: Mapping[str, str] | None = None, path: str | Path | None = None,
+                 metadata: Mapping[str, Any] | None = None, settings: Mapping[str, float] | None = None):
         if kind not in KINDS:
             raise ValueError(f"invalid kind = {kind!r}: expected one of {list(KINDS)}")
         if "time" not in channels:
             raise ValueError(f"invalid channels {list(channels)}: a response needs a 'time' channel")
-        data = {n: (np.asarray(v) if n in _INTEGER else np.asarray(v, dtype=float)) for n, v in channels.items()}
+        data = {n: (np.asarray(v) if n in _INTEGER or n.endswith(".flags") else np.asarray(v, dtype=float))
+                for n, v in channels.items()}
         table = channel_units(kind, mode)
         self.channels = Channels(data)
         self.units = {n: (units or {}).get(n, table.get(n, "?")) for n in data}
@@ -237,6 +293,8 @@ class Response:
             work = Work.from_core(work)
         self.kind, self.mode, self.rig, self.work = kind, mode, rig, work
         self.path = None if path is None else Path(path)
+        self.metadata = dict(metadata or {})
+        self.settings = dict(settings or {})
         t = data["time"]
         self.dt = float(dt) if dt is not None else (float((t[-1] - t[0]) / (t.size - 1)) if t.size > 1 else math.nan)
         status = None if work is None else work.status
@@ -265,6 +323,14 @@ class Response:
     def __repr__(self) -> str:
         return (f"Response(kind={self.kind!r}, mode={self.mode!r}, rows={len(self)}, dt={self.dt:.6g}, "
                 f"status={self.status!r}, channels={list(self.channels)})")
+
+    def with_settings(self, **settings: float) -> Response:
+        """A copy (sharing the channel arrays) whose ``settings`` are these rig keys [SI] over its own."""
+        import copy
+
+        out = copy.copy(self)
+        out.settings = {**self.settings, **{k: float(v) for k, v in settings.items()}}
+        return out
 
     # ---- outcome ---------------------------------------------------------------------
     @property
@@ -295,14 +361,21 @@ class Response:
         return self._warning_list(rig)
 
     def _warning_list(self, rig: Rig | None) -> list[str]:
+        return [text for _, text in self.notes(rig)]
+
+    def notes(self, rig: Rig | None = None) -> list[tuple[str, str]]:
+        """(code, note) of every warning (:meth:`warnings`): the limits the run hit
+        (``limit_notes``' codes), ``run_mr_law``, ``run_accuracy`` and ``run_solver`` for the
+        integrator's notes (:func:`solver_notes`) and ``run_failed`` for a failure."""
         rig = self.rig if rig is None else rig
         peak = getattr(self.work, "peak_force", None)
         if peak is None:
             peak = float(np.max(np.abs(self.channels.get("force", np.zeros(0))), initial=0.0))
-        out = limit_warnings(self.flags, self.time, peak, rig)
-        out += solver_warnings(self.work)
+        out = [(code, text) for code, text, _ in limit_notes(self.flags, self.time, peak, rig)]
+        out += [("run_mr_law", text) for text in mr_law_warnings(rig)]
+        out += solver_notes(self.work)
         if not self.success:
-            out.append(self.message)
+            out.append(("run_failed", self.message))
         return out
 
     # ---- export ----------------------------------------------------------------------
@@ -337,7 +410,7 @@ class Response:
 
 
 _LABELS = {"plant": "simulation", "eft": "EFT", "rpsd": "RPsD", "tracking": "tracking", "record": "record",
-           "rths": "RTHS"}
+           "rths": "RTHS", "marths": "maRTHS", "multi": "multi-actuator run"}
 
 
 def _failure_message(kind: str, status: SimpleNamespace) -> str:
@@ -366,5 +439,5 @@ def finish(res: Response, raise_on_failure: bool) -> Response:
     return res
 
 
-__all__ = ["Channels", "Response", "Work", "SimulationError", "channel_units", "limit_warnings", "solver_warnings",
-           "uniform_dt"]
+__all__ = ["Channels", "Response", "Work", "SimulationError", "channel_units", "limit_notes", "limit_warnings",
+           "solver_notes", "solver_warnings", "uniform_dt"]

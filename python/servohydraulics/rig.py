@@ -51,6 +51,18 @@ PARAMETERS: tuple[Parameter, ...] = tuple(
 #: The switches of [effects], from the core's table (parameters.hpp: kEffects).
 EFFECTS: tuple[str, ...] = tuple(e["key"] for e in _core.EFFECTS)
 
+#: The keys whose value is a name, from the core's table (parameters.hpp: ChoiceInfo): key ->
+#: (section, {name: the core's enum}); e.g. ``[specimen] mr_input = "current"``.
+CHOICES: dict[str, tuple[str, dict[str, Any]]] = {
+    c["key"]: (c["section"], dict(c["names"])) for c in _core.RIG_CHOICES}
+
+
+def choice_name(rig: Rig, key: str) -> str:
+    """The name of a choice key's value in ``rig`` (``"current"`` for ``rig.mr_input``)."""
+    value = getattr(rig, key)
+    return next(name for name, v in CHOICES[key][1].items() if v == value)
+
+
 FLOW_CURVE_KEYS = ("kind", "b", "opening", "flow")
 #: servovalve.flow_curve.kind: name -> FlowCurve.Kind (the core's table, rig.hpp).
 FLOW_CURVE_KINDS = dict(_core.FLOW_CURVE_KIND_NAMES)
@@ -89,6 +101,8 @@ def rig_to_dict(rig: Rig) -> dict[str, dict[str, Any]]:
         curve["opening"] = [float(v) for v in fc.opening]
         curve["flow"] = [float(v) for v in fc.flow]
     out["servovalve"]["flow_curve"] = curve
+    for key, (section, _) in CHOICES.items():
+        out[section][key] = choice_name(rig, key)
     out["effects"] = {name: bool(getattr(rig.effects, name)) for name in EFFECTS}
     return out
 
@@ -136,10 +150,16 @@ def _apply(rig: Rig, data: dict[str, Any]) -> None:
                 setattr(rig.effects, key, value)
             elif section == "servovalve" and key == "flow_curve":
                 rig.flow_curve = _flow_curve_from_dict(value)
+            elif key in CHOICES and CHOICES[key][0] == section:
+                names = CHOICES[key][1]
+                if not isinstance(value, str) or value not in names:
+                    raise ValueError(f"invalid {where} = {value!r}: expected one of {list(names)}")
+                setattr(rig, key, names[value])
             elif key in known[section]:
                 setattr(rig, key, _number(where, value))
             else:
-                raise ValueError(f"unknown rig key {where}: expected one of {sorted(known[section])}")
+                choices = [k for k, (sec, _) in CHOICES.items() if sec == section]
+                raise ValueError(f"unknown rig key {where}: expected one of {sorted(known[section]) + choices}")
 
 
 def _flow_curve_from_dict(table: Any) -> _core.FlowCurve:
@@ -213,6 +233,8 @@ def parameter_table() -> str:
                  "Q/K_v, mirrored for x < 0) or `rational` (g = x/(1 + b abs(x)), key `b`) | Fig 4a |")
     lines.append(f"| `servovalve.flow_curve.opening`, `.flow` | - | {pts} | linear below 10 %, rated flow "
                  "at full opening | p. 1780, MTS 256.09 rating; docs/calibration.md |")
+    for c in _core.RIG_CHOICES:
+        lines.append(f"| `{c['section']}.{c['key']}` | name | {c['default']} | {c['doc']} | {c['source']} |")
     for name in EFFECTS:
         lines.append(f"| `effects.{name}` | bool | {str(getattr(default.effects, name)).lower()} | "
                      "switch the effect on/off | |")

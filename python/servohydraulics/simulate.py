@@ -30,16 +30,19 @@ def solver_options(method: str = DEFAULT_METHOD, rtol: float | None = None, rest
                    max_order: int | None = None, rk4_h_rho: float | None = None,
                    rk4_v_ref: float | None = None, atol_fraction: float | None = None,
                    stiff_fallback: bool | None = None, stiff_steps: int | None = None,
-                   rk4_flag_rtol: float | None = None, rk4_max_refinements: int | None = None,
+                   stiff_check: bool | None = None, rk4_flag_rtol: float | None = None,
+                   rk4_max_refinements: int | None = None,
                    max_internal_step: float | None = None) -> _core.SolverOptions:
     """Builds solver options; see ``SolverOptions`` in solver_options.hpp (one keyword per row of
     its field table, ``_core.SOLVER_OPTION_FIELDS``).
 
     ``method``: ``"dopri5"`` (default: Dormand-Prince 5(4) with error control at ``rtol``, a sample
     where it turns stiff is redone by CVODE, or reported as status ``stiff`` if ``stiff_fallback`` is
-    False), ``"rk4"`` (the real-time option: fixed cost, ``rk4_substeps`` per sample or automatic,
-    samples flagged by its error estimate at ``rk4_flag_rtol``, redone with doubled substeps up to
-    ``rk4_max_refinements`` times), ``"cvode"`` (BDF, the reference), ``"arkode_erk"``,
+    False; a run that turned stiff is checked against one at ``rtol / 10``, ``stiff_check`` False
+    drops that check), ``"rk4"`` (the real-time option: fixed cost, ``rk4_substeps`` per sample or automatic,
+    checked by a companion run at twice the substeps that flags where the two differ by more than
+    ``rk4_flag_rtol`` of the peaks (0: no check), the rest of the run at doubled substeps from a
+    flagged sample up to ``rk4_max_refinements`` times), ``"cvode"`` (BDF, the reference), ``"arkode_erk"``,
     ``"arkode_dirk"`` (SUNDIALS ARKODE references).  Absolute tolerances scale with the rig:
     ``rtol * atol_fraction * state_scale`` (``_core.absolute_tolerances``).  A keyword left at None
     keeps the core's default."""
@@ -53,7 +56,8 @@ def solver_options(method: str = DEFAULT_METHOD, rtol: float | None = None, rest
             max_steps_per_sample=max_steps_per_sample, max_order=max_order, rk4_h_rho=rk4_h_rho,
             rk4_v_ref=rk4_v_ref, atol_fraction=atol_fraction,
             stiff_fallback=None if stiff_fallback is None else bool(stiff_fallback), stiff_steps=stiff_steps,
-            rk4_flag_rtol=rk4_flag_rtol, rk4_max_refinements=rk4_max_refinements,
+            stiff_check=None if stiff_check is None else bool(stiff_check), rk4_flag_rtol=rk4_flag_rtol,
+            rk4_max_refinements=rk4_max_refinements,
             max_internal_step=max_internal_step)
     o.validate()
     return o
@@ -156,13 +160,21 @@ def simulate(rig: Rig, mode: str = "displacement", command: ArrayLike | None = N
     Returns:
         A :class:`~servohydraulics.response.Response` of kind ``"plant"``: the
         plant's channels, ``command``, ``flags``, ``internal_steps``, ``rhs_evals``;
-        ``work.stiff_samples`` and ``work.inaccurate_samples`` count the samples CVODE took
-        over and the RK4 samples its error estimate flagged (also in ``warnings()``).
+        ``work.stiff_samples`` counts the samples CVODE took over; ``work.error_estimate`` is
+        the run's accuracy check over its bound (> 1: the run probably misses the method's stated
+        accuracy, also in ``warnings()``: RK4's companion at twice the substeps, or the default's
+        check of a run that turned stiff), ``work.inaccurate_samples`` the samples it flagged.
     """
     dt = _check_dt(dt)
     u = _command_array(command, duration, dt)
-    plant = make_plant(rig, mode, dt, options, x0)
+    opts = options or solver_options()
+    plant = make_plant(rig, mode, dt, opts, x0)
     channels, s = _core.run_record(plant, u)
+    # A default run that turned stiff is checked from its start as well (record.hpp, check_record).
+    tight = _core.record_check_options(opts, s)
+    if tight is not None:
+        s = _core.check_record(make_plant(rig, mode, dt, tight, x0), u, channels["displacement"][: s.rows],
+                               channels["force"][: s.rows], s)
     data = {"time": channels["time"][: s.rows], "command": u[: s.rows]}
     data.update((k, v[: s.rows]) for k, v in channels.items())
     return finish(Response(data, kind="plant", mode=mode, dt=dt, rig=rig, work=s), raise_on_failure)

@@ -36,6 +36,8 @@ int main() {
     for (std::size_t i = 0; i < 2; ++i) {
       CHECK_NEAR(c.dstroke_dtheta(i, th), (sp[i] - sm[i]) / (2 * h), 1e-9);
       CHECK_NEAR(c.d2stroke_dtheta2(i, th), (sp[i] - 2 * s0[i] + sm[i]) / (h * h), 1e-3);
+      CHECK_NEAR(c.d3stroke_dtheta3(i, th), (c.d2stroke_dtheta2(i, th + h) - c.d2stroke_dtheta2(i, th - h)) / (2 * h),
+                 1e-8);
     }
     // Virtual work: F . ds = Fx dx + M dtheta for any small motion.
     const double F[2] = {1234.5, -987.0};

@@ -28,6 +28,7 @@
 
 #include "check.hpp"
 #include "randomizer.hpp"
+#include "servohydraulics/elements/mr_damper.hpp"
 #include "servohydraulics/linearize.hpp"
 #include "servohydraulics/plant.hpp"
 #include "servohydraulics/presets.hpp"
@@ -88,9 +89,9 @@ bool away_from_kinks(const Dynamics& dyn, const Draw& d) {
     if (r.bw_n == 1.0 && std::fabs(y[iz]) < 1e-6) return false;
   }
   if (const int iy = L.offset_of<MrDamper>(); iy >= 0) {
-    const double cs = (r.mr_c0_a + r.mr_c0_b * r.mr_voltage) + (r.mr_c1_a + r.mr_c1_b * r.mr_voltage);
-    const double ydot = ((r.mr_alpha_a + r.mr_alpha_b * r.mr_voltage) * y[iy + 1] +
-                         (r.mr_c0_a + r.mr_c0_b * r.mr_voltage) * y[kV] + r.mr_k0 * (y[kX] - y[iy])) / cs;
+    const MrLawValues law = mr_damper_law(r);  // the parameters at the rig's field input
+    const double cs = law.c0 + law.c1;
+    const double ydot = (law.alpha * y[iy + 1] + law.c0 * y[kV] + r.mr_k0 * (y[kX] - y[iy])) / cs;
     if (std::fabs(y[kV] - ydot) < margin_v) return false;
     if (r.mr_n == 1.0 && std::fabs(y[iy + 1]) < 1e-6) return false;
   }
@@ -356,6 +357,23 @@ int main() {
       run(spec, mode, 40, "specimens, n 2.5 / 1, Pade order " + std::to_string(order));
     }
   }
+  // The MR damper by the UTFSM thesis' law (Quiroz 2022) in the coil current, at three currents:
+  // alpha quadratic, beta and gamma scaled by exp(-d i) (its parameters in SI: N/m, N s/m, 1/m^2).
+  for (ControlMode mode : modes)
+    for (double amps : {0.0, 0.5, 1.0}) {
+      Rig q = zhao2003();
+      q.effects.mr_damper = true;
+      q.mr_input = MrInput::Current;
+      q.mr_law = MrLaw::Quiroz2022;
+      q.mr_current = amps;
+      q.mr_law_max = 1.0;
+      q.mr_alpha_a = 15.221e3, q.mr_alpha_b = 41.508e3, q.mr_alpha_c = -38.152e3;
+      q.mr_c0_a = 0.92491e3, q.mr_c0_b = 7.6260e3, q.mr_c1_a = 9.8671e3, q.mr_c1_b = 78.337e3;
+      q.mr_k0 = 0.15013, q.mr_k1 = 1.2388e3, q.mr_x0 = 2.3091e-6, q.mr_A = 300.0, q.mr_n = 2.0;
+      q.mr_beta = q.mr_gamma = 1.8941e6;
+      q.mr_bw_decay = 3.6561;
+      run(q, mode, 60, "MR damper, thesis law at " + std::to_string(amps) + " A");
+    }
   // The fluid damper linear (alpha = 1, a Maxwell element) and at alpha 0.3, with the specimens.
   for (ControlMode mode : modes)
     for (double alpha : {1.0, 0.3}) {

@@ -60,13 +60,14 @@ CSVS = {
     "nan": HEADER + "\n0,0,0,0\n0.0005,nan,0,0\n0.001,0,0,0\n",
     "text": HEADER + "\n0,0,0,0\n0.0005,abc,0,0\n0.001,0,0,0\n",
     "ragged": HEADER + "\n0,0,0,0\n0.0005,0,0\n0.001,0,0,0\n",
-    "semicolon": HEADER.replace(",", ";") + "\n" + _rows().replace(",", ";"),
+    "semicolon": HEADER.replace(",", ";") + "\n" + _rows().replace(",", ";"),  # read (issue 25), all zero
+    "mixed_delimiters": HEADER + "\n" + _rows().replace(",", ";"),
 }
 CSV_EXPECT = {
     "duplicate": "'force' appears twice", "missing_column": "missing column", "unknown_column": "temperature",
     "empty": "missing column", "header_only": "no data rows", "one_row": "at least 2 rows",
     "nonuniform": "uniform", "decreasing": "increasing", "nan": "'command'", "text": "could not parse",
-    "ragged": "could not parse", "semicolon": "missing column",
+    "ragged": "could not parse", "semicolon": "'displacement' is all zero", "mixed_delimiters": "mixed or unknown",
 }
 
 

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 import servohydraulics as sh
 from servohydraulics.records import read_record, write_record
-from servohydraulics.rig import EFFECTS, PARAMETERS
+from servohydraulics.rig import CHOICES, EFFECTS, PARAMETERS
 
 # ---- rig files ----------------------------------------------------------------
 
@@ -51,13 +51,16 @@ def _every_field_changed() -> sh.Rig:
     curve.opening = [0.0, 0.1, 0.5, 1.0]
     curve.flow = [0.0, 0.1, 0.4, 0.6]
     rig.flow_curve = curve
+    # the choices off their defaults; the MR damper reads one field input, the other must be 0
+    rig.mr_input, rig.mr_law = sh._core.MrInput.Current, sh._core.MrLaw.Quiroz2022
+    rig.mr_voltage = 0.0
     return rig
 
 
 def test_every_parameter_is_in_the_rig_file():
     """PARAMETERS (the file's keys) covers every numeric field of the C++ Rig."""
     fields = {n for n in dir(sh.Rig()) if not n.startswith("_")} - {"effects", "flow_curve", "validate"}
-    assert fields == {p.key for p in PARAMETERS}
+    assert fields == {p.key for p in PARAMETERS} | set(CHOICES)
 
 
 @pytest.mark.parametrize("which", ["calibrated", "printed", "every-field-changed"])
@@ -67,8 +70,10 @@ def test_rig_toml_round_trip(tmp_path, which):
     back = sh.load_rig(path)
     _assert_same_rig(rig, back)
     if which == "every-field-changed":
-        for p in PARAMETERS:
-            assert getattr(back, p.key) != getattr(sh.zhao2003(), p.key), p.key
+        for p in PARAMETERS:  # (mr_voltage: 0 as the preset's, the rig reads mr_current)
+            assert p.key == "mr_voltage" or getattr(back, p.key) != getattr(sh.zhao2003(), p.key), p.key
+        for key in CHOICES:
+            assert getattr(back, key) != getattr(sh.zhao2003(), key), key
     # Saving what was loaded writes the same file.
     again = sh.save_rig(back, tmp_path / "again.toml")
     assert again.read_text() == path.read_text()
@@ -108,6 +113,9 @@ def _flow_curves(draw) -> sh.FlowCurve:
     return curve
 
 
+_FINITE_KEYS = {k for k, b in _BOUNDS.items() if b == "finite"}  # signed: the thesis' MR-damper law terms
+
+
 @st.composite
 def _rigs(draw) -> sh.Rig:
     rig = sh.Rig()
@@ -116,11 +124,25 @@ def _rigs(draw) -> sh.Rig:
             setattr(rig, p.key, float(draw(st.integers(min_value=1, max_value=6))))
         elif p.key in _AT_LEAST_ONE_KEYS:
             setattr(rig, p.key, 1.0 + draw(_nonneg))
+        elif p.key in _FINITE_KEYS:
+            setattr(rig, p.key, draw(st.floats(min_value=-1e3, max_value=1e3)))
         else:
             setattr(rig, p.key, draw(_nonneg if p.key in _NONNEG_KEYS else _positive))
     for name in EFFECTS:
         setattr(rig.effects, name, draw(st.booleans()))
     rig.flow_curve = draw(_flow_curves())
+    # the MR damper's choices, and what they require of its keys (elements/mr_damper.hpp: validate_mr_law)
+    for key, (_, names) in CHOICES.items():
+        setattr(rig, key, names[draw(st.sampled_from(sorted(names)))])
+    setattr(rig, "mr_voltage" if rig.mr_input == sh._core.MrInput.Current else "mr_current", 0.0)
+    if rig.mr_law == sh._core.MrLaw.Spencer:
+        rig.mr_alpha_c = rig.mr_bw_decay = 0.0
+    else:  # alpha(u) >= 0 and beta, gamma finite at the run's u
+        u = max(rig.mr_voltage, rig.mr_current)
+        # (1 - 1e-9): alpha(u) just above 0, not on it, where rounding could give -2e-16
+        rig.mr_alpha_c = max(rig.mr_alpha_c, -(1.0 - 1e-9) * (rig.mr_alpha_a + rig.mr_alpha_b * u) / max(u * u, 1e-300))
+        rig.mr_bw_decay = max(rig.mr_bw_decay, -1.0 / max(u, 1e-300))
+    rig.mr_law_min, rig.mr_law_max = sorted((rig.mr_law_min, rig.mr_law_max))
     rig.validate()
     return rig
 

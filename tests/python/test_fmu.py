@@ -429,3 +429,28 @@ def test_rig_details_travel_through_the_resources(rig, tmp_path):
     s.close()
     assert _rel(got, ref.displacement) <= RTOL
     assert s.var["effects.coulomb_friction"].start in ("false", False)
+
+
+def test_mr_damper_law_travels_through_the_resources(rig, tmp_path):
+    """The MR damper's field input and law (rig keys whose value is a name: Enumeration parameters):
+    a current-driven damper under the thesis' law at 0.5 A equals sh.simulate in the FMU."""
+    from servohydraulics.identification.baselines import thesis_law_keys
+
+    r = sh.rig_from_dict({"specimen": {**thesis_law_keys(), "mr_current": 0.5}}, base=rig)
+    r.effects.mr_damper = True
+    dt = 1e-3
+    path = sh.export_fmu(r, tmp_path / "mr.fmu", dt=dt)
+    u = 0.005 * np.sin(2 * np.pi * 2.0 * np.arange(400) * dt)
+    ref = sh.simulate(r, "displacement", u, dt)
+    s = Slave(path, tmp_path / "mr")
+    assert s.var["specimen.mr_input"].type == "Enumeration" and s.var["specimen.mr_law"].type == "Enumeration"
+    got = []
+    for k in range(u.size):
+        got.append(s.get(["force"])[0])
+        s.set(command=u[k])
+        s.step(dt)
+    s.close()
+    assert _rel(got, ref.force) <= RTOL
+    spencer = sh.copy_rig(r)
+    spencer.mr_law, spencer.mr_alpha_c, spencer.mr_bw_decay = _core.MrLaw.Spencer, 0.0, 0.0
+    assert _rel(sh.simulate(spencer, "displacement", u, dt).force, ref.force) > 1e-3  # the law matters here

@@ -1,7 +1,12 @@
 """Property tests of ``identify`` and ``compare`` on the command line (issue 26,
 docs/robustness.md): drawn records (length, rate, noise, NaN/inf, non-uniform,
 duplicate or reversed times, constant signals, missing columns, huge values),
-drawn rigs (a TOML value replaced, a missing or empty file) and drawn flags.
+drawn rigs (a TOML value replaced, a missing or empty file) and drawn flags;
+and (issue 25) drawn record files: CSV, semicolon with decimal commas, tab,
+whitespace, .mat vectors and structs, a DAQ export with a layout file, in m,
+mm or inches and N or kN, with units in the header or given by ``--units``,
+truncated, with a lying sample count, mixed delimiters or a missing variable,
+and drawn reader flags (bad units, scales, columns, ``--accept``).
 
 Every invocation ends in exit 0 with the whole output set, or one ``error:``
 line that names a field and its value (or the input file), exit 2 (1 for a run
@@ -43,7 +48,7 @@ COMPARE_FILES = ("comparison.json", "overlay.png", "frf.png")
 IDENTIFY_FILES = ("rig_identified.toml", "identification.json", "report.md")
 #: a message names a field and its value (``invalid dt = 0.0: ...``), argparse's ``argument --x: invalid``,
 #: or the input file (a record or rig file, a column of it)
-NAMED = re.compile(r"invalid [^=\n]{1,80}? = \S|argument --?[\w-]+: |rec_?\S*\.csv|rig_?\S*\.toml")
+NAMED = re.compile(r"invalid [^=\n]{1,80}? = \S|argument --?[\w-]+: |rec_?\S*\.(csv|txt|mat)|rig_?\S*\.toml")
 
 
 def teardown_module() -> None:
@@ -349,3 +354,141 @@ def test_subprocess_smoke(tmp_path, command, defect, dt, expected):
     assert "Traceback" not in p.stderr and "internal error" not in p.stderr
     if expected:
         assert len(p.stderr.strip().splitlines()) == 1 and NAMED.search(p.stderr), p.stderr
+
+
+# ----------------------------------------------------------------------------- record files and their flags
+
+#: file unit -> factor from SI, per kind
+LENGTHS = {"m": 1.0, "mm": 1e3, "in": 1 / 0.0254}
+FORCES = {"N": 1.0, "kN": 1e-3}
+FORMATS = ["csv", "csv", "semicolon_comma", "tab", "whitespace", "mat_vectors", "mat_struct", "daq"]
+FILE_DEFECTS = ["none"] * 8 + ["truncated", "count_lie", "mixed_delimiters", "missing_variable"]
+
+
+def write_file(path: Path, mode: str, fmt: str, length: str, force: str, named_units: bool, defect: str
+               ) -> tuple[Path, dict, dict]:
+    """The reference record written in a drawn format and units; returns (path, the flags that
+    read it right, the columns the file uses)."""
+    ref = reference(mode)
+    cmd_kind = LENGTHS if mode == "displacement" else FORCES
+    cmd_unit = length if mode == "displacement" else force
+    f = {"time": 1.0, "command": cmd_kind[cmd_unit], "displacement": LENGTHS[length], "force": FORCES[force]}
+    unit = {"time": "s", "command": cmd_unit, "displacement": length, "force": force}
+    cols = {k: ref[k] * f[k] for k in ("time", "command", "displacement", "force")}
+    names = {k: (f"{k}_{unit[k]}" if named_units else k) for k in cols}
+    right = {} if named_units else {"units": ",".join(f"{k}={unit[k]}" for k in cols if unit[k] not in ("m", "N", "s"))}
+    if fmt.startswith("mat"):
+        from scipy.io import savemat
+
+        path = path.with_suffix(".mat")
+        data = {names[k]: v for k, v in cols.items()}
+        if defect == "missing_variable":
+            data.pop(names["force"])
+        savemat(path, {"rec": data} if fmt == "mat_struct" else data)
+        return path, right, names
+    if fmt == "daq":  # a header block, sample numbers, channels in volts (scale 0.01 unit/V)
+        lines = ["Header Size:  7", "Version:  2", f"Sampling Interval:  {DT}", f"Sampling Rate:  {1 / DT:g}",
+                 f"Sample Count:  {N + (5 if defect == 'count_lie' else 0)}", "Device Serial Number:  0",
+                 "Sample Number, CHANNEL0, CHANNEL1, CHANNEL2, Events"]
+        for k in range(N):
+            lines.append(f"{k + 1:>8}, {cols['displacement'][k] / 0.01:.9g}, {cols['force'][k] / 0.01:.9g}, "
+                         f"{cols['command'][k] / 0.01:.9g}" + (", DAQ Start" if k == 0 else ""))
+        text = "\n".join(lines) + "\n"
+        if defect == "truncated":
+            text = text[: len(text) - 15]
+        path.write_text(text)
+        lay = path.with_name(path.stem + "_layout.toml")
+        lay.write_text('sample_interval = "Sampling Interval"\n[columns]\ntime = "Sample Number"\n'
+                       'command = "CHANNEL2"\ndisplacement = "CHANNEL0"\nforce = "CHANNEL1"\n'
+                       f'[units]\ntime = "samples"\ncommand = "{unit["command"]}"\ndisplacement = "{length}"\n'
+                       f'force = "{force}"\n[scale]\ncommand = 0.01\ndisplacement = 0.01\nforce = 0.01\n')
+        return path, {"layout": str(lay)}, names
+    sep, dec = {"csv": (",", "."), "semicolon_comma": (";", ","), "tab": ("\t", "."), "whitespace": ("  ", ".")}[fmt]
+    rows = []
+    for k in range(N):
+        cells = [repr(float(cols[c][k])) for c in cols]
+        if dec == ",":
+            cells = [c.replace(".", ",") for c in cells]
+        rows.append(sep.join(cells))
+    if defect == "mixed_delimiters":
+        rows[N // 2] = rows[N // 2].replace(sep, "|")
+    if defect == "truncated":
+        rows[-1] = rows[-1][: len(rows[-1]) // 2].rstrip(sep)
+    path.write_text(sep.join(names[c] for c in cols) + "\n" + "\n".join(rows) + "\n")
+    return path, right, names
+
+
+READ_DRAW = dict(
+    mode=st.sampled_from(["displacement", "force"]), fmt=st.sampled_from(FORMATS),
+    length=st.sampled_from(["m", "m", "mm", "in"]), force=st.sampled_from(["N", "N", "kN"]),
+    named_units=st.booleans(), defect=st.sampled_from(FILE_DEFECTS),
+    flags=st.sampled_from(["right"] * 6 + ["none", "none", "bad_unit", "wrong_dimension", "malformed",
+                                           "scale_zero", "scale_text", "column_missing", "column_unknown",
+                                           "accept_warning", "accept_error", "accept_bogus"]))
+
+
+def read_case(tmp_path, mode, fmt, length, force, named_units, defect, flags):
+    """One drawn record file and flags through ``compare``: a named error with nothing written,
+    or the whole output set; the right reading compares at ~0 NRMSE, and a wrong one (no
+    units given for a file in mm, in or kN) is never silent: refused, or a warning on screen."""
+    tag = uuid.uuid4().hex[:8]
+    rec, right, names = write_file(tmp_path / f"rec_{fmt}_{length}_{force}_{defect}_{tag}.txt", mode, fmt, length,
+                                   force, named_units, defect)
+    rig, out = tmp_path / f"rig_{tag}.toml", tmp_path / f"out_{tag}"
+    write_rig(rig, "none", "m", "1")
+    argv = ["compare", str(rec), "--rig", str(rig), "--mode", mode, "--out", str(out)]
+    correct = flags in ("right", "accept_warning") and defect == "none"
+    if flags in ("right", "accept_warning"):
+        argv += [f"--{k}={v}" for k, v in right.items() if v]
+    elif flags == "bad_unit":
+        argv += ["--units", "displacement=mmm"]
+    elif flags == "wrong_dimension":
+        argv += ["--units", "force=mm"]
+    elif flags == "malformed":
+        argv += ["--units", "displacement"]
+    elif flags == "scale_zero":
+        argv += ["--scale", "force=0"]
+    elif flags == "scale_text":
+        argv += ["--scale", "force=big"]
+    elif flags == "column_missing":
+        argv += ["--columns", "force=no_such_column"]
+    elif flags == "column_unknown":
+        argv += ["--columns", "forse=force"]
+    elif flags.startswith("accept_"):
+        argv += ["--accept", {"accept_error": "displacement_outside_stroke", "accept_bogus": "bogus"}[flags]]
+    if flags == "accept_warning":
+        argv += ["--accept", "flat_at_limit,run_spool"]
+    outcome, code, err = _run(argv)
+    _check_outcome(argv, outcome, code, err, out, COMPARE_FILES)
+    truly_si = (length == "m" and force == "N") or named_units or flags in ("right", "accept_warning")
+    if outcome == "ok":
+        data = json.loads((out / "comparison.json").read_text())
+        worst = max(m["nrmse_pct"] for m in data["channels"].values())
+        if correct and (truly_si or fmt == "daq"):
+            OUTCOMES["read: right reading checked"] += 1
+            _require(worst < 1.0, "wrong answer", argv, f"NRMSE {worst} % on the rig's own record")
+        elif worst > 5.0:  # a misreading that ran: it must have said so
+            OUTCOMES["read: misread, warned"] += 1
+            _require("warning:" in err, "silent misreading", argv, f"NRMSE {worst} %, no warning")
+    else:
+        _require(not (correct and (truly_si or fmt == "daq")), "right reading refused", argv, err)
+
+
+@settings(max_examples=8, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(**READ_DRAW)
+@example(mode="displacement", fmt="csv", length="mm", force="N", named_units=False, defect="none", flags="none")
+@example(mode="displacement", fmt="daq", length="mm", force="kN", named_units=False, defect="none", flags="right")
+@example(mode="force", fmt="mat_struct", length="m", force="kN", named_units=True, defect="none", flags="right")
+@counted(OUTCOMES)
+def test_record_files_and_flags(tmp_path, **draw):
+    read_case(tmp_path, **draw)
+
+
+@pytest.mark.slow
+@settings(max_examples=300, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(**READ_DRAW)
+@counted(OUTCOMES)
+def test_record_files_and_flags_many(tmp_path, **draw):
+    read_case(tmp_path, **draw)

@@ -103,7 +103,7 @@ def test_parameter_table_drives_validation_and_binding():
     for row in rows:
         assert getattr(default, row["key"]) == row["default"]
         bad = {"finite and > 0": (0.0,), "finite and >= 0": (-1.0,), "finite and >= 1": (0.5,),
-               "an integer in 1..6": (0.0, 2.5, 7.0)}[row["bound"]]
+               "an integer in 1..6": (0.0, 2.5, 7.0), "finite": ()}[row["bound"]]
         for value in (*bad, math.nan, math.inf):
             r = sh.Rig()
             setattr(r, row["key"], value)

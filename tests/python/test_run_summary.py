@@ -11,8 +11,8 @@ import servohydraulics as sh
 from servohydraulics import rths
 
 SUMMARY = {"ok", "status", "rows", "internal_steps", "rhs_evals", "restarts", "max_internal_steps",
-           "stiff_samples", "inaccurate_samples", "flags_any", "peak_force", "peak_displacement", "peak_velocity",
-           "failure_time", "first_capacity_time"}
+           "stiff_samples", "inaccurate_samples", "error_estimate", "max_sample_error_estimate", "flags_any",
+           "peak_force", "peak_displacement", "peak_velocity", "failure_time", "first_capacity_time"}
 
 
 def _ag(n=1000, dt=5e-4):

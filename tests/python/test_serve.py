@@ -208,6 +208,19 @@ def test_one_client_at_a_time_idle_timeout_and_ctrl_c(linear_rig):
     assert "stopped (interrupt)" in log and "interrupted" in log and "Traceback" not in log
 
 
+def test_ctrl_c_stops_a_server_started_with_sigint_ignored(linear_rig):
+    """A server started from a shell's background job inherits SIGINT ignored (no job control):
+    it still stops on SIGINT with exit 130 (it failed CI that way: killed after 20 s)."""
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        proc, _ = _start("--rig", str(linear_rig), "--actuator", "ideal")
+    finally:
+        signal.signal(signal.SIGINT, old)
+    log = _finish(proc, 20, signal.SIGINT)
+    assert proc.returncode == 130, log
+    assert "stopped (interrupt)" in log and "Traceback" not in log
+
+
 @pytest.mark.parametrize("args, text", [
     (["--port", "70000"], "--port = 70000"),
     (["--port", "0", "--actuators", "0"], "--actuators = 0"),

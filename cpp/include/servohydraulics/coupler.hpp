@@ -9,10 +9,10 @@
 //
 //   s_i(x, theta) = x + d_i (cos(theta + alpha_i) - cos(alpha_i))        (the benchmark's frame -> actuator)
 //
-// with ds_i/dx = 1, ds_i/dtheta = -d_i sin(theta + alpha_i) and
-// d2s_i/dtheta2 = -d_i cos(theta + alpha_i); by virtual work the actuator
-// forces F_i [N] load the node with Q = J^T F (force along x, moment about the
-// node).  A nonlinear geometry: the benchmark and a simulated fixture use the
+// with ds_i/dx = 1, ds_i/dtheta = -d_i sin(theta + alpha_i),
+// d2s_i/dtheta2 = -d_i cos(theta + alpha_i) and d3s_i/dtheta3 = d_i sin(theta + alpha_i);
+// by virtual work the actuator forces F_i [N] load the node with Q = J^T F (force along x,
+// moment about the node).  A nonlinear geometry: the benchmark and a simulated fixture use the
 // same functions.
 //
 // Construction validates (Error naming the field and the value); every other
@@ -44,6 +44,8 @@ class Coupler {
   double dstroke_dtheta(std::size_t i, double theta) const noexcept;
   //! d2s_i/dtheta2 [m/rad^2] at theta.
   double d2stroke_dtheta2(std::size_t i, double theta) const noexcept;
+  //! d3s_i/dtheta3 [m/rad^3] at theta (the pistons' inertia in a coupled rig's Jacobian).
+  double d3stroke_dtheta3(std::size_t i, double theta) const noexcept;
   //! Generalised node load (Fx [N], M [N m]) of the actuator forces F[i] [N]: Q = J(theta)^T F.
   void node_load(double theta, const double* F, double* Fx, double* M) const noexcept;
 

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <utility>
 
 #include "servohydraulics/elements.hpp"
@@ -43,6 +44,24 @@ class Dynamics {
   //! J = df/dy; if B is given, also B = df/du.
   void jacobian(const double* y, const Input& in, Jacobian& J, State* B = nullptr) const noexcept;
   void outputs(const double* y, const Input& in, Output& out, OutputGradients* grad = nullptr) const noexcept;
+
+  // The actuator alone, for a rig that moves its piston by other equations (the coupled
+  // multi-actuator rig, multi_rig.hpp).  Displacement mode only.
+  //! Eqs (1)-(4) and the friction on the piston at a local state y whose y[kX], y[kV] are the
+  //! stroke and its rate (set by the caller): writes into g the drive, spool, flow, pressure rate,
+  //! spool acceleration, the bristle's rate (LuGre) and the drive elements' rates, with their
+  //! gradients by the states (columns 0..num_states()-1) and u (column num_states()), and returns
+  //! the piston friction (the structure's friction laws of Eq 5 along the stroke) with its
+  //! derivatives.  The structure's spring, damping and specimens are not evaluated.
+  LawForce actuator(const double* y, const Input& in, Algebra& g) const noexcept;
+  //! The rates of the actuator's own states (kP, kXv, kXvDot, kZ and the elements') from an
+  //! evaluation g at y, into ydot (the rows rhs writes past x and v).
+  void actuator_rates(const double* y, const Algebra& g, double* ydot) const noexcept;
+  //! Their rows of J (columns 0..num_states()-1) and of B from an evaluation g; the other rows untouched.
+  void actuator_jacobian(const Algebra& g, Jacobian& J, State* B = nullptr) const noexcept;
+  //! The OutputFlag bits of state y (its x and p) with the spool and the drive saturated or not and
+  //! the load-cell force [N].
+  std::uint32_t flags(const double* y, bool spool_saturated, bool drive_saturated, double force) const noexcept;
 
   //! Static equilibrium for a held command u with the structure at x0: v = 0,
   //! the pressure that holds the springs, the spool that feeds the leakage.
@@ -100,6 +119,9 @@ class Dynamics {
   const Rig& rig() const noexcept { return rig_; }
   ControlMode mode() const noexcept { return mode_; }
   double moving_mass() const noexcept { return M_; }
+  //! The piston mass that moves with the structure and that the load cell sees [kg] (0 when
+  //! effects.piston_mass is off or in free mode).
+  double piston_mass() const noexcept { return mp_; }
 
   // Pieces of the model, exposed for compensators and tests (the laws' own, elements/*.hpp).
   //! The structure's force against the applied one in Eq (5), f_s(x) + c v + F_f [N]:
@@ -123,6 +145,11 @@ class Dynamics {
   template <int W>
   void evaluate(const double* y, const Input& in, Algebra& a) const noexcept;
   void evaluate_any(const double* y, const Input& in, Algebra& a) const noexcept;
+  template <int W>
+  LawForce evaluate_actuator(const double* y, const Input& in, Algebra& a) const noexcept;
+  // f(std::integral_constant<int, W>) with W = num_states() + 1, a compile-time constant in each case.
+  template <class F>
+  decltype(auto) at_width(F&& f) const noexcept;
   template <int W>
   void structure(const double* y, const Input& in, Algebra& a) const noexcept;
   template <int W>

@@ -12,7 +12,7 @@
 // (decentralized single-actuator compensators, a MIMO model-based feedforward,
 // RoDeAC, or a user's own in C++ or Python):
 //
-//   MultiTrackingInput in{n, desired, measured};
+//   MultiTrackingInput in{n, desired, measured, desired_velocity, desired_acceleration};
 //   controller.command(in, u);          // u[i]: the command for actuator i [m]
 //
 // Units are SI (m); a loop that reports mm converts at its edge.  Implementations
@@ -40,10 +40,14 @@ class MultiActuatorSystem {
 };
 
 //! What a multi-actuator tracking compensator reads at t_k (arrays of n values, owned by the loop).
+//! The rates of the targets are optional (nullptr when the loop has none): the maRTHS loop gives the
+//! numerical substructure's, carried through the fixture kinematics (coupler.hpp).
 struct MultiTrackingInput {
   std::size_t n = 0;                //!< number of actuators
   const double* desired = nullptr;  //!< target actuator displacements [m]
   const double* measured = nullptr;  //!< measured actuator displacements (with sensor noise) [m]
+  const double* desired_velocity = nullptr;      //!< rates of the targets [m/s] (nullptr: not given)
+  const double* desired_acceleration = nullptr;  //!< their second derivatives [m/s^2] (nullptr: not given)
 };
 
 //! The interface: reset() to rest, command() once per sample.

@@ -15,6 +15,7 @@ enum class Bound {
   NonNegative,  //!< >= 0
   AtLeastOne,   //!< >= 1
   PadeOrder,    //!< an integer in 1..kMaxPadeOrder
+  Finite,       //!< any finite value (a signed coefficient)
 };
 
 struct ParameterInfo {
@@ -83,18 +84,18 @@ inline constexpr ParameterInfo kRigParameters[] = {
      Bound::NonNegative, &Rig::bw_gamma},
     {"specimen", "bw_n", "-", "Bouc-Wen exponent n", "Wen (1976): n >= 1; 1 (smooth yield)", Bound::AtLeastOne,
      &Rig::bw_n},
-    {"specimen", "mr_alpha_a", "N/m", "MR damper alpha = alpha_a + alpha_b u", "Spencer et al. 1997 Table 1",
-     Bound::NonNegative, &Rig::mr_alpha_a},
-    {"specimen", "mr_alpha_b", "N/(m V)", "MR damper alpha's slope by the voltage", "Spencer et al. 1997 Table 1",
-     Bound::NonNegative, &Rig::mr_alpha_b},
+    {"specimen", "mr_alpha_a", "N/m", "MR damper alpha = alpha_a + alpha_b u (+ alpha_c u^2: mr_law)",
+     "Spencer et al. 1997 Table 1", Bound::NonNegative, &Rig::mr_alpha_a},
+    {"specimen", "mr_alpha_b", "N/(m u)", "MR damper alpha's slope by the field input u (V or A: mr_input)",
+     "Spencer et al. 1997 Table 1 (per V)", Bound::NonNegative, &Rig::mr_alpha_b},
     {"specimen", "mr_c0_a", "N s/m", "MR damper viscous c0 = c0_a + c0_b u (high velocity)",
      "Spencer et al. 1997 Table 1", Bound::Positive, &Rig::mr_c0_a},
-    {"specimen", "mr_c0_b", "N s/(m V)", "MR damper c0's slope by the voltage", "Spencer et al. 1997 Table 1",
-     Bound::NonNegative, &Rig::mr_c0_b},
+    {"specimen", "mr_c0_b", "N s/(m u)", "MR damper c0's slope by the field input u (V or A: mr_input)",
+     "Spencer et al. 1997 Table 1 (per V)", Bound::NonNegative, &Rig::mr_c0_b},
     {"specimen", "mr_c1_a", "N s/m", "MR damper c1 = c1_a + c1_b u (roll-off at low velocity)",
      "Spencer et al. 1997 Table 1", Bound::Positive, &Rig::mr_c1_a},
-    {"specimen", "mr_c1_b", "N s/(m V)", "MR damper c1's slope by the voltage", "Spencer et al. 1997 Table 1",
-     Bound::NonNegative, &Rig::mr_c1_b},
+    {"specimen", "mr_c1_b", "N s/(m u)", "MR damper c1's slope by the field input u (V or A: mr_input)",
+     "Spencer et al. 1997 Table 1 (per V)", Bound::NonNegative, &Rig::mr_c1_b},
     {"specimen", "mr_k0", "N/m", "MR damper stiffness k0 (large velocities)", "Spencer et al. 1997 Table 1",
      Bound::NonNegative, &Rig::mr_k0},
     {"specimen", "mr_k1", "N/m", "MR damper accumulator stiffness k1", "Spencer et al. 1997 Table 1",
@@ -109,8 +110,18 @@ inline constexpr ParameterInfo kRigParameters[] = {
      "Spencer et al. 1997 Table 1", Bound::NonNegative, &Rig::mr_gamma},
     {"specimen", "mr_n", "-", "MR damper Bouc-Wen exponent n", "Spencer et al. 1997 Table 1", Bound::AtLeastOne,
      &Rig::mr_n},
-    {"specimen", "mr_voltage", "V", "MR damper command voltage u (constant over a run)",
+    {"specimen", "mr_voltage", "V", "MR damper command voltage u (constant over a run; mr_input = voltage)",
      "Spencer et al. 1997 tested 0-2.25 V", Bound::NonNegative, &Rig::mr_voltage},
+    {"specimen", "mr_current", "A", "MR damper coil current u (constant over a run; mr_input = current)",
+     "not in the paper: 0", Bound::NonNegative, &Rig::mr_current},
+    {"specimen", "mr_alpha_c", "N/(m u^2)", "MR damper alpha's curvature in u (mr_law = quiroz2022)",
+     "Quiroz 2022 (UTFSM thesis): -38.152 N/(mm A^2); 0 under spencer", Bound::Finite, &Rig::mr_alpha_c},
+    {"specimen", "mr_bw_decay", "1/u", "MR damper beta, gamma times exp(-mr_bw_decay u) (mr_law = quiroz2022)",
+     "Quiroz 2022 (UTFSM thesis): 3.6561 1/A; 0 under spencer", Bound::Finite, &Rig::mr_bw_decay},
+    {"specimen", "mr_law_min", "u", "lowest field input the MR damper law was identified on (below: reported)",
+     "Spencer et al. 1997 tested 0-2.25 V", Bound::NonNegative, &Rig::mr_law_min},
+    {"specimen", "mr_law_max", "u", "highest field input the MR damper law was identified on (above: reported)",
+     "Spencer et al. 1997 tested 0-2.25 V", Bound::NonNegative, &Rig::mr_law_max},
     {"delays", "command_delay", "s", "digital command delay (held command switches at t_k + delay)",
      "not in the paper: 0; at most 64 samples", Bound::NonNegative, &Rig::command_delay},
     {"delays", "measurement_delay_displacement", "s", "acquisition delay of the displacement channel",
@@ -134,6 +145,24 @@ struct EffectInfo {
   const char* doc;  //!< what it switches
   bool Effects::*member;
 };
+
+//! A rig-file key whose value is a name (an enum of the rig): section, key, meaning, source.  Its
+//! names come from the enum's table (rig.hpp); the binding, the rig file and the FMU each spell
+//! out the two (mr_input: kMrInputNames, mr_law: kMrLawNames).
+struct ChoiceInfo {
+  const char* section;
+  const char* key;
+  const char* doc;
+  const char* source;
+};
+
+inline constexpr ChoiceInfo kMrInputChoice = {
+    "specimen", "mr_input", "MR damper field input u: \"voltage\" (mr_voltage [V]) or \"current\" (mr_current [A])",
+    "Spencer et al. 1997: voltage"};
+inline constexpr ChoiceInfo kMrLawChoice = {
+    "specimen", "mr_law",
+    "MR damper law of alpha, c0, c1, beta, gamma in u: \"spencer\" (linear) or \"quiroz2022\" (the UTFSM thesis)",
+    "Spencer et al. 1997: spencer"};
 
 inline constexpr EffectInfo kEffects[] = {
     {"servovalve_dynamics", "Eq (2) second-order valve; off: static valve (Eq 6)", &Effects::servovalve_dynamics},

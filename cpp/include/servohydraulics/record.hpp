@@ -8,6 +8,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "servohydraulics/channels.hpp"
@@ -45,7 +46,15 @@ struct RunSummary {
   long restarts = 0;              //!< CVodeReInit calls in the run
   int max_internal_steps = 0;     //!< the largest number in one sample
   long stiff_samples = 0;         //!< samples the default pair found stiff and CVODE integrated (Status::stiff)
-  long inaccurate_samples = 0;    //!< samples flagged Status::inaccurate (Rk4's estimate, dopri5's stiff-sample check)
+  long inaccurate_samples = 0;    //!< samples flagged Status::inaccurate (Rk4's companion, dopri5's stiff-run check)
+  //! The run's accuracy check (Status::run_error_estimate of its last sample): the largest gap
+  //! between the result and the method's check (Rk4's companion, dopri5's shadow of a run that
+  //! turned stiff) relative to the run's peak displacement and force, over the check's bound.
+  //! > 1 (or NaN): the run probably misses the method's stated accuracy; 0: nothing was checked.
+  //! The gap scales with it, so a bound b' flags the run iff this x the configured bound > b'.
+  double error_estimate = 0.0;
+  //! The largest Status::error_estimate of a sample (> 1: a sample was flagged; a NaN sticks).
+  double max_sample_error_estimate = 0.0;
   std::uint32_t flags_any = 0;    //!< OR of every row's OutputFlag bits
   //! max |force| [N]: the load cell (run_record, EFT, RPsD), the actuator force Force_act (RTHS)
   double peak_force = 0.0;
@@ -58,6 +67,27 @@ struct RunSummary {
 //! Runs n samples from the plant's current state.  No allocation, no throw:
 //! stops at the first failed sample and reports it.
 RunSummary run_record(Plant& plant, const double* command, std::size_t n, const Channels& out) noexcept;
+
+//! The default's check of a whole record.  Dopri5's shadow follows a run from its first stiff
+//! sample, so an error made before it that the loop amplifies later is in the result and in the
+//! shadow alike (a high-gain force loop ringing at the end of a record: 1.03e-3 off while the
+//! shadow's gap read 0.39 of its bound; docs/benchmarks.md).  When the whole record is at hand,
+//! a run that turned stiff is checked from its start: a second run of the same set-up at
+//! rtol / 10 (its own check off), started where the run started, over the same commands.
+//!
+//! record_check_options: the second run's options, or nothing when the run needs no such check
+//! (not Dopri5 with stiff_fallback and stiff_check, no stiff sample, or a failed run).
+std::optional<SolverOptions> record_check_options(const SolverOptions& run, const RunSummary& summary) noexcept;
+
+//! Runs `companion` (a plant set up as the run's with record_check_options, reset to the run's
+//! start) over command[0..n) and compares its displacement and load-cell force with the run's
+//! (x, F: the result's rows, `rows` of them, rows <= n) relative to the run's peaks (the floors
+//! of the shadow's measure, detail/output_gap.hpp): summary.error_estimate becomes the larger of
+//! its own and that gap over the shadow's bound (5e-4 of the peaks), so > 1 says the run may miss
+//! the default's 1e-3.  A companion that fails is compared over the rows it ran.  Allocates (its
+//! rows): not for a real-time step.
+void check_record(Plant& companion, const double* command, std::size_t n, const double* x, const double* F,
+                  std::size_t rows, RunSummary& summary);
 
 //! Every channel as vectors, for C++ users who want a convenient result.
 //! Row k holds the sensors at t_k, before command[k] (the convention above).

@@ -51,6 +51,32 @@ static_assert(in_enum_order(kFlowCurveKindNames), "kFlowCurveKindNames: one row 
 //! monotonically (concave), so the curve is invertible.  docs/calibration.md.
 FlowCurve zhao2003_flow_curve();
 
+//! The MR damper's field input u (rig file: [specimen] mr_input): the coil current mr_current [A]
+//! or the command voltage mr_voltage [V]; the law's coefficients are per unit of it.
+enum class MrInput {
+  Voltage,  //!< u = mr_voltage [V] (Spencer et al. 1997 drive a current driver by a voltage)
+  Current,  //!< u = mr_current [A] (a damper driven by a current-controlled amplifier)
+};
+inline constexpr EnumName<MrInput> kMrInputNames[] = {
+    {MrInput::Voltage, "voltage", "Voltage"},
+    {MrInput::Current, "current", "Current"},
+};
+static_assert(in_enum_order(kMrInputNames), "kMrInputNames: one row per enumerator, in order");
+
+//! The law of the MR damper's field-dependent parameters (rig file: [specimen] mr_law).
+enum class MrLaw {
+  //! Spencer et al. (1997): alpha, c0, c1 = (.)_a + (.)_b u; beta, gamma constant
+  Spencer,
+  //! Quiroz (2022, UTFSM MSc thesis, chapter 7): alpha = alpha_a + alpha_b u + alpha_c u^2, c0 and
+  //! c1 as Spencer's, beta and gamma times exp(-mr_bw_decay u) (the thesis: beta = gamma)
+  Quiroz2022,
+};
+inline constexpr EnumName<MrLaw> kMrLawNames[] = {
+    {MrLaw::Spencer, "spencer", "Spencer"},
+    {MrLaw::Quiroz2022, "quiroz2022", "Quiroz2022"},
+};
+static_assert(in_enum_order(kMrLawNames), "kMrLawNames: one row per enumerator, in order");
+
 //! Which physical effects are on.  Off gives the paper's linear-analysis model
 //! (Eqs 6-8) piece by piece.
 struct Effects {
@@ -128,7 +154,8 @@ struct Rig {
   // --- Specimen: MR damper, Spencer, Dyke, Sain, Carlson (1997) (effects.mr_damper) ---
   // F = c1 y' + k1 (x - x0),  y' = (alpha z + c0 x' + k0 (x - y)) / (c0 + c1),
   // z' = -gamma |x' - y'| z |z|^(n-1) - beta (x' - y') |z|^n + A (x' - y'),
-  // alpha, c0, c1 = (.)_a + (.)_b u with u the command voltage (held constant per run).
+  // alpha, c0, c1 = (.)_a + (.)_b u (+ alpha_c u^2) with u the field input (mr_input: the voltage or
+  // the current, held constant per run) by the law mr_law (mr_damper_law in elements/mr_damper.hpp).
   double mr_alpha_a = 140e2;   //!< alpha_a [N/m] (Spencer 1997 Table 1: 140 N/cm)
   double mr_alpha_b = 695e2;   //!< alpha_b [N/(m V)] (695 N/(cm V))
   double mr_c0_a = 21.0e2;     //!< c0a [N s/m] (21.0 N s/cm)
@@ -142,7 +169,14 @@ struct Rig {
   double mr_beta = 363e4;      //!< beta [1/m^2] (363 cm^-2)
   double mr_gamma = 363e4;     //!< gamma [1/m^2] (363 cm^-2)
   double mr_n = 2.0;           //!< n >= 1 [-] (2)
-  double mr_voltage = 0.0;     //!< command voltage u, constant over a run [V]
+  double mr_voltage = 0.0;     //!< command voltage u, constant over a run [V] (mr_input = voltage)
+  double mr_current = 0.0;     //!< coil current u, constant over a run [A] (mr_input = current)
+  double mr_alpha_c = 0.0;     //!< alpha's curvature [N/(m u^2)] (mr_law = quiroz2022; thesis: -38.152 N/(mm A^2))
+  double mr_bw_decay = 0.0;    //!< beta, gamma times exp(-mr_bw_decay u) [1/u] (quiroz2022; thesis: 3.6561 /A)
+  double mr_law_min = 0.0;     //!< field input range the law was identified on: a run outside is
+  double mr_law_max = 2.25;    //!< reported as an extrapolation [u] (Spencer et al. 1997 tested 0-2.25 V)
+  MrInput mr_input = MrInput::Voltage;  //!< which field input u is
+  MrLaw mr_law = MrLaw::Spencer;        //!< the law of alpha, c0, c1, beta, gamma in u
 
   // --- Specimen: nonlinear viscous fluid damper (effects.fluid_damper) ----------
   // F = fd_k (x - u) = fd_c |u'|^fd_alpha sign(u')  (the dashpot in series with its stiffness)

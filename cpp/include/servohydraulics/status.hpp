@@ -19,14 +19,21 @@ struct Status {
   int rhs_evals = 0;       //!< right-hand-side evaluations in this sample
   bool restarted = false;  //!< CVodeReInit was called at the start of this sample
   bool stiff = false;      //!< Dopri5: the sample was stiff for the explicit pair and CVODE integrated it
-  //! The result is kept, the code stays Ok, the flag says it is not to be trusted.  Rk4: the sample's
-  //! embedded error estimate exceeded the tolerance (rk4_flag_rtol) after any refinement.  Dopri5:
-  //! a stiff sample whose CVODE result a looser shadow run does not confirm to the default's stated
-  //! accuracy (dopri5_integrator.hpp, kVerifyTolerance of the run's peak displacement and force).
+  //! The result is kept, the code stays Ok, the flag says it is not to be trusted.  Rk4: the result's
+  //! displacement or force departs from a companion run at twice the substeps by more than
+  //! rk4_flag_rtol of the run's peak.  Dopri5: a sample of a run that has turned stiff where a
+  //! tighter shadow run does not confirm the result to the default's stated accuracy
+  //! (dopri5_integrator.hpp, kVerifyTolerance of the run's peak displacement and force).
   bool inaccurate = false;
-  //! Rk4: the weighted RMS norm of the sample's estimated error; Dopri5 on a stiff sample: the
-  //! shadow's gap over its bound (<= 1: within)
+  //! The check's gap over its bound (<= 1: within; 0 where nothing was checked): Rk4 against its
+  //! companion, Dopri5 against its shadow, relative to the run's peak up to this sample
   double error_estimate = 0.0;
+  //! The run's verdict so far: the largest gap since the reset relative to the peaks so far, over
+  //! the same bound (0 while nothing was checked).  The last sample's is the run's
+  //! (RunSummary::error_estimate): measured against the run's peaks, as the stated accuracy is;
+  //! a sample's flag, against the peak up to that sample, fires also where a later, larger signal
+  //! makes an early error small (the start of a run, the onset of a step).
+  double run_error_estimate = 0.0;
 
   bool ok() const noexcept { return code == Ok; }
   const char* message() const noexcept;  //!< static text for the code

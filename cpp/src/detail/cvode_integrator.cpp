@@ -23,23 +23,25 @@ std::string flag_name(int flag) {
 }
 }  // namespace
 
-CvodeIntegrator::CvodeIntegrator(const Dynamics& dyn, double dt, const SolverOptions& opt, const State& y_prime)
-    : n_(dyn.num_states()), restart_(opt.restart), dyn_(&dyn) {
+template <class System>
+BasicCvodeIntegrator<System>::BasicCvodeIntegrator(const System& sys, double dt, const SolverOptions& opt,
+                                                   const State& y_prime)
+    : n_(Sys::size(sys)), restart_(opt.restart), sys_(&sys) {
   // The vectors and the matrix have the active length (the base states and the switched-on elements').
   y_.reset(SH_PTR(N_VNew_Serial, n_, ctx_));
   atol_.reset(SH_PTR(N_VNew_Serial, n_, ctx_));
-  absolute_tolerances(dyn, opt, N_VGetArrayPointer(atol_.get()));
+  Sys::tolerances(sys, opt, N_VGetArrayPointer(atol_.get()));
   for (int i = 0; i < n_; ++i) NV_Ith_S(y_.get(), i) = 0.0;
   mem_.reset(SH_PTR(CVodeCreate, CV_BDF, ctx_));
   void* cv = mem_.get();
-  SH_FLAG(CVodeInit, cv, &CvodeIntegrator::rhs, 0.0, y_.get());
+  SH_FLAG(CVodeInit, cv, &BasicCvodeIntegrator::rhs, 0.0, y_.get());
   SH_FLAG(CVodeSetUserData, cv, this);
   SH_FLAG(CVodeSetErrHandlerFn, cv, silent_error_handler, nullptr);
   SH_FLAG(CVodeSVtolerances, cv, opt.rtol, atol_.get());
   J_.reset(SH_PTR(SUNDenseMatrix, n_, n_, ctx_));
   LS_.reset(SH_PTR(SUNLinSol_Dense, y_.get(), J_.get(), ctx_));
   SH_FLAG(CVodeSetLinearSolver, cv, LS_.get(), J_.get());
-  SH_FLAG(CVodeSetJacFn, cv, &CvodeIntegrator::jac);
+  SH_FLAG(CVodeSetJacFn, cv, &BasicCvodeIntegrator::jac);
   SH_FLAG(CVodeSetMaxNumSteps, cv, opt.max_steps_per_sample);
   SH_FLAG(CVodeSetMaxOrd, cv, opt.max_order);
   // A held command that jumps (a step input) makes the right-hand side
@@ -57,7 +59,8 @@ CvodeIntegrator::CvodeIntegrator(const Dynamics& dyn, double dt, const SolverOpt
 // throw-away internal step here, at construction, so that advance() never
 // allocates (tests/cpp/test_allocations.cpp).  The caller resets afterwards
 // (CVodeReInit keeps that memory).
-void CvodeIntegrator::prime(const State& y_prime, double dt) {
+template <class System>
+void BasicCvodeIntegrator<System>::prime(const State& y_prime, double dt) {
   in_ = {};
   for (int i = 0; i < n_; ++i) NV_Ith_S(y_.get(), i) = y_prime[i];
   SH_FLAG(CVodeReInit, mem_.get(), 0.0, y_.get());
@@ -66,29 +69,31 @@ void CvodeIntegrator::prime(const State& y_prime, double dt) {
   const int flag = inject_setup_fault() ? -1 : CVode(mem_.get(), dt, y_.get(), &tret, CV_ONE_STEP);
   if (flag < 0) {
     std::ostringstream s;
-    s << kSetup << ": the priming step (one internal step from the equilibrium at x = 0, command 0, "
+    s << kSetup << ": the priming step (one internal step from " << Sys::kPrimeState << ", "
       << "t = 0 towards dt = " << dt << " s) failed at t = " << tret << " s: CVode returned flag " << flag << " ("
       << flag_name(flag) << "); the rig's equilibrium or right-hand side is not finite there, or it is too stiff";
     throw Error(s.str());
   }
 }
 
-int CvodeIntegrator::rhs(sunrealtype, N_Vector yv, N_Vector ydot, void* user) {
-  auto* self = static_cast<CvodeIntegrator*>(user);
-  self->dyn_->rhs(N_VGetArrayPointer(yv), self->in_, N_VGetArrayPointer(ydot));
+template <class System>
+int BasicCvodeIntegrator<System>::rhs(sunrealtype, N_Vector yv, N_Vector ydot, void* user) {
+  auto* self = static_cast<BasicCvodeIntegrator*>(user);
+  Sys::rhs(*self->sys_, N_VGetArrayPointer(yv), self->in_, N_VGetArrayPointer(ydot));
   return 0;
 }
 
-int CvodeIntegrator::jac(sunrealtype, N_Vector yv, N_Vector, SUNMatrix Jm, void* user, N_Vector, N_Vector, N_Vector) {
-  auto* self = static_cast<CvodeIntegrator*>(user);
-  Jacobian Jl;
-  self->dyn_->jacobian(N_VGetArrayPointer(yv), self->in_, Jl);
-  for (int i = 0; i < self->n_; ++i)
-    for (int j = 0; j < self->n_; ++j) SM_ELEMENT_D(Jm, i, j) = Jl[i][j];
+// SUNDIALS' dense matrix is column-major with n rows (SM_ELEMENT_D(J, i, j) = data[j n + i]).
+template <class System>
+int BasicCvodeIntegrator<System>::jac(sunrealtype, N_Vector yv, N_Vector, SUNMatrix Jm, void* user, N_Vector,
+                                      N_Vector, N_Vector) {
+  auto* self = static_cast<BasicCvodeIntegrator*>(user);
+  Sys::jacobian(*self->sys_, N_VGetArrayPointer(yv), self->in_, SM_DATA_D(Jm));
   return 0;
 }
 
-void CvodeIntegrator::reset(const State& y, double t) noexcept {
+template <class System>
+void BasicCvodeIntegrator<System>::reset(const State& y, double t) noexcept {
   steps_done_ = rhs_done_ = restarts_ = 0;
   in_ = {};
   // CVodeReInit also zeroes the counters of the current run, so that the totals restart.
@@ -97,7 +102,8 @@ void CvodeIntegrator::reset(const State& y, double t) noexcept {
   need_reinit_ = false;
 }
 
-void CvodeIntegrator::accumulate_counters() noexcept {
+template <class System>
+void BasicCvodeIntegrator<System>::accumulate_counters() noexcept {
   long ns = 0, nf = 0;
   CVodeGetNumSteps(mem_.get(), &ns);
   CVodeGetNumRhsEvals(mem_.get(), &nf);
@@ -105,13 +111,14 @@ void CvodeIntegrator::accumulate_counters() noexcept {
   rhs_done_ += nf;
 }
 
-Status CvodeIntegrator::advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t,
-                                double t_next) noexcept {
+template <class System>
+Status BasicCvodeIntegrator<System>::advance(const System& sys, const Input& in, State& y, double& t,
+                                             double t_next) noexcept {
   // A ZOH jump (the held command or its rate changed) is a discontinuity of the
   // right-hand side at the sample start: restart the BDF history there.
-  const bool changed = in.u != in_.u || in.u_rate != in_.u_rate;
+  const bool changed = Sys::changed(in, in_);
   if (changed && restart_ == SolverOptions::Restart::OnInputChange) need_reinit_ = true;
-  dyn_ = &dyn;
+  sys_ = &sys;
   in_ = in;
   void* cv = mem_.get();
   Status st;
@@ -145,15 +152,20 @@ Status CvodeIntegrator::advance(const Dynamics& dyn, const Dynamics::Input& in, 
   return st;
 }
 
-long CvodeIntegrator::total_steps() const noexcept {
+template <class System>
+long BasicCvodeIntegrator<System>::total_steps() const noexcept {
   long ns = 0;
   CVodeGetNumSteps(mem_.get(), &ns);
   return steps_done_ + ns;
 }
-long CvodeIntegrator::total_rhs_evals() const noexcept {
+template <class System>
+long BasicCvodeIntegrator<System>::total_rhs_evals() const noexcept {
   long nf = 0;
   CVodeGetNumRhsEvals(mem_.get(), &nf);
   return rhs_done_ + nf;
 }
+
+template class BasicCvodeIntegrator<Dynamics>;
+template class BasicCvodeIntegrator<MultiRig>;
 
 }  // namespace servohydraulics::detail

@@ -13,6 +13,7 @@
 #include <memory>
 #include <type_traits>
 
+#include "detail/ode_system.hpp"
 #include "servohydraulics/dynamics.hpp"
 #include "servohydraulics/solver_options.hpp"
 #include "servohydraulics/status.hpp"
@@ -32,22 +33,29 @@ struct CvodeMemDeleter {
   void operator()(void* mem) const noexcept { CVodeFree(&mem); }
 };
 
-class CvodeIntegrator {
+//! CVODE over a system of the OdeSystem interface (ode_system.hpp): the single-actuator plant
+//! (CvodeIntegrator) or the coupled multi-actuator rig.
+template <class System>
+class BasicCvodeIntegrator {
  public:
-  //! Creates and configures CVODE for dyn, then takes one priming step from
-  //! y_prime (the plant passes the equilibrium at x = 0); throws Error if a
+  using Sys = OdeSystem<System>;
+  using State = typename Sys::State;
+  using Input = typename Sys::Input;
+
+  //! Creates and configures CVODE for sys, then takes one priming step from
+  //! y_prime (the plant passes its rest state); throws Error if a
   //! SUNDIALS call fails.  Call reset() before advancing.
-  CvodeIntegrator(const Dynamics& dyn, double dt, const SolverOptions& options, const State& y_prime);
+  BasicCvodeIntegrator(const System& sys, double dt, const SolverOptions& options, const State& y_prime);
   // CVODE keeps a pointer to this object (its user data): neither copied nor moved.
-  CvodeIntegrator(const CvodeIntegrator&) = delete;
-  CvodeIntegrator& operator=(const CvodeIntegrator&) = delete;
+  BasicCvodeIntegrator(const BasicCvodeIntegrator&) = delete;
+  BasicCvodeIntegrator& operator=(const BasicCvodeIntegrator&) = delete;
 
   //! Restart at (y, t) with the held input zero; zeroes the counters.
   void reset(const State& y, double t) noexcept;
   //! Integrates from t to the stop time t_next with the input held, updating
   //! y and t (to where a failure happened).  Restarts (CVodeReInit) first if
   //! the input changed and the policy says so, or after a failure.
-  Status advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t, double t_next) noexcept;
+  Status advance(const System& sys, const Input& in, State& y, double& t, double t_next) noexcept;
 
   long total_steps() const noexcept;
   long total_rhs_evals() const noexcept;
@@ -59,7 +67,7 @@ class CvodeIntegrator {
   void prime(const State& y_prime, double dt);
   void accumulate_counters() noexcept;
 
-  int n_;  // active states (Dynamics::num_states): the vectors' and the matrix' length
+  int n_;  // active states (Sys::size): the vectors' and the matrix' length
   // Declared in creation order: destroyed in reverse, the context last.
   sundials::Context ctx_;
   std::unique_ptr<std::remove_pointer_t<N_Vector>, NVectorDeleter> y_;
@@ -69,10 +77,13 @@ class CvodeIntegrator {
   std::unique_ptr<void, CvodeMemDeleter> mem_;
 
   SolverOptions::Restart restart_;
-  const Dynamics* dyn_;     // what the callbacks evaluate (set before every CVode call)
-  Dynamics::Input in_{};    // the held input of the current sample
+  const System* sys_;       // what the callbacks evaluate (set before every CVode call)
+  Input in_{};              // the held input of the current sample
   bool need_reinit_ = true;
   long steps_done_ = 0, rhs_done_ = 0, restarts_ = 0;  // totals of past CVODE runs (ReInit resets its counters)
 };
+
+//! The single-actuator plant's CVODE integrator.
+using CvodeIntegrator = BasicCvodeIntegrator<Dynamics>;
 
 }  // namespace servohydraulics::detail

@@ -22,96 +22,91 @@ constexpr double e1 = 71.0 / 57600.0, e3 = -71.0 / 16695.0, e4 = 71.0 / 1920.0, 
 constexpr double kSafety = 0.9, kShrink = 0.2, kGrow = 5.0;
 }  // namespace
 
-Dopri5Integrator::Dopri5Integrator(const Dynamics& dyn, double dt, const SolverOptions& opt, const State& y_prime)
-    : n_(dyn.num_states()),
+template <class System>
+BasicDopri5Integrator<System>::BasicDopri5Integrator(const System& sys, double dt, const SolverOptions& opt,
+                                                     const State& y_prime, bool checked)
+    : n_(Sys::size(sys)),
       rtol_(opt.rtol),
       max_steps_(opt.max_steps_per_sample),
       stiff_steps_(opt.stiff_steps),
       dt_(dt),
+      gap_(sys),
       h_(dt) {
-  absolute_tolerances(dyn, opt, atol_);
+  Sys::tolerances(sys, opt, atol_);
   if (opt.stiff_fallback) {
     // Absolute tolerances 1e-2 of these cut the error on high-gain rigs ~7x but made one of 150
     // such rigs overrun max_steps_per_sample (10x the steps): the check below flags instead.
-    implicit_ = std::make_unique<CvodeIntegrator>(dyn, dt, opt, y_prime);
-    SolverOptions tight = opt;
-    tight.rtol = opt.rtol / kShadowTighten;  // the absolute tolerances follow rtol
-    shadow_ = std::make_unique<CvodeIntegrator>(dyn, dt, tight, y_prime);
+    implicit_ = std::make_unique<BasicCvodeIntegrator<System>>(sys, dt, opt, y_prime);
+    if (checked && opt.stiff_check) {
+      SolverOptions tight = opt;
+      tight.rtol = opt.rtol / kShadowTighten;  // the absolute tolerances follow rtol
+      shadow_ = std::make_unique<BasicDopri5Integrator>(sys, dt, tight, y_prime, false);
+    }
   }
-  // A run that stays near rest is checked against a millionth of the rig's scales, not against zero.
-  floor_x_ = 1e-6 * state_scale(dyn, kX);
-  floor_f_ = 1e-6 * state_scale(dyn, kP) * dyn.rig().A;
 }
 
-void Dopri5Integrator::reset(const State& y, double t) noexcept {
+template <class System>
+void BasicDopri5Integrator<System>::reset(const State& y, double t) noexcept {
   steps_done_ = rhs_done_ = restarts_ = stiff_samples_ = 0;
   fsal_ = false;
   h_ = dt_;
   hold_ = 0;
   shadow_live_ = false;
-  since_stiff_ = 0;
-  peak_x_ = peak_f_ = 0.0;
+  gap_.reset();
   if (implicit_) implicit_->reset(y, t);
   if (shadow_) shadow_->reset(y, t);
 }
 
-void Dopri5Integrator::track_peaks(const Dynamics& dyn, const Dynamics::Input& in, const State& y) noexcept {
-  Output o;
-  dyn.outputs(y.data(), in, o);
-  peak_x_ = std::max(peak_x_, std::fabs(o.displacement));
-  peak_f_ = std::max(peak_f_, std::fabs(o.force));
-}
-
 // The error of the result grows with its tolerance: the shadow, kShadowTighten times tighter, is
 // off by less, so the gap between the two measures the result's error (kShadowGap).  The shadow
-// follows the run from the state where the first stiff sample began, so that an error the loop
-// amplifies from sample to sample shows in the gap as it does in the result.
-void Dopri5Integrator::verify(const Dynamics& dyn, const Dynamics::Input& in, const State& y_start,
-                              double t_start, const State& y, double t_next, Status& st) noexcept {
+// follows the run from the state where its first stiff sample began to its end, explicit samples
+// included: an error the loop amplifies from sample to sample, or one that a sharp event far from
+// the stiff stretches makes (a force reversal), shows in the gap as it does in the result.
+template <class System>
+void BasicDopri5Integrator<System>::verify(const System& sys, const Input& in, const State& y_start,
+                                           double t_start, const State& y, double t_next, Status& st) noexcept {
   if (!shadow_live_) {
     shadow_y_ = y_start;
+    shadow_->reset(shadow_y_, t_start);
     shadow_live_ = true;
   }
-  shadow_->reset(shadow_y_, t_start);
   double ts = t_start;
-  const Status s = shadow_->advance(dyn, in, shadow_y_, ts, t_next);
+  const Status s = shadow_->advance(sys, in, shadow_y_, ts, t_next);
   st.internal_steps += s.internal_steps;
   st.rhs_evals += s.rhs_evals;
-  if (!s.ok()) {  // the tighter run failed (too much work) where the result did not: restart next sample
-    shadow_live_ = false;
+  if (!s.ok()) {  // the tighter run failed (too much work) where the result did not: it restarts from the result
+    shadow_y_ = y;
+    shadow_->reset(shadow_y_, t_next);
+    gap_.track(sys, in, y);
+    st.run_error_estimate = gap_.run_gap() / (kShadowGap * kVerifyTolerance);
     return;
   }
-  Output o, os;
-  dyn.outputs(y.data(), in, o);
-  dyn.outputs(shadow_y_.data(), in, os);
-  peak_x_ = std::max(peak_x_, std::fabs(o.displacement));
-  peak_f_ = std::max(peak_f_, std::fabs(o.force));
-  const double gap = std::max(std::fabs(o.displacement - os.displacement) / std::max(peak_x_, floor_x_),
-                              std::fabs(o.force - os.force) / std::max(peak_f_, floor_f_));
-  st.error_estimate = gap / (kShadowGap * kVerifyTolerance);
+  st.error_estimate = gap_.gap(sys, in, y, shadow_y_) / (kShadowGap * kVerifyTolerance);
+  st.run_error_estimate = gap_.run_gap() / (kShadowGap * kVerifyTolerance);
   st.inaccurate = !(st.error_estimate <= 1.0);
 }
 
-double Dopri5Integrator::trial_step(const Dynamics& dyn, const Dynamics::Input& in, const State& y, double h,
-                                    State& y5) noexcept {
+template <class System>
+double BasicDopri5Integrator<System>::trial_step(const System& sys, const Input& in, const State& y, double h,
+                                                 State& y5) noexcept {
   State& k1 = k_[0];
   State tmp{};
   const int n = n_;
   for (int i = 0; i < n; ++i) tmp[i] = y[i] + h * a21 * k1[i];
-  dyn.rhs(tmp.data(), in, k_[1].data());
+  Sys::rhs(sys, tmp.data(), in, k_[1].data());
   for (int i = 0; i < n; ++i) tmp[i] = y[i] + h * (a31 * k1[i] + a32 * k_[1][i]);
-  dyn.rhs(tmp.data(), in, k_[2].data());
+  Sys::rhs(sys, tmp.data(), in, k_[2].data());
   for (int i = 0; i < n; ++i) tmp[i] = y[i] + h * (a41 * k1[i] + a42 * k_[1][i] + a43 * k_[2][i]);
-  dyn.rhs(tmp.data(), in, k_[3].data());
+  Sys::rhs(sys, tmp.data(), in, k_[3].data());
   for (int i = 0; i < n; ++i)
     tmp[i] = y[i] + h * (a51 * k1[i] + a52 * k_[1][i] + a53 * k_[2][i] + a54 * k_[3][i]);
-  dyn.rhs(tmp.data(), in, k_[4].data());
+  Sys::rhs(sys, tmp.data(), in, k_[4].data());
   for (int i = 0; i < n; ++i)
     tmp[i] = y[i] + h * (a61 * k1[i] + a62 * k_[1][i] + a63 * k_[2][i] + a64 * k_[3][i] + a65 * k_[4][i]);
-  dyn.rhs(tmp.data(), in, k_[5].data());
+  Sys::rhs(sys, tmp.data(), in, k_[5].data());
   for (int i = 0; i < n; ++i)
     y5[i] = y[i] + h * (b1 * k1[i] + b3 * k_[2][i] + b4 * k_[3][i] + b5 * k_[4][i] + b6 * k_[5][i]);
-  dyn.rhs(y5.data(), in, k_[6].data());
+  Sys::rhs(sys, y5.data(), in, k_[6].data());
   double sum = 0.0;
   for (int i = 0; i < n; ++i) {
     const double e = h * (e1 * k1[i] + e3 * k_[2][i] + e4 * k_[3][i] + e5 * k_[4][i] + e6 * k_[5][i] +
@@ -122,11 +117,11 @@ double Dopri5Integrator::trial_step(const Dynamics& dyn, const Dynamics::Input& 
   return std::sqrt(sum / n);  // NaN if a stage was not finite: rejected by the caller
 }
 
-Dopri5Integrator::Outcome Dopri5Integrator::explicit_sample(const Dynamics& dyn, const Dynamics::Input& in,
-                                                            State& y, double& t, double t_next,
-                                                            Status& st) noexcept {
-  if (!fsal_ || in.u != fsal_in_.u || in.u_rate != fsal_in_.u_rate) {
-    dyn.rhs(y.data(), in, k_[0].data());
+template <class System>
+typename BasicDopri5Integrator<System>::Outcome BasicDopri5Integrator<System>::explicit_sample(
+    const System& sys, const Input& in, State& y, double& t, double t_next, Status& st) noexcept {
+  if (!fsal_ || Sys::changed(in, fsal_in_)) {
+    Sys::rhs(sys, y.data(), in, k_[0].data());
     ++st.rhs_evals;
   }
   fsal_ = false;
@@ -140,7 +135,7 @@ Dopri5Integrator::Outcome Dopri5Integrator::explicit_sample(const Dynamics& dyn,
     const double h = remaining / std::max(1.0, n_left);
     if (++attempts > stiff_steps_ || h < 1e-12 * dt_) return Outcome::Stiff;
     if (attempts > max_steps_) return Outcome::TooMuchWork;
-    const double err = trial_step(dyn, in, y, h, y5);
+    const double err = trial_step(sys, in, y, h, y5);
     st.rhs_evals += 6;
     if (!(err <= 1.0)) {  // rejected (or NaN: a stage blew up)
       h_ = h * (std::isfinite(err) ? std::max(kShrink, kSafety * std::pow(err, -0.2)) : kShrink);
@@ -160,14 +155,11 @@ Dopri5Integrator::Outcome Dopri5Integrator::explicit_sample(const Dynamics& dyn,
   return Outcome::Done;
 }
 
-Status Dopri5Integrator::implicit_sample(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t,
-                                         double t_next) noexcept {
-  const State y_start = y;
-  const double t_start = t;
+template <class System>
+Status BasicDopri5Integrator<System>::implicit_sample(const System& sys, const Input& in, State& y, double& t,
+                                                      double t_next) noexcept {
   implicit_->reset(y, t);
-  Status st = implicit_->advance(dyn, in, y, t, t_next);
-  if (st.ok() && shadow_) verify(dyn, in, y_start, t_start, y, t_next, st);
-  since_stiff_ = 0;
+  Status st = implicit_->advance(sys, in, y, t, t_next);
   ++restarts_;
   fsal_ = false;
   h_ = dt_;
@@ -176,22 +168,23 @@ Status Dopri5Integrator::implicit_sample(const Dynamics& dyn, const Dynamics::In
   return st;
 }
 
-Status Dopri5Integrator::advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t,
-                                 double t_next) noexcept {
+template <class System>
+Status BasicDopri5Integrator<System>::advance(const System& sys, const Input& in, State& y, double& t,
+                                              double t_next) noexcept {
   Status st;
+  const State y0 = y;
+  const double t0 = t;
   if (hold_ > 0 && implicit_) {
     --hold_;
-    st = implicit_sample(dyn, in, y, t, t_next);
+    st = implicit_sample(sys, in, y, t, t_next);
   } else {
-    const State y0 = y;
-    const double t0 = t;
-    const Outcome out = explicit_sample(dyn, in, y, t, t_next, st);
+    const Outcome out = explicit_sample(sys, in, y, t, t_next, st);
     if (out != Outcome::Done) {
       y = y0;
       t = t0;
       if (out == Outcome::Stiff && implicit_) {
         const Status tried = st;
-        st = implicit_sample(dyn, in, y, t, t_next);
+        st = implicit_sample(sys, in, y, t, t_next);
         st.internal_steps += tried.internal_steps;  // the explicit attempt's work counts too
         st.rhs_evals += tried.rhs_evals;
         hold_ = kImplicitHold;
@@ -200,17 +193,21 @@ Status Dopri5Integrator::advance(const Dynamics& dyn, const Dynamics::Input& in,
         fsal_ = false;
         h_ = dt_;
       }
-    } else if (shadow_live_ && ++since_stiff_ <= kShadowFollow) {
-      verify(dyn, in, y0, t0, y, t_next, st);  // the shadow still follows an error made in a stiff stretch
-    } else {
-      shadow_live_ = false;
-      if (shadow_) track_peaks(dyn, in, y);
     }
+  }
+  if (shadow_ && st.ok()) {
+    if (shadow_live_ || st.stiff)
+      verify(sys, in, y0, t0, y, t_next, st);  // from the first stiff sample to the end of the run
+    else
+      gap_.track(sys, in, y);
   }
   steps_done_ += st.internal_steps;
   rhs_done_ += st.rhs_evals;
   st.t = t;
   return st;
 }
+
+template class BasicDopri5Integrator<Dynamics>;
+template class BasicDopri5Integrator<MultiRig>;
 
 }  // namespace servohydraulics::detail

@@ -10,6 +10,11 @@
 namespace servohydraulics {
 
 namespace {
+// The operating envelope the loop reaches: load pressures and spool openings as fractions of p_s
+// and x_v_max.
+constexpr double kPressureFractions[] = {-0.9, -0.5, 0.0, 0.5, 0.9};
+constexpr double kSpoolFractions[] = {-1.0, -0.5, 0.0, 0.5, 1.0};
+
 double spectral_radius(const Dynamics& dyn, const State& y) {
   Jacobian J;
   dyn.jacobian(y.data(), {}, J);
@@ -31,8 +36,8 @@ double loop_spectral_radius(const Dynamics& dyn) {
   double rho = spectral_radius(dyn, y0);
   if (dyn.mode() == ControlMode::Free) return rho;
   const Rig& r = dyn.rig();
-  for (double pf : {-0.9, -0.5, 0.0, 0.5, 0.9})
-    for (double sf : {-1.0, -0.5, 0.0, 0.5, 1.0}) {
+  for (double pf : kPressureFractions)
+    for (double sf : kSpoolFractions) {
       State y = y0;
       y[kP] = pf * r.p_s;
       if (r.effects.servovalve_dynamics) y[kXv] = sf * r.x_v_max;
@@ -40,96 +45,130 @@ double loop_spectral_radius(const Dynamics& dyn) {
     }
   return rho;
 }
-}  // namespace
 
-int rk4_automatic_substeps(const Dynamics& dyn, double dt, const SolverOptions& opt) {
-  require(std::isfinite(dt) && dt > 0.0, "dt", dt, "controller sample time must be finite and > 0 [s]");
-  opt.validate();
-  double rho = loop_spectral_radius(dyn);
-  // The laws' and the elements' states (LuGre's bristle, hysteretic specimens, dashpots) stiffen with the
-  // sliding speed (Dynamics::rate_bound):
-  // bound |v| by v_ref, given, or the no-load actuator speed (1 m/s in free mode, no actuator).
+// The laws' and the elements' states (LuGre's bristle, hysteretic specimens, dashpots) stiffen with the
+// sliding speed (Dynamics::rate_bound): bound |v| by v_ref, given, or the no-load actuator speed (1 m/s
+// in free mode, no actuator).
+double sliding_rate_bound(const Dynamics& dyn, const SolverOptions& opt) {
   const double v_ref =
       opt.rk4_v_ref > 0.0 ? opt.rk4_v_ref : (dyn.mode() == ControlMode::Free ? 1.0 : dyn.no_load_speed());
-  rho = std::max(rho, dyn.rate_bound(v_ref));
+  return dyn.rate_bound(v_ref);
+}
+
+// The fewest substeps with h rho <= rk4_h_rho.
+int substeps_for(double rho, double dt, const SolverOptions& opt) {
   const double n = std::ceil(dt * rho / opt.rk4_h_rho);
   require(std::isfinite(n) && n <= SolverOptions::kMaxSubsteps, "rk4_substeps (automatic)", n,
           "exceeds the cap of 100000 per sample: the plant is too stiff for a fixed-step integrator at this dt; "
           "use the default (dopri5) or CVODE");
   return std::max(1, static_cast<int>(n));
 }
+}  // namespace
+
+int rk4_automatic_substeps(const Dynamics& dyn, double dt, const SolverOptions& opt) {
+  require(std::isfinite(dt) && dt > 0.0, "dt", dt, "controller sample time must be finite and > 0 [s]");
+  opt.validate();
+  double rho = loop_spectral_radius(dyn);
+  rho = std::max(rho, sliding_rate_bound(dyn, opt));
+  return substeps_for(rho, dt, opt);
+}
+
+// The coupled rig: the same envelope, every actuator at once, and every actuator's sliding bound.
+int rk4_automatic_substeps(const MultiRig& rig, double dt, const SolverOptions& opt) {
+  require(std::isfinite(dt) && dt > 0.0, "dt", dt, "the loop's sample time must be finite and > 0 [s]");
+  opt.validate();
+  const int n = rig.num_states();
+  Eigen::MatrixXd A(n, n);  // column-major: element (r, c) at r + c n
+  auto radius = [&](const MultiRig::State& y) {
+    rig.jacobian(y.data(), MultiRig::Input{}, A.data(), 1, n);
+    const double rho = A.eigenvalues().cwiseAbs().maxCoeff();
+    return std::isfinite(rho) ? rho : 0.0;
+  };
+  const MultiRig::State y0 = rig.rest();
+  double rho = radius(y0);
+  for (double pf : kPressureFractions)
+    for (double sf : kSpoolFractions) {
+      MultiRig::State y = y0;
+      for (int i = 0; i < rig.actuators(); ++i) {
+        const Rig& r = rig.actuator(i).rig();
+        y[static_cast<std::size_t>(rig.index(i, kP))] = pf * r.p_s;
+        if (r.effects.servovalve_dynamics) y[static_cast<std::size_t>(rig.index(i, kXv))] = sf * r.x_v_max;
+      }
+      rho = std::max(rho, radius(y));
+    }
+  for (int i = 0; i < rig.actuators(); ++i) rho = std::max(rho, sliding_rate_bound(rig.actuator(i), opt));
+  return substeps_for(rho, dt, opt);
+}
 
 namespace detail {
 
-Rk4Integrator::Rk4Integrator(const Dynamics& dyn, double dt, const SolverOptions& opt)
-    : n_(dyn.num_states()),
-      substeps_(opt.rk4_substeps > 0 ? opt.rk4_substeps : rk4_automatic_substeps(dyn, dt, opt)),
+template <class System>
+BasicRk4Integrator<System>::BasicRk4Integrator(const System& sys, double dt, const SolverOptions& opt)
+    : n_(Sys::size(sys)),
+      substeps_(opt.rk4_substeps > 0 ? opt.rk4_substeps : Sys::rk4_substeps(sys, dt, opt)),
       max_refinements_(opt.rk4_max_refinements),
-      rtol_(opt.rk4_flag_rtol) {
-  SolverOptions flag = opt;
-  flag.rtol = opt.rk4_flag_rtol;
-  absolute_tolerances(dyn, flag, atol_);
-}
+      flag_rtol_(opt.rk4_flag_rtol),
+      gap_(sys) {}
 
-double Rk4Integrator::sweep(const Dynamics& dyn, const Dynamics::Input& in, State& y, int n, double h) const
-    noexcept {
-  State k1, k2, k3, k4, tmp, err{};
-  const int m = n_;
-  dyn.rhs(y.data(), in, k1.data());
+template <class System>
+void BasicRk4Integrator<System>::sweep(const System& sys, const Input& in, State& y, int n, int m,
+                                       double h) noexcept {
+  State k1, k2, k3, k4, tmp;
   for (int s = 0; s < n; ++s) {
+    Sys::rhs(sys, y.data(), in, k1.data());
     for (int i = 0; i < m; ++i) tmp[i] = y[i] + 0.5 * h * k1[i];
-    dyn.rhs(tmp.data(), in, k2.data());
+    Sys::rhs(sys, tmp.data(), in, k2.data());
     for (int i = 0; i < m; ++i) tmp[i] = y[i] + 0.5 * h * k2[i];
-    dyn.rhs(tmp.data(), in, k3.data());
+    Sys::rhs(sys, tmp.data(), in, k3.data());
     for (int i = 0; i < m; ++i) tmp[i] = y[i] + h * k3[i];
-    dyn.rhs(tmp.data(), in, k4.data());
+    Sys::rhs(sys, tmp.data(), in, k4.data());
     for (int i = 0; i < m; ++i) y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-    dyn.rhs(y.data(), in, k1.data());  // k5 of this substep, k1 of the next
-    for (int i = 0; i < m; ++i) err[i] += std::fabs(h / 6.0 * (k4[i] - k1[i]));
   }
-  double sum = 0.0;
-  for (int i = 0; i < m; ++i) {
-    const double q = err[i] / (atol_[i] + rtol_ * std::max(peak_[i], std::fabs(y[i])));
-    sum += q * q;
-  }
-  return std::sqrt(sum / m);  // NaN if the state blew up: flagged, and the plant's guard fails the sample
 }
 
-void Rk4Integrator::reset(const State& y0, double) noexcept {
+template <class System>
+void BasicRk4Integrator<System>::reset(const State& y0, double) noexcept {
   steps_done_ = rhs_done_ = flagged_ = 0;
-  for (int i = 0; i < n_; ++i) peak_[i] = 0.0;
-  track_peak(y0);
+  refined_ = 0;
+  companion_ = y0;
+  gap_.reset();
 }
 
-void Rk4Integrator::track_peak(const State& y) noexcept {
-  for (int i = 0; i < n_; ++i) peak_[i] = std::max(peak_[i], std::fabs(y[i]));
-}
-
-Status Rk4Integrator::advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t,
-                              double t_next, int substeps) noexcept {
+template <class System>
+Status BasicRk4Integrator<System>::advance(const System& sys, const Input& in, State& y, double& t,
+                                           double t_next, int substeps) noexcept {
   Status st;
-  const State y0 = y;
-  int n = substeps > 0 ? substeps : substeps_;
-  track_peak(y0);
-  for (int r = 0;; ++r) {
-    st.error_estimate = sweep(dyn, in, y, n, (t_next - t) / n);
-    st.internal_steps += n;
-    st.rhs_evals += 4 * n + 1;
-    // Flagged if the configured substeps missed the tolerance, refined or not: the local estimate
-    // does not bound the error carried into later samples, so a refined sample still says so.
-    if (r == 0) st.inaccurate = !(st.error_estimate <= 1.0);
-    if (st.error_estimate <= 1.0 || r >= max_refinements_ || 2L * n > SolverOptions::kMaxSubsteps) break;
-    y = y0;
-    n *= 2;
+  const int n = (substeps > 0 ? substeps : substeps_) << refined_;
+  const double h = (t_next - t) / n;
+  sweep(sys, in, y, n, n_, h);
+  st.internal_steps = n;
+  st.rhs_evals = 4 * n;
+  if (flag_rtol_ > 0.0) {
+    sweep(sys, in, companion_, 2 * n, n_, 0.5 * h);
+    st.internal_steps += 2 * n;
+    st.rhs_evals += 8 * n;
+    st.error_estimate = gap_.gap(sys, in, y, companion_) / flag_rtol_;
+    st.run_error_estimate = gap_.run_gap() / flag_rtol_;
+    st.inaccurate = !(st.error_estimate <= 1.0);
+    if (st.inaccurate) {
+      ++flagged_;
+      bool finite = true;
+      for (int i = 0; i < n_; ++i) finite = finite && std::isfinite(companion_[i]);
+      if (finite && refined_ < max_refinements_ && 2L * n <= SolverOptions::kMaxSubsteps) {
+        y = companion_;  // go on from the more accurate run, at twice the substeps
+        ++refined_;
+      }
+    }
   }
-  if (st.inaccurate) ++flagged_;
-  track_peak(y);
   t = t_next;
   steps_done_ += st.internal_steps;
   rhs_done_ += st.rhs_evals;
   st.t = t;
   return st;
 }
+
+template class BasicRk4Integrator<Dynamics>;
+template class BasicRk4Integrator<MultiRig>;
 
 }  // namespace detail
 }  // namespace servohydraulics

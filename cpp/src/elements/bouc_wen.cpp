@@ -26,9 +26,10 @@ void BoucWen::eval(const double* y, int iz, Algebra& g) const noexcept {
   std::fill(dr, dr + W, 0.0);
   const detail::Hysteretic h = detail::hysteretic_rate(y[kV], y[iz], A, beta, gamma, n);
   g.rate[iz] = h.f;
+  g.Fsp += k * y[iz];
+  if constexpr (W == 0) return;  // the values alone (rhs)
   dr[kV] = h.df_dw;
   dr[iz] = h.df_dz;
-  g.Fsp += k * y[iz];
   g.dFsp[iz] += k;
 }
 

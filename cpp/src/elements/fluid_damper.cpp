@@ -42,9 +42,10 @@ void FluidDamper::eval(const double* y, int iu, Algebra& g) const noexcept {
   double* dr = g.drate[iu];
   std::fill(dr, dr + W, 0.0);
   g.rate[iu] = rate;
+  g.Fsp += F;
+  if constexpr (W == 0) return;  // the values alone (rhs)
   dr[kX] = slope * k;
   dr[iu] = -slope * k;
-  g.Fsp += F;
   g.dFsp[kX] += k;
   g.dFsp[iu] -= k;
 }

@@ -16,7 +16,8 @@ struct Hysteretic {
 };
 inline Hysteretic hysteretic_rate(double w, double z, double A, double b, double g, double n) noexcept {
   const double az = std::fabs(z);
-  const double p = n == 1.0 ? 1.0 : std::pow(az, n - 1.0);  // |z|^(n-1)
+  // |z|^(n-1); pow(|z|, 1) is |z| exactly (the common n = 2 without the library call)
+  const double p = n == 1.0 ? 1.0 : (n == 2.0 ? az : std::pow(az, n - 1.0));
   const double zn = p * az;                                   // |z|^n
   Hysteretic h;
   h.f = A * w - b * std::fabs(w) * p * z - g * w * zn;

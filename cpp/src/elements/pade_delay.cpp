@@ -74,7 +74,7 @@ void PadeDelay::eval(const double* y, int i0, Algebra& g) const noexcept {
   for (int j = 0; j < W; ++j) g.dvdrive[j] = d * g.ddrive[j];
   for (int k = 0; k < N; ++k) {
     vdrive += c[k] * q[k];
-    g.dvdrive[i0 + k] += c[k];
+    if constexpr (W > 0) g.dvdrive[i0 + k] += c[k];
     last -= a[k] * q[k];
   }
   g.vdrive = vdrive;
@@ -82,6 +82,7 @@ void PadeDelay::eval(const double* y, int i0, Algebra& g) const noexcept {
   // the last state's rate and row.
   for (int k = 0; k + 1 < N; ++k) g.rate[i0 + k] = q[k + 1] / tau;
   g.rate[i0 + N - 1] = last / tau;
+  if constexpr (W == 0) return;  // the values alone (rhs)
   double row[kGradientCapacity];
   for (int j = 0; j < W; ++j) row[j] = g.ddrive[j] / tau;
   for (int k = 0; k < N; ++k) row[i0 + k] -= a_tau[k];

@@ -32,7 +32,11 @@ def _run(args) -> int:
         Path(args.record).mkdir(parents=True, exist_ok=True)
     server = Server(site, args.port, bind=args.bind, timeout=args.timeout, quickack=not args.no_quickack,
                     record=args.record)
-    signal.signal(signal.SIGTERM, signal.default_int_handler)  # SIGTERM stops it as Ctrl-C does
+    # Ctrl-C (SIGINT) and SIGTERM stop it cleanly.  SIGINT explicitly: a process started in the
+    # background of a shell without job control inherits SIGINT ignored, and Python then installs
+    # no handler, so `kill -INT` would never reach the server.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.signal(signal.SIGTERM, signal.default_int_handler)
     server.serve(max_clients=args.max_clients, on_ready=lambda: print(f"listening on {server.address[0]}:"
                                                                        f"{server.port}", flush=True))
     return 0

@@ -82,9 +82,10 @@ def _heldout(space, z_tr: np.ndarray, x0_tr: np.ndarray, cases: list[Case], base
 
 def _cost(space, z: np.ndarray, cases: list[Case], x0s, tau: float, which: str, weights: dict | None = None
           ) -> float:
-    """Sum of squared normalised (and weighted) residuals of the model at ``z`` (fitting coordinates)."""
+    """Sum of squared normalised (and weighted) residuals of the model at ``z`` (fitting coordinates;
+    the search's runs, ``engine.run_options``: it chooses the fits' starts)."""
     rig, t = space.rig_and_tau(z, tau)
-    r = engine.residuals(engine.simulate_all(rig, cases, t, x0s), cases, which, weights)
+    r = engine.residuals(engine.simulate_all(rig, cases, t, x0s, search=True), cases, which, weights)
     return float(r @ r)
 
 

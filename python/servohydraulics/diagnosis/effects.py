@@ -24,6 +24,7 @@ from typing import Callable
 
 import numpy as np
 
+from .. import _core
 from ..identification.coordinates import units
 from ..rig import Rig
 
@@ -391,16 +392,17 @@ def _mr_exercised(ctx: Context) -> str | None:
 
 
 def _apply_mr(rig: Rig, th: np.ndarray) -> Rig:
-    # theta = (alpha [N/m], c0 [N s/m], c1 [N s/m]) at the rig's voltage: the field-dependent parameters of Spencer's
-    # model; the voltage-dependent parts are moved into the a-terms
-    u = rig.mr_voltage
-    return _with(rig, mr_alpha_a=max(th[0] - rig.mr_alpha_b * u, 0.0),
-                 mr_c0_a=max(th[1] - rig.mr_c0_b * u, 1e-6), mr_c1_a=max(th[2] - rig.mr_c1_b * u, 1e-6))
+    # theta = (alpha [N/m], c0 [N s/m], c1 [N s/m]) at the rig's field input: the field-dependent parameters of
+    # Spencer's model; the field-dependent parts of its law (the core's mr_damper_law) stay, the a-terms take the rest
+    law = _core.mr_damper_law(rig)
+    return _with(rig, mr_alpha_a=max(th[0] - (law["alpha"] - rig.mr_alpha_a), 0.0),
+                 mr_c0_a=max(th[1] - (law["c0"] - rig.mr_c0_a), 1e-6),
+                 mr_c1_a=max(th[2] - (law["c1"] - rig.mr_c1_a), 1e-6))
 
 
 def _mr_absent(ctx: Context) -> np.ndarray:
-    r, u = ctx.rig, ctx.rig.mr_voltage
-    return _a(r.mr_alpha_a + r.mr_alpha_b * u, r.mr_c0_a + r.mr_c0_b * u, r.mr_c1_a + r.mr_c1_b * u)
+    law = _core.mr_damper_law(ctx.rig)
+    return _a(law["alpha"], law["c0"], law["c1"])
 
 
 def _mr_bounds(ctx: Context) -> tuple[np.ndarray, np.ndarray]:
@@ -660,12 +662,12 @@ CANDIDATES: tuple[Candidate, ...] = (
     Candidate(
         "mr_damper",
         (Param("alpha", unit="N/m",
-               rig_key="specimen.mr_alpha_a (+ mr_alpha_b mr_voltage): the damper's Bouc-Wen force level"),
+               rig_key="specimen.mr_alpha_a (+ the field terms of mr_law): the damper's Bouc-Wen force level"),
          Param("c0", unit="N s/m",
-               rig_key="specimen.mr_c0_a (+ mr_c0_b mr_voltage): the damper's viscous coefficient"),
+               rig_key="specimen.mr_c0_a (+ the field terms of mr_law): the damper's viscous coefficient"),
          Param("c1", unit="N s/m", tests_absent=False,
-               rig_key="specimen.mr_c1_a (+ mr_c1_b mr_voltage): the dashpot in series that sets the damper's "
-                       "roll-off at low velocity")),
+               rig_key="specimen.mr_c1_a (+ the field terms of mr_law): the dashpot in series that sets the "
+                       "damper's roll-off at low velocity")),
         "the MR damper element's field-dependent force (Spencer et al. 1997): its hysteretic level alpha, viscous "
         "coefficient c0 and series dashpot c1 at the record's current, the three parameters Spencer's model makes "
         "field-dependent (the rest of the damper as in the model)",

@@ -21,7 +21,7 @@ from scipy.signal import savgol_filter
 from .. import _core
 from ..identification.coordinates import Coordinates
 from ..identification.run import simulate_command
-from ..identification.stats import LEVEL, ar1_coefficient, ar1_effective_n, quantile
+from ..identification.stats import LEVEL, ar1_coefficient, ar1_effective_n, noise_sigma, quantile
 from ..identification.stats import covariance as hac_covariance
 from ..rig import Rig
 from ..simulate import MODES, SimulationError, solver_options
@@ -41,15 +41,9 @@ CHANNELS = {mode: tuple(c for c in SIM_CHANNELS if not (mode == "free" and c in 
 N_SEGMENTS = 6  #: held-out split: contiguous segments, even ones train, odd ones test
 
 
-def noise_sigma(y: np.ndarray) -> float:
-    """Noise standard deviation of a record channel from its third differences
-    (robust MAD; smooth signal content sampled well above its bandwidth cancels)."""
-    d3 = np.diff(y, 3)
-    return float(1.4826 * np.median(np.abs(d3 - np.median(d3))) / math.sqrt(20.0))
-
-
-def make_case(rec: Any, mode: str, name: str) -> Case:
-    """A record (``read_record``'s result: ``.channels``, ``.dt``) prepared for the diagnosis."""
+def make_case(rec: Any, mode: str, name: str, controller_dt: float | None = None) -> Case:
+    """A record (``read_record``'s result: ``.channels``, ``.dt``) prepared for the diagnosis,
+    simulated with the controller sample ``controller_dt`` [s] (None: the record's)."""
     ch = rec.channels
     t = ch["time"] - ch["time"][0]
     dt = rec.dt
@@ -85,7 +79,7 @@ def make_case(rec: Any, mode: str, name: str) -> Case:
     derived["rms_v"] = float(np.sqrt(np.mean(derived["velocity"] ** 2)))
     x0, x0_sd = initial_displacement(t, x, sigma["displacement"])
     return Case(name, mode, dt, t, np.asarray(ch["command"], float), meas, scale, sigma, train, derived,
-                x0, x0_sd, float(np.max(np.abs(derived["velocity"]))))
+                x0, x0_sd, float(np.max(np.abs(derived["velocity"]))), controller_dt)
 
 
 def initial_displacement(t: np.ndarray, x: np.ndarray, sigma: float) -> tuple[float, float]:
@@ -113,7 +107,7 @@ def refine_x0(rig: Rig, cases: list[Case], tau: float) -> tuple[float, ...]:
         x0, sd = case.x0_data, max(case.x0_sd, 1e-8)
 
         def fun(z, case=case):
-            return residuals([simulate_case(rig, case, tau, float(z[0]))], [case])
+            return residuals([simulate_case(rig, case, tau, float(z[0]), search=True)], [case])
 
         try:
             res = least_squares(fun, [x0], bounds=([x0 - 4 * sd], [x0 + 4 * sd]), x_scale=[sd], diff_step=1e-3,
@@ -126,14 +120,28 @@ def refine_x0(rig: Rig, cases: list[Case], tau: float) -> tuple[float, ...]:
 
 # --- simulation ---------------------------------------------------------------------
 
-def simulate_case(rig: Rig, case: Case, tau: float, x0: float) -> Sim:
+def run_options(search: bool):
+    """The integrator of a diagnosis run.  The runs of the search (the least-squares fits'
+    residuals and difference columns, the screening's signatures, the fits' starts, the initial
+    displacements) use the time stage's tolerance of ``sh.identify`` (``identification.fit.FIT_RTOL``,
+    1e-6: its differences are clean, 1e-2 of a column at worst on the UTFSM chirp against rtol
+    1e-9); every run a decision reads (the channel statistics of the BIC, the held-out error, the
+    gaps) uses the core's default (rtol 1e-8).  A search run costs 1.5 (a friction rig) to 23 (the
+    UTFSM MR damper, whose default run turns stiff) times less.  No run is checked by the pair's
+    shadow (``stiff_check``: the diagnosis reads no flag; the results are the same to the bit)."""
+    from ..identification.fit import FIT_RTOL
+
+    return solver_options(rtol=FIT_RTOL if search else None, stiff_check=False)
+
+
+def simulate_case(rig: Rig, case: Case, tau: float, x0: float, search: bool = False) -> Sim:
     """The model's channels for the record's command delayed by ``tau`` [s]
     from the initial displacement ``x0`` [m] (None if the run fails).
-    The default error-controlled pair (dopri5, CVODE for its stiff samples); CVODE alone if
-    that run fails."""
-    for opts in (solver_options(), solver_options(method="cvode")):
+    The default error-controlled pair (dopri5, CVODE for its stiff samples; ``search``: at the
+    search's tolerance, ``run_options``); CVODE alone if that run fails."""
+    for opts in (run_options(search), solver_options(method="cvode")):
         try:
-            r = simulate_command(rig, case.mode, case.u, case.dt, float(x0), opts, delay=tau)
+            r = simulate_command(rig, case.mode, case.u, case.dt, float(x0), opts, dt=case.controller_dt, delay=tau)
         except (SimulationError, ValueError):
             continue
         return {c: r.channels[c] for c in SIM_CHANNELS}
@@ -375,9 +383,30 @@ class JointSpace:
         return rig, tau
 
 
-def simulate_all(rig: Rig, cases: list[Case], tau: float, x0s) -> list[Sim]:
-    """``simulate_case`` of every record, each from its initial displacement in ``x0s`` [m]."""
-    return [simulate_case(rig, c, tau, x0) for c, x0 in zip(cases, x0s)]
+def simulate_all(rig: Rig, cases: list[Case], tau: float, x0s, search: bool = False) -> list[Sim]:
+    """``simulate_case`` of every record, each from its initial displacement in ``x0s`` [m]
+    (``search``: at the search's tolerance, ``run_options``)."""
+    return [simulate_case(rig, c, tau, x0, search) for c, x0 in zip(cases, x0s)]
+
+
+_POOL = None
+
+
+def workers():
+    """The map of the fits' difference columns: a thread pool of ``fit.default_workers()`` threads
+    (the core releases the GIL while it simulates; scipy's ``least_squares(workers=...)`` keeps the
+    columns, and so the fit, identical to the serial ones), None on one core."""
+    global _POOL
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ..identification.fit import default_workers
+
+    n = default_workers()
+    if n <= 1:
+        return None
+    if _POOL is None:
+        _POOL = ThreadPoolExecutor(max_workers=n, thread_name_prefix="diagnose")
+    return _POOL.map
 
 
 # --- screening ----------------------------------------------------------------------------
@@ -392,7 +421,7 @@ def secant_screen(space: Space, cases: list[Case], x0s, r0: np.ndarray, base_tau
         z = space.absent.copy()
         z[i] = space.probe[i]
         rig, tau = space.rig_and_tau(z, base_tau)
-        sims = simulate_all(rig, cases, tau, x0s)
+        sims = simulate_all(rig, cases, tau, x0s, search=True)
         if any(s is None for s in sims):
             return Screening(0.0, space.probe.copy(), None, failed=True)
         cols.append(-(residuals(sims, cases) - r0))  # change of the normalised simulation
@@ -460,10 +489,10 @@ def fit(space: Space, cases: list[Case], z0: np.ndarray, base_tau: float, which:
 
     def fun(z):
         rig, tau = space.rig_and_tau(z[:p], base_tau)
-        return residuals(simulate_all(rig, cases, tau, z[p:]), cases, which, weights)
+        return residuals(simulate_all(rig, cases, tau, z[p:], search=True), cases, which, weights)
 
     res = least_squares(fun, zs, bounds=(lo, hi), x_scale=np.concatenate([space.scale, sd]), diff_step=1e-3,
-                        max_nfev=max_nfev, method="trf", xtol=1e-6, ftol=1e-8)
+                        max_nfev=max_nfev, method="trf", xtol=1e-6, ftol=1e-8, workers=workers())
     return FitResult(z=res.x[:p].copy(), x0=res.x[p:].copy(), jac=res.jac, fun=res.fun, nuisance_scale=sd,
                      nfev=int(res.nfev))
 

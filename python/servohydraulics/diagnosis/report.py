@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import FileSet, WriteError
+from ..identification.report import checks_markdown
 from ..identification.stats import STATUS_WORDS
 from ..rig import save_rig
 
@@ -46,8 +47,10 @@ def _plots(d, out: Path, files: FileSet) -> dict:
     as PNG to ``out``); returns their file names by kind."""
     if not d.plots:
         return {}
-    figs = {"residual": _residual_figure(d), "signature": _signature_figure(d), "gap": _gap_figure(d)}
-    names = {"residual": "residual_before_after.png", "signature": "signature.png", "gap": "gap_closing.png"}
+    figs = {"residual": _residual_figure(d), "signature": _signature_figure(d), "gap": _gap_figure(d),
+            "overlay": _overlay_figure(d)}
+    names = {"residual": "residual_before_after.png", "signature": "signature.png", "gap": "gap_closing.png",
+             "overlay": "overlay.png"}
     for kind, fig in figs.items():
         if fig is not None:
             fig.tight_layout()
@@ -77,6 +80,18 @@ def _residual_figure(d):
     axes[0, 0].legend(loc="upper right")
     axes[-1, 0].set_xlabel("time [s] (records end to end)")
     return fig
+
+
+def _overlay_figure(d):
+    """The first record measured against the updated model (``identification.figures.overlay_figure``:
+    the whole record and the windows where they still part most)."""
+    from ..identification.figures import overlay_figure
+
+    case, after = d.plots["cases"][0], d.plots["sims_after"][0]
+    chans = [c for c in ("displacement", "force") if c in case.meas]
+    return overlay_figure(case.t, {c: case.meas[c] for c in chans}, {c: after[c] for c in chans},
+                          f"{case.name}: measured and the updated model (lettered: where they still part most)",
+                          labels=("measured", "updated model"), command=case.u)
 
 
 def _signature_figure(d):
@@ -147,6 +162,7 @@ def _markdown(d, figs: dict) -> str:
     L = ["# Diagnosis", "", f"**Verdict: {d.verdict}.** {d.summary}", "",
          f"Mode: {d.mode}. Records: " + ", ".join(f"`{r}`" for r in d.records) + f". Runtime {d.runtime_s:.1f} s.",
          ""]
+    L += checks_markdown(getattr(d, "checks", []))
     L += ["## Gap per channel (normalised RMS error, %)", "",
           "| channel | before | after | noise floor | gap closed (of the part above the floor) |",
           "|---|---|---|---|---|"]
@@ -208,5 +224,8 @@ def _markdown(d, figs: dict) -> str:
         L += ["The signature that named the effect:", "", f"![signature]({figs['signature']})", ""]
     if "gap" in figs:
         L += ["The gap closing:", "", f"![gap]({figs['gap']})", ""]
+    if "overlay" in figs:
+        L += ["The first record against the updated model, with zooms where they still part most:", "",
+              f"![overlay]({figs['overlay']})", ""]
     L += ["The updated rig is `rig_updated.toml`; the full result is `diagnosis.json`.", ""]
     return "\n".join(L)

@@ -41,6 +41,7 @@ class Case:
     x0_data: float = 0.0  #: initial displacement estimated from the record alone [m]
     x0_sd: float = 0.0  #: its standard deviation [m]
     v_peak: float = 1.0  #: largest |velocity| of the record (measured or derived) [m/s]
+    controller_dt: float | None = None  #: the controller's sample time [s] (None: the record's ``dt``)
 
     @property
     def channels(self) -> tuple[str, ...]:

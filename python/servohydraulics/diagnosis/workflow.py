@@ -17,10 +17,13 @@ from typing import Any
 
 import numpy as np
 
+from ..identification.checks import gate, run_checks, settle
 from ..identification.records import as_records
+from ..identification.run import controller_ratio, simulate_command
 from ..identification.stats import precision_order
 from ..rig import Rig, rig_to_dict
-from ..simulate import MODES
+from ..simulate import MODES, SimulationError
+from ..workers import single_blas_thread
 from . import engine
 from .confirm import confirm, param_groups, param_report
 from .effects import LIBRARY, Context, check_names, interacting, nested, separating_experiment
@@ -67,6 +70,8 @@ class Diagnosis:
     record_shift: float = 0.0  #: the part of it < 0: the record's command shifted (response rows lead it) [s]
     summary: str = ""
     runtime_s: float = 0.0
+    checks: list = field(default_factory=list)  #: the records' plausibility checks (``identification.checks``)
+    dt: float | None = None  #: the controller sample time the records were simulated with [s] (None: each record's)
     #: arrays for the report (not in the JSON): cases, sims_before, sims_after, history, signatures
     plots: dict[str, Any] = field(default_factory=dict, repr=False)
 
@@ -92,6 +97,8 @@ class Diagnosis:
             "record_shift_s": self.record_shift,
             "rig_updated": rig_to_dict(self.rig),
             "runtime_s": self.runtime_s,
+            "controller_dt_s": self.dt,
+            "checks": [c.to_dict() for c in self.checks],
         }
 
     def write(self, out: str | Path) -> Path:
@@ -189,9 +196,11 @@ class _Passing:
     screening: Screening
 
 
+@single_blas_thread  # the simulations' threads need the cores (workers.blas_threads)
 def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = True,
              keep: int = KEEP, max_effects: int = MAX_EFFECTS, candidates: Sequence[str] | None = None,
-             refit_interacting: bool = True, joint_refit: bool = True) -> Diagnosis:
+             refit_interacting: bool = True, joint_refit: bool = True, dt: float | None = None, layout=None,
+             accept=None) -> Diagnosis:
     """Finds the effect the model ``rig`` is missing in lab ``records``.
 
     Args:
@@ -210,17 +219,32 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
         joint_refit: after each effect from the second on, re-fit all
             accepted effects' parameters together (``joint.joint_refit``); kept
             only if its BIC is not worse than the greedy fit's.
+        dt: the controller's sample time [s] (default: each record's own).  A record sampled
+            slower than the controller (a 1 kHz record of a 2 kHz rig) simulated at its own
+            rate holds the command twice as long and shows a spurious command delay; with
+            ``dt`` the command is interpolated onto the controller's grid
+            (``identification.run.simulate_command``, as ``compare`` and ``identify`` do).
+        layout: how record paths are read (``read_record``'s ``layout``: units, columns...).
+        accept: codes of warning-level plausibility checks acknowledged (``identification.checks``);
+            an error-level check raises ``CheckError`` (a ValueError) before any work.
 
     Returns:
         A ``Diagnosis`` (``.write(dir)`` writes diagnosis.json, rig_updated.toml, report.md).
     """
     t_start = time.time()
-    setup = _prepare(records, rig, mode, candidates, keep, refit_interacting, joint_refit)
+    recs = as_records(records, layout)
+    if mode not in MODES:
+        raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(MODES)}")
+    for r in recs:
+        controller_ratio(r.dt, r.time.size, dt)
+    checks = gate(recs, rig, mode, dt, accept)
+    setup = _prepare(recs, rig, mode, candidates, keep, refit_interacting, joint_refit, dt)
     current = copy.copy(rig)
     x0 = engine.refine_x0(current, setup.cases, 0.0)
     sims0 = engine.simulate_all(current, setup.cases, 0.0, x0)
     if any(s is None for s in sims0):
         raise ValueError("the nominal rig's simulation fails on this record: check the rig and --mode")
+    checks += _nominal_run_checks(current, setup.cases, x0, accept)
     setup = dataclasses.replace(setup, bar=_progress(max_effects * (len(setup.names) + keep), progress, "diagnose"))
     state = _State(rig=current, tau=0.0, x0=x0, sims=sims0, history=[("nominal", engine.gap(sims0, setup.cases))])
     last = None
@@ -232,11 +256,26 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
             break
         _accept(setup, state, outcome)
     setup.bar.close()
-    return _result(setup, state, sims0, last, time.time() - t_start)
+    d = _result(setup, state, sims0, last, time.time() - t_start)
+    d.checks, d.dt = checks, dt
+    return d
+
+
+def _nominal_run_checks(rig: Rig, cases: list[Case], x0s, accept) -> list:
+    """The nominal rig's run of each record as ``compare`` reports it (issue 25, item 4): the
+    stroke, capacity, supply, spool and drive limits it hit and its solver notes, as checks."""
+    out = []
+    for case, x0 in zip(cases, x0s):
+        try:
+            sim = simulate_command(rig, case.mode, case.u, case.dt, float(x0), None, dt=case.controller_dt)
+        except (SimulationError, ValueError):
+            continue  # the engine's own run (CVODE as the fallback) went through: nothing to add here
+        out += settle(run_checks(sim, rig, case.name), accept)
+    return out
 
 
 def _prepare(records, rig: Rig, mode: str, candidates: Sequence[str] | None, keep: int, refit_interacting: bool,
-             joint_refit: bool) -> _Setup:
+             joint_refit: bool, dt: float | None = None) -> _Setup:
     """Checks the arguments and prepares the records (unique names)."""
     if mode not in MODES:
         raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(MODES)}")
@@ -246,7 +285,7 @@ def _prepare(records, rig: Rig, mode: str, candidates: Sequence[str] | None, kee
     cases: list[Case] = []
     for i, r in enumerate(recs):
         path = getattr(r, "path", None)
-        c = engine.make_case(r, mode, str(path) if path else f"record{i}")
+        c = engine.make_case(r, mode, str(path) if path else f"record{i}", dt)
         cases.append(dataclasses.replace(c, name=f"{c.name}#{i}") if any(c.name == o.name for o in cases) else c)
     return _Setup(rig, mode, cases, names, keep, refit_interacting, joint_refit)
 
@@ -301,23 +340,47 @@ def _screen_all(setup: _Setup, state: _State, ctx: Context, rnd: int) -> tuple[l
     r0 = engine.residuals(state.sims, cases)
     setup.bar.set_description_str(f"round {rnd}: screening")
     added = {e["name"] for e in state.effects}
-    screened, log = [], {}
+    log, spaces = {}, {}
     for nme in setup.names:
-        setup.bar.update(1)
         why = _not_screened(nme, added, setup.mode, ctx)
         if why:
             log[nme] = CandidateLog(nme, rnd, rejection=why)
             continue
         cand = LIBRARY[nme]
         inter = interacting(cand, state.rig, setup.mode) if setup.refit_interacting else ()
-        space = engine.Space(cand, ctx, inter)
+        spaces[nme] = engine.Space(cand, ctx, inter)
+
+    def screen(nme: str) -> _Screened:
+        space, cand = spaces[nme], LIBRARY[nme]
         sc = engine.secant_screen(space, cases, state.x0, r0, state.tau)
         bal = (engine.balance_screen(state.rig, cases, cand.structural_signature)
                if cand.structural_signature is not None else None)
-        log[nme] = CandidateLog(nme, rnd, screening_score=sc.score, balance_score=bal)
-        screened.append(_Screened(nme, space, sc, bal))
+        return _Screened(nme, space, sc, bal)
+
+    done = dict(zip(spaces, _each(screen, list(spaces))))
+    screened = []
+    for nme in setup.names:  # the log in library order
+        setup.bar.update(1)
+        if nme in done:
+            s = done[nme]
+            log[nme] = CandidateLog(nme, rnd, screening_score=s.screening.score, balance_score=s.balance)
+            screened.append(s)
     screened.sort(key=lambda s: -s.screening.score)
     return screened, log
+
+
+def _each(fn, items: list) -> list:
+    """``[fn(i) for i in items]``, the items on ``fit.default_workers()`` threads (the candidates of a
+    round are independent: each result is the one a serial loop gives)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ..identification.fit import default_workers
+
+    n = min(default_workers(), len(items))
+    if n <= 1:
+        return [fn(i) for i in items]
+    with ThreadPoolExecutor(max_workers=n, thread_name_prefix="diagnose-candidate") as pool:
+        return list(pool.map(fn, items))
 
 
 def _shortlist(screened: list[_Screened], keep: int) -> list[_Screened]:
@@ -345,18 +408,22 @@ def _confirm_all(setup: _Setup, state: _State, ctx: Context, survivors: list[_Sc
     """Fits each shortlisted candidate (``confirm.confirm``), logs its tests and
     returns those that pass them all."""
     base_test = engine.channel_stats(state.sims, setup.cases, "test")
-    passing = []
-    for s in survivors:
-        setup.bar.set_description_str(f"round {log[s.name].round}: fitting {s.name}")
-        setup.bar.update(1)
+    setup.bar.set_description_str(f"round {log[survivors[0].name].round}: fitting" if survivors else "")
+
+    def fit_one(s: _Screened):
         t_fit = time.time()
         fit = confirm(s.space, s.screening.z0, setup.cases, state.x0, stats, base_test, state.tau, ctx,
                       setup.refit_interacting)
+        return fit, time.time() - t_fit
+
+    passing = []
+    for s, (fit, seconds) in zip(survivors, _each(fit_one, survivors)):
+        setup.bar.update(1)
         reasons = _rejection(fit)
         log[s.name] = dataclasses.replace(
             log[s.name], score=fit.dbic, delta_bic=fit.dbic, heldout_improvement=fit.held,
             parameters=param_report(fit.space, fit.z, fit.lo, fit.hi), joint_p_absent=fit.joint_p, refit=fit.refit,
-            fit_seconds=time.time() - t_fit, heldout_lr=fit.held_lr, rejection="; ".join(reasons) or None)
+            fit_seconds=seconds, heldout_lr=fit.held_lr, rejection="; ".join(reasons) or None)
         if not reasons:
             passing.append(_Passing(s.name, fit, s.screening))
     return passing

@@ -68,15 +68,41 @@ class SpencerParameters:
     n: float  #: [-]
 
 
+#: The thesis' current law (``parametros.mat``; its ``MR_BoucWen.m``: alpha = p4 i^2 + p5 i + p6,
+#: gamma = p7 exp(p8 i), c0 = p9 i + p10, c1 = p11 i + p12, beta = gamma in its Simulink chart),
+#: in its units N, mm, s, A: per parameter its coefficients of 1, i, i^2 (and the decay of exp(-d i)).
+THESIS_LAW = {"alpha": (15.221, 41.508, -38.152), "c0": (0.92491, 7.6260), "c1": (9.8671, 78.337),
+              "beta_gamma": 1.8941, "decay": 3.6561, "k0": 1.5013e-4, "k1": 1.2388, "x0": 2.3091e-3, "A": 300.0,
+              "n": 2.0}
+#: the field range the thesis fitted its law on [A]
+THESIS_CURRENTS = (0.0, 1.0)
+
+
 def thesis_mr_parameters(current: float) -> SpencerParameters:
     """The thesis' current-dependent fit (README: fitted to the May 2022 sinusoidal tests, 0-1 A)."""
     i = float(current)
-    if not (math.isfinite(i) and 0.0 <= i <= 1.0):
+    if not (math.isfinite(i) and THESIS_CURRENTS[0] <= i <= THESIS_CURRENTS[1]):
         raise ValueError(f"invalid current = {current!r}: the thesis' fit covers 0 ... 1 A")
-    bg = 1.8941 * math.exp(-3.6561 * i)
-    return SpencerParameters(alpha=-38.152 * i**2 + 41.508 * i + 15.221, c0=7.6260 * i + 0.92491,
-                             c1=78.337 * i + 9.8671, k0=1.5013e-4, k1=1.2388, x0=2.3091e-3, A=300.0,
-                             beta=bg, gamma=bg, n=2.0)
+    L = THESIS_LAW
+    bg = L["beta_gamma"] * math.exp(-L["decay"] * i)
+    return SpencerParameters(alpha=L["alpha"][2] * i**2 + L["alpha"][1] * i + L["alpha"][0],
+                             c0=L["c0"][1] * i + L["c0"][0], c1=L["c1"][1] * i + L["c1"][0], k0=L["k0"], k1=L["k1"],
+                             x0=L["x0"], A=L["A"], beta=bg, gamma=bg, n=L["n"])
+
+
+def thesis_law_keys() -> dict[str, float | str]:
+    """The thesis' whole current law as the core's ``[specimen]`` keys in SI (N, m, s, A): the
+    law ``quiroz2022`` in the coil current (``mr_input = "current"``), identified on 0 ... 1 A;
+    the current itself (``mr_current``) is the run's.  ``sh.rig_from_dict({"specimen": ...})``
+    takes it (the names as the rig file spells them)."""
+    L = THESIS_LAW
+    n = L["n"]
+    return {"mr_input": "current", "mr_law": "quiroz2022", "mr_alpha_a": 1e3 * L["alpha"][0],
+            "mr_alpha_b": 1e3 * L["alpha"][1], "mr_alpha_c": 1e3 * L["alpha"][2], "mr_c0_a": 1e3 * L["c0"][0],
+            "mr_c0_b": 1e3 * L["c0"][1], "mr_c1_a": 1e3 * L["c1"][0], "mr_c1_b": 1e3 * L["c1"][1],
+            "mr_k0": 1e3 * L["k0"], "mr_k1": 1e3 * L["k1"], "mr_x0": 1e-3 * L["x0"], "mr_A": L["A"],
+            "mr_beta": L["beta_gamma"] * 1e3**n, "mr_gamma": L["beta_gamma"] * 1e3**n, "mr_bw_decay": L["decay"],
+            "mr_n": n, "mr_voltage": 0.0, "mr_law_min": THESIS_CURRENTS[0], "mr_law_max": THESIS_CURRENTS[1]}
 
 
 def spencer_rig_keys(p: SpencerParameters) -> dict[str, float]:
@@ -122,5 +148,6 @@ def thesis_mr_force(displacement: ArrayLike, dt: float, current: float) -> np.nd
     return spencer_force(displacement, dt, thesis_mr_parameters(current))
 
 
-__all__ = ["THESIS_ACTUATOR", "SpencerParameters", "smoothed_motion", "spencer_rig_keys", "spencer_force",
-           "thesis_actuator_tf", "thesis_displacement", "thesis_mr_force", "thesis_mr_parameters"]
+__all__ = ["THESIS_ACTUATOR", "THESIS_CURRENTS", "THESIS_LAW", "SpencerParameters", "smoothed_motion",
+           "spencer_rig_keys", "spencer_force", "thesis_actuator_tf", "thesis_displacement", "thesis_law_keys",
+           "thesis_mr_force", "thesis_mr_parameters"]

@@ -5,9 +5,12 @@ Per channel: ``nrmse_pct`` = 100 rms(sim - measured) / std(measured) (the
 issue's definition), ``nrmse_demeaned_pct`` (the same with the error's mean
 removed, the UTFSM README's figure), and the gain and phase of the measured
 and simulated frequency responses channel/command (H1, with coherence) at a
-set of frequencies.  ``warnings`` are the simulated run's (``Response.warnings``: the limits it
-hit, the solver's notes), in the JSON and on the command line's stderr.
-``Comparison.write(out)`` writes ``comparison.json``, ``overlay.png`` and ``frf.png``.
+set of frequencies.  ``checks`` are the record's plausibility checks (:mod:`.checks`: an
+error-level one stops the comparison before the run) and the simulated run's warnings (the
+limits it hit, the solver's notes), in the JSON and on the command line's stderr;
+``warnings`` keeps the run's warnings as plain text.
+``Comparison.write(out)`` writes ``comparison.json``, ``overlay.png``, ``frf.png`` and, with a
+force channel, ``loops.png``.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ import numpy as np
 from ..atomic import FileSet, check_folder, write_text
 from ..response import Response
 from ..rig import Rig
+from .checks import gate, run_checks, scale_checks, settle
 from .frf import FrequencyResponse, command_band, gain_phase, h1
 from .run import (
     CHANNELS,
@@ -31,6 +35,7 @@ from .run import (
     nrmse_demeaned_pct,
     nrmse_pct,
     record_name,
+    record_rig,
     simulate_record,
 )
 
@@ -62,6 +67,9 @@ class Comparison:
     f_max: float = 0.0
     channels: dict = field(default_factory=dict)  #: channel -> metrics (the JSON's "channels")
     warnings: list = field(default_factory=list)  #: the simulated run's limits and solver notes (``Response.warnings``)
+    checks: list = field(default_factory=list)  #: ``checks.Check``: the record's plausibility and the run's limits
+    command: np.ndarray | None = field(default=None, repr=False)  #: the record's command (for the zoom windows)
+    field_input: dict | None = None  #: the MR damper field input of the record (input, value, unit, law), or None
 
     def nrmse(self, channel: str) -> float:
         return self.channels[channel]["nrmse_pct"]
@@ -71,20 +79,33 @@ class Comparison:
                 "dt_s": float(self.time[1] - self.time[0]), "command_band_hz": self.f_max,
                 "definition": "nrmse_pct = 100 rms(sim - measured) / std(measured); nrmse_demeaned_pct: the "
                               "error's mean removed; frf: H1 = S_uy/S_uu (Welch, Hann, nperseg) of channel/command",
-                "warnings": self.warnings, "channels": self.channels}
+                "warnings": self.warnings, "checks": [c.to_dict() for c in self.checks], "field": self.field_input,
+                "channels": self.channels}
+
+    def figure_names(self) -> list[str]:
+        """The figures :meth:`write` writes (``NAME.png``)."""
+        return ["overlay", "frf"] + (["loops"] if "force" in self.measured and "displacement" in self.measured
+                                     else [])
 
     def figures(self) -> dict:
-        from .figures import frf_figure, overlay_figure
+        """The comparison's figures by name (``figure_names``): ``matplotlib.figure.Figure`` objects."""
+        from .figures import frf_figure, loops_figure, overlay_figure
 
         unit = "N" if self.mode == "force" else "m"
-        return {"overlay": overlay_figure(self.time, self.measured, self.simulated, f"{self.name}: measured "
-                                          "and simulated"),
+        figs = {"overlay": overlay_figure(self.time, self.measured, self.simulated,
+                                          f"{self.name}: measured and simulated (lettered: where they part most)",
+                                          command=self.command),
                 "frf": frf_figure(self.frf_measured, self.frf_simulated, 1.2 * self.f_max,
                                   f"{self.name}: frequency response (H1)", unit)}
+        if "loops" in self.figure_names():
+            figs["loops"] = loops_figure(self.time, self.measured, self.simulated,
+                                         f"{self.name}: force loops, measured and simulated", command=self.command)
+        return figs
 
     def write(self, out: str | Path) -> Path:
-        """Writes ``comparison.json``, ``overlay.png`` and ``frf.png`` into ``out``, as one
-        ``atomic.FileSet``: all of them, or (an OSError naming the file) none."""
+        """Writes ``comparison.json`` and the figures (``overlay.png``, ``frf.png``, ``loops.png``
+        with a force channel) into ``out``, as one ``atomic.FileSet``: all of them, or (an
+        OSError naming the file) none."""
         out = check_folder(out)
         figs = self.figures()
         with FileSet() as files:
@@ -131,7 +152,8 @@ def frf_points(measured: FrequencyResponse, simulated: FrequencyResponse, freque
 
 
 def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, options=None,
-            frequencies=None, simulated: Response | None = None) -> Comparison:
+            frequencies=None, simulated: Response | None = None, accept=None, check: bool = True,
+            current: float | None = None, voltage: float | None = None) -> Comparison:
     """Simulates the record's command through the rig and compares (see the module docstring).
 
     Args:
@@ -141,19 +163,38 @@ def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, opti
         options: solver options (default: CVODE BDF).
         frequencies: FRF points [Hz] (default ``FREQUENCIES`` up to the command's band).
         simulated: the record already simulated (``run.simulate_record``; skips the run).
+        accept: codes of warning-level checks the user acknowledges (``checks.CODES``).
+        check: run the record's plausibility checks first (``checks.record_checks``; an error
+            raises ``checks.CheckError``, a ValueError); ``identify`` checks its records once itself.
+        current, voltage: the MR damper's coil current [A] or voltage [V] the record was made at (its
+            law predicts the damper there, ``law.predict_at``; a value outside the range the law was
+            identified on is reported in ``warnings``); ValueError naming the flag when the rig has
+            no MR damper, its law reads the other input, or the value is not a finite number >= 0.
     """
+    from .law import FIELD_INPUTS, choice_name, predict_at, rig_field
+
+    rig = predict_at(rig, current, voltage)
     if mode not in ("displacement", "force"):
         raise ValueError(f"invalid mode = {mode!r}: a record compares in 'displacement' or 'force' control")
     check_record(record)
     controller_ratio(record.dt, record.time.size, dt)
     chans = channels_of(record, mode)
+    found = gate([record], rig, mode, dt, accept) if check else []
     sim = simulated if simulated is not None else simulate_record(rig, record, mode, dt=dt, options=options)
     u = np.asarray(record.command, dtype=float)
     f_max = command_band(u, record.dt)
     freq = np.asarray(frequencies if frequencies is not None else [f for f in FREQUENCIES if f <= 1.05 * f_max],
                       dtype=float)
     out = Comparison(name=record_name(record), mode=mode, time=np.asarray(record.time), measured={}, simulated={},
-                     frf_measured={}, frf_simulated={}, frequencies=freq, f_max=f_max, warnings=sim.warnings(rig))
+                     command=u,
+                     frf_measured={}, frf_simulated={}, frequencies=freq, f_max=f_max,
+                     warnings=sim.warnings(record_rig(rig, record)),
+                     checks=found + settle(run_checks(sim, record_rig(rig, record),
+                                                      str(record.path or record_name(record))), accept))
+    if rig.effects.mr_damper:
+        kind, value = rig_field(rig)
+        out.field_input = {"input": kind, "value": value, "unit": FIELD_INPUTS[kind][1],
+                     "law": choice_name(rig, "mr_law"), "given": current is not None or voltage is not None}
     for ch in chans:
         m, s = np.asarray(record.channels[ch], dtype=float), np.asarray(sim.channels[ch], dtype=float)
         out.measured[ch], out.simulated[ch] = m, s
@@ -162,6 +203,9 @@ def compare(record: Response, rig: Rig, mode: str, dt: float | None = None, opti
                             "rms_error": float(np.sqrt(np.mean((s - m) ** 2))), "std_measured": float(np.std(m)),
                             "unit": {"displacement": "m", "force": "N"}[ch],
                             "frf": frf_points(out.frf_measured[ch], out.frf_simulated[ch], freq)}
+    if check:
+        out.checks += settle(scale_checks(out.measured, out.simulated, str(record.path or record_name(record))),
+                             accept)
     return out
 
 

@@ -44,11 +44,13 @@ SPECIMEN_KEYS = {
 #: keys that act on the measured force and hardly on the displacement: in displacement
 #: control they are fitted on the force channel, the others on the displacement
 FORCE_KEYS = frozenset({k for ks in SPECIMEN_KEYS.values() for k in ks} |
-                       {"measurement_delay_force", "F_c", "bw_A", "bw_n", "mr_k0", "mr_x0", "mr_A", "mr_n"})
+                       {"measurement_delay_force", "F_c", "bw_A", "bw_n", "mr_k0", "mr_x0", "mr_A", "mr_n",
+                        "mr_alpha_b", "mr_c0_b", "mr_c1_b", "mr_alpha_c", "mr_bw_decay"})
 
 #: the Spencer element's fields (the fitted ones and those held at one constant current)
 MR_DAMPER_FIELDS = ("mr_alpha_a", "mr_alpha_b", "mr_c0_a", "mr_c0_b", "mr_c1_a", "mr_c1_b", "mr_k0", "mr_k1",
-                    "mr_x0", "mr_A", "mr_beta", "mr_gamma", "mr_n", "mr_voltage")
+                    "mr_x0", "mr_A", "mr_beta", "mr_gamma", "mr_n", "mr_voltage", "mr_current", "mr_alpha_c",
+                    "mr_bw_decay")
 
 SPECIMEN_EFFECT = {"linear": None, "bouc_wen": "bouc_wen_hysteresis", "mr_damper": "mr_damper"}
 
@@ -60,7 +62,8 @@ RANGES = {"f_v": (1.0, 300.0), "zeta_v": (0.1, 2.0)}
 #: log-space keys move at most a factor exp(30) ~ 1e13 from their start
 Z_LOG_MAX = 30.0
 
-SIGNED_KEYS = frozenset({"x_contact"})
+#: (the thesis' MR-damper law's alpha curvature and Bouc-Wen decay: identification.law)
+SIGNED_KEYS = frozenset({"x_contact", "mr_alpha_c", "mr_bw_decay"})
 
 
 def _bounds() -> dict[str, str]:
@@ -131,10 +134,13 @@ class Coordinates:
             raise ValueError(f"invalid coordinate kinds = {self.kind}: one of {KINDS} per key {self.keys}")
 
     @classmethod
-    def about(cls, rig: Rig, keys) -> Coordinates:
+    def about(cls, rig: Rig, keys, scales: dict | None = None) -> Coordinates:
+        """z = 0 at the rig's values; a linear key's step scale is its start's size, or
+        ``scales[key]`` (a key that may start at 0: law.coordinate_scales)."""
         start = np.array([float(np.clip(getattr(rig, k), *RANGES.get(k, (-np.inf, np.inf)))) for k in keys])
         kind = tuple("log" if s > 0 and k not in SIGNED_KEYS else "linear" for k, s in zip(keys, start))
-        return cls(tuple(keys), start, kind, np.maximum(np.abs(start), 1e-12))
+        scale = np.array([float((scales or {}).get(k, max(abs(s), 1e-12))) for k, s in zip(keys, start)])
+        return cls(tuple(keys), start, kind, scale)
 
     @classmethod
     def absolute(cls, keys, reciprocal) -> Coordinates:

@@ -7,13 +7,15 @@
   weighted by the coherence.  Keys that do not change the linear model
   (friction, hysteresis) are left for stage 2.
 * :func:`fit_time` (stage 2): the records' commands simulated through the
-  nonlinear model (the fast integrator, :func:`fit_options`), the residual
-  (sim - measured) / std(measured) of every channel (optionally weighted per
-  channel), minimised by ``scipy.optimize.least_squares`` (trust region
-  reflective, Jacobian by forward differences of 0.1 % steps in the fitting
-  coordinates, its columns on two threads) over the active keys.
-  ``records.py`` runs it block by block (loop keys on the
-  displacement, force keys on the force) in displacement control.
+  nonlinear model (a ``segments.Target``: the records in segments on the threads,
+  RK4 at a fixed number of substeps, :data:`RK4_SUBSTEPS`, or the error-controlled
+  pair, :func:`fit_options`), the residual (sim - measured) / std(measured) of every
+  channel (optionally weighted per channel), minimised by
+  ``scipy.optimize.least_squares`` (trust region reflective, Jacobian by forward
+  differences of 0.1 % steps in the fitting coordinates, its columns' runs together
+  on the threads) over the active keys.  ``records.py`` runs it block by block
+  (loop keys on the displacement, force keys on the force) in displacement control,
+  and checks the result against the pair's whole runs.
 * :func:`keep_best`: the start and the stages compared by the time-domain cost
   (:func:`time_costs`), the best kept, so that identification never ends worse
   than it starts (``sh.diagnose`` keeps the same invariant for its candidate
@@ -31,16 +33,17 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..response import Response, SimulationError
+from .. import _core
+from ..response import Response
 from ..rig import Error, Rig
 from ..simulate import make_plant, solver_options
 from .coordinates import Coordinates
 from .frf import FrequencyResponse, command_band, h1
-from .run import initial_displacement, simulate_record
+from .run import initial_displacement, record_rig
+from .segments import FAILED, Target, whole
 
 MIN_COHERENCE = 0.9
 MAX_POINTS = 80  #: frequency points per channel in stage 1 (log-spaced thinning)
-FAILED = 10.0  #: normalised residual of a failed simulation
 
 
 @dataclass(frozen=True, eq=False)
@@ -102,7 +105,7 @@ def fit_frequency(records: list[Response], rig: Rig, coords: Coordinates, mode: 
         out = []
         for rec, ch, f, H, coh in targets:
             try:  # an invalid rig (ValueError naming the key) or a singular model: a failed point
-                Hm = linear_response(coords.apply(rig, zz), mode, x0s[id(rec)], (ch,), f)[0]
+                Hm = linear_response(record_rig(coords.apply(rig, zz), rec), mode, x0s[id(rec)], (ch,), f)[0]
             except (ValueError, np.linalg.LinAlgError):
                 return np.full(sum(2 * t[2].size for t in targets), FAILED)
             e = np.sqrt(coh) * (Hm - H) / np.abs(H)
@@ -149,9 +152,11 @@ def fit_options(rig: Rig, records: list[Response], mode: str, method: str = "dop
     fixed at ``margin`` times the automatic count of the start (a hysteretic specimen's
     rate bounded with ``V_REF_MARGIN`` times the records' peak velocity; a fixed count keeps
     the residual a smooth function of the keys), CVODE when that count would exceed
-    ``MAX_RK4_SUBSTEPS``."""
+    ``MAX_RK4_SUBSTEPS``.  Without the integrators' accuracy checks (the default's check of a run
+    that turned stiff, RK4's companion): they never change a result, and a fit's thousands of runs
+    would pay for them (up to 2.5x per run); ``compare`` of the fitted rig runs them."""
     if method == "dopri5":
-        return solver_options(method="dopri5", rtol=FIT_RTOL)
+        return solver_options(method="dopri5", rtol=FIT_RTOL, stiff_check=False)
     if method != "rk4":
         raise ValueError(f"invalid method = {method!r}: expected 'dopri5' or 'rk4'")
     dt = min(r.dt for r in records)
@@ -163,36 +168,49 @@ def fit_options(rig: Rig, records: list[Response], mode: str, method: str = "dop
         n = MAX_RK4_SUBSTEPS + 1
     if margin * n > MAX_RK4_SUBSTEPS:
         return solver_options(method="cvode")
-    return solver_options(method="rk4", rk4_substeps=max(1, int(np.ceil(margin * n))))
+    return solver_options(method="rk4", rk4_substeps=max(1, int(np.ceil(margin * n))), rk4_flag_rtol=0.0)
+
+
+def checked_options(options):
+    """``options`` with the integrators' accuracy checks back on (the core's defaults of
+    ``stiff_check`` and ``rk4_flag_rtol``): for the fitted rig's reported runs."""
+    default = _core.SolverOptions()
+    out = _core.SolverOptions()
+    for f in _core.SOLVER_OPTION_FIELDS:
+        setattr(out, f["name"], getattr(options, f["name"]))
+    out.stiff_check, out.rk4_flag_rtol = default.stiff_check, default.rk4_flag_rtol
+    return out
+
+
+#: the time stage's runs: classical RK4 at a fixed number of substeps per sample (a residual that
+#: is a smooth function of the keys: the differences are clean, 2e-2 of a column at worst on the
+#: UTFSM chirp against rtol 1e-9, as the pair's at rtol 1e-6), the fewest of these that agrees
+#: with the error-controlled pair on the start (``segments.Target.agrees``); the pair where none does
+RK4_SUBSTEPS = (3, 4, 6, 8, 12, 16)
+
+
+def rk4_options(substeps: int):
+    """RK4 at ``substeps`` per sample without its companion check (the time stage checks its runs
+    against the error-controlled pair's instead: ``segments.Target.agrees``)."""
+    return solver_options(method="rk4", rk4_substeps=int(substeps), rk4_flag_rtol=0.0)
 
 
 def time_residual(rig: Rig, records: list[Response], mode: str, channels: tuple[str, ...], options,
                   dt: float | None = None, weights: dict | None = None) -> np.ndarray:
     """w_ch (sim - measured) / std(measured) of every record and channel, concatenated
-    (w_ch = 1 unless ``weights`` gives it)."""
-    out = []
-    for rec in records:
-        try:
-            sim = simulate_record(rig, rec, mode, dt=dt, options=options)
-        except (SimulationError, ValueError):
-            sim = None
-        for ch in channels:
-            m = np.asarray(rec.channels[ch], dtype=float)
-            s = sim.channels[ch] if sim is not None and np.all(np.isfinite(sim.channels[ch])) else None
-            w = 1.0 if weights is None else weights[ch]
-            out.append(np.full(m.size, FAILED) if s is None else w * (s - m) / np.std(m))
-    return np.concatenate(out)
+    (w_ch = 1 unless ``weights`` gives it), each record run whole."""
+    target = Target(records, mode, channels, options, dt, [whole(r) for r in records])
+    return target.residual(rig, weights)
 
 
-def channel_weights(rig: Rig, records: list[Response], mode: str, channels: tuple[str, ...], options,
-                    dt: float | None = None) -> dict[str, float]:
+def channel_weights(target: Target, rig: Rig, channels: tuple[str, ...] | None = None) -> dict[str, float]:
     """1 / (rms normalised residual) of each channel over all records at ``rig`` (floored at 1e-3)."""
-    e = time_residual(rig, records, mode, channels, options, dt)
-    sizes = [rec.time.size for rec in records for _ in channels]
-    parts = np.split(e, np.cumsum(sizes)[:-1])
-    names = [ch for _ in records for ch in channels]
+    chans = target.channels if channels is None else tuple(channels)
+    e = target.residual(rig, channels=chans)
+    parts = np.split(e, np.cumsum(target.lengths_of(chans))[:-1])
+    names = [ch for _ in target.records for ch in chans]
     return {ch: 1.0 / max(float(np.sqrt(np.mean(np.concatenate([p for p, n in zip(parts, names) if n == ch])
-                                                    ** 2))), 1e-3) for ch in channels}
+                                                    ** 2))), 1e-3) for ch in chans}
 
 
 #: least_squares' stopping tolerances: a relative cost change below 1e-4 is far below
@@ -204,102 +222,106 @@ DIFF_STEP = 1e-3
 
 
 def default_workers() -> int:
-    """Threads for the Jacobian's columns: the core releases the GIL while it simulates."""
+    """Threads for the runs: the core releases the GIL while it simulates."""
     import os
 
     return max(1, min(2, os.cpu_count() or 1))
 
 
-def forward_jacobian(fun, z: np.ndarray, f0: np.ndarray, hi: np.ndarray, workers: int) -> np.ndarray:
+def forward_jacobian(fun, z: np.ndarray, f0: np.ndarray, hi: np.ndarray, workers: int, many=None) -> np.ndarray:
     """Forward differences of ``fun`` at z (steps DIFF_STEP max(1, |z_i|), backwards at an
-    upper bound), the columns evaluated on ``workers`` threads."""
+    upper bound), the columns evaluated on ``workers`` threads, or by ``many`` (a function of a
+    list of points returning their residuals, which runs them together)."""
     from concurrent.futures import ThreadPoolExecutor
 
     h = DIFF_STEP * np.maximum(1.0, np.abs(z))
     h = np.where(z + h > hi, -h, h)
-
-    def column(i: int) -> np.ndarray:
+    points = []
+    for i in range(z.size):
         zi = z.copy()
         zi[i] += h[i]
-        return (fun(zi) - f0) / h[i]
-
-    if workers <= 1:
-        cols = [column(i) for i in range(z.size)]
+        points.append(zi)
+    if many is not None:
+        values = many(points)
+    elif workers <= 1:
+        values = [fun(p) for p in points]
     else:
         with ThreadPoolExecutor(max_workers=workers) as pool:
-            cols = list(pool.map(column, range(z.size)))
-    return np.column_stack(cols)
+            values = list(pool.map(fun, points))
+    return np.column_stack([(v - f0) / hi_ for v, hi_ in zip(values, h)])
 
 
-def fit_time(records: list[Response], rig: Rig, coords: Coordinates, z0: np.ndarray, mode: str,
-             channels: tuple[str, ...], options, dt: float | None = None, max_nfev: int = 60,
-             progress=None, weights: dict | None = None, active: np.ndarray | None = None,
-             workers: int | None = None) -> StageResult:
-    """Stage 2 from z0 (see the module docstring): the ``active`` keys (default all)
-    move, the others stay at z0; the Jacobian's columns run on ``workers`` threads.
-    The result's z covers every key; its ``jac`` the active ones."""
-    n = sum(rec.time.size for rec in records) * len(channels)
-    act = np.ones(z0.size, dtype=bool) if active is None else np.asarray(active, dtype=bool)
-    workers = default_workers() if workers is None else int(workers)
-    cache: dict = {}
+class _Problem:
+    """The residual of ``target`` in the fitting coordinates of the ``active`` keys (the others at
+    z0), one point or several at once; an invalid rig is a failed point."""
 
-    def full(za: np.ndarray) -> np.ndarray:
-        z = np.array(z0, dtype=float)
-        z[act] = za
+    def __init__(self, target: Target, rig: Rig, coords: Coordinates, z0: np.ndarray, active: np.ndarray,
+                 channels: tuple[str, ...], weights: dict | None, progress) -> None:
+        self.target, self.rig, self.coords, self.z0, self.active = target, rig, coords, z0, active
+        self.channels, self.weights, self.progress = channels, weights, progress
+
+    def full(self, za: np.ndarray) -> np.ndarray:
+        z = np.array(self.z0, dtype=float)
+        z[self.active] = za
         return z
 
-    def residual(za: np.ndarray) -> np.ndarray:
-        if progress is not None:
-            progress.update(1)
+    def rig_at(self, za: np.ndarray) -> Rig | None:
         try:
-            r = coords.apply(rig, full(za))
+            return self.coords.apply(self.rig, self.full(za))
         except ValueError:  # the step left the rig's valid range: a failed point
-            return np.full(n, FAILED)
-        return time_residual(r, records, mode, channels, options, dt, weights)
+            return None
 
-    def fun(za: np.ndarray) -> np.ndarray:
-        cache["z"], cache["f"] = za.copy(), residual(za)
-        return cache["f"]
+    def many(self, points: list) -> list[np.ndarray]:
+        if self.progress is not None:
+            self.progress.update(len(points))
+        return self.target.residuals([self.rig_at(p) for p in points], self.weights, self.channels)
 
+    def __call__(self, za: np.ndarray) -> np.ndarray:
+        return self.many([za])[0]
+
+
+def fit_time(target: Target, rig: Rig, coords: Coordinates, z0: np.ndarray, channels: tuple[str, ...],
+             max_nfev: int = 60, progress=None, weights: dict | None = None,
+             active: np.ndarray | None = None) -> StageResult:
+    """Stage 2 from z0 (see the module docstring) on ``target``'s runs: the ``active`` keys
+    (default all) move on the ``channels``, the others stay at z0; the Jacobian's columns run
+    together on the target's threads.  The result's z covers every key; its ``jac`` the active ones."""
+    act = np.ones(z0.size, dtype=bool) if active is None else np.asarray(active, dtype=bool)
+    problem = _Problem(target, rig, coords, np.asarray(z0, dtype=float), act, tuple(channels), weights, progress)
     lo, hi = (b[act] for b in coords.bounds())
 
     def jac(za: np.ndarray) -> np.ndarray:
-        f0 = cache["f"] if "z" in cache and np.array_equal(cache["z"], za) else residual(za)
-        return forward_jacobian(residual, za, f0, hi, workers)
+        return forward_jacobian(problem, za, problem(za), hi, target.workers, problem.many)
 
-    sol = least_squares(fun, np.clip(np.asarray(z0, dtype=float)[act], lo, hi), bounds=(lo, hi), method="trf",
+    sol = least_squares(problem, np.clip(np.asarray(z0, dtype=float)[act], lo, hi), bounds=(lo, hi), method="trf",
                         jac=jac, x_scale=1.0, xtol=XTOL, ftol=FTOL, max_nfev=max_nfev)
-    return StageResult(full(sol.x), float(sol.cost), int(sol.nfev), sol.fun, sol.jac)
+    return StageResult(problem.full(sol.x), float(sol.cost), int(sol.nfev), sol.fun, sol.jac)
 
 
-def jacobian_at(records: list[Response], rig: Rig, coords: Coordinates, z: np.ndarray, mode: str,
-                channels: tuple[str, ...], options, dt: float | None = None, weights: dict | None = None,
-                workers: int | None = None, progress=None) -> StageResult:
+def jacobian_at(target: Target, rig: Rig, coords: Coordinates, z: np.ndarray, weights: dict | None = None,
+                progress=None) -> StageResult:
     """The residual and its Jacobian over every key at z (for the uncertainty after a block-wise fit)."""
-    def residual(zz: np.ndarray) -> np.ndarray:
-        if progress is not None:
-            progress.update(1)
-        return time_residual(coords.apply(rig, zz), records, mode, channels, options, dt, weights)
-
-    f0 = residual(np.asarray(z, dtype=float))
-    J = forward_jacobian(residual, np.asarray(z, dtype=float), f0, coords.bounds()[1],
-                         default_workers() if workers is None else int(workers))
-    return StageResult(np.asarray(z, dtype=float), float(f0 @ f0) / 2, 1 + z.size, f0, J)
+    z = np.asarray(z, dtype=float)
+    problem = _Problem(target, rig, coords, z, np.ones(z.size, dtype=bool), target.channels, weights, progress)
+    f0 = problem(z)
+    J = forward_jacobian(problem, z, f0, coords.bounds()[1], target.workers, problem.many)
+    return StageResult(z, float(f0 @ f0) / 2, 1 + z.size, f0, J)
 
 
-def time_costs(recs, start, coords, candidates: dict, mode, chans, options, dt) -> dict[str, float]:
+def time_costs(target: Target, start: Rig, coords: Coordinates, candidates: dict) -> dict[str, float]:
     """The time-domain cost of each candidate (name -> z): half the sum of squares of
     (sim - measured) / std(measured) over every record and channel, i.e. of the NRMSEs the
-    comparison reports (no channel weights, so that every candidate is judged alike)."""
-    out = {}
-    for name, z in candidates.items():
+    comparison reports (no channel weights, so that every candidate is judged alike); the
+    candidates run together."""
+    rigs = []
+    for z in candidates.values():
         try:
-            r = time_residual(coords.apply(start, z), recs, mode, chans, options, dt)
+            rigs.append(coords.apply(start, z))
         except ValueError:  # the candidate is no valid rig
-            out[name] = float("inf")
-            continue
-        out[name] = float(r @ r) / 2
-    return out
+            rigs.append(None)
+    res = target.residuals(rigs)
+    return {name: (float(r @ r) / 2 if rig is not None else float("inf"))
+            for (name, r), rig in zip(zip(candidates, res), rigs)}
 
 
 def best(costs: dict) -> str:
@@ -309,14 +331,14 @@ def best(costs: dict) -> str:
     return min(names, key=lambda k: (costs[k], names.index(k)))
 
 
-def keep_best(recs, start, coords, candidates: dict, mode, chans, options, dt, bar, workers):
+def keep_best(target: Target, start: Rig, coords: Coordinates, candidates: dict, bar):
     """The best of the start and the stages' results (``candidates``: name -> z, in order) by
     :func:`time_costs`; returns (the name kept, the costs, the channel weights there (1 / rms of
     each channel's residual), the residual and Jacobian over every key there)."""
-    costs = time_costs(recs, start, coords, candidates, mode, chans, options, dt)
+    costs = time_costs(target, start, coords, candidates)
     kept = best(costs)
-    weights = channel_weights(coords.apply(start, candidates[kept]), recs, mode, chans, options, dt)
-    final = jacobian_at(recs, start, coords, candidates[kept], mode, chans, options, dt, weights, workers, bar)
+    weights = channel_weights(target, coords.apply(start, candidates[kept]))
+    final = jacobian_at(target, start, coords, candidates[kept], weights, bar)
     return kept, costs, weights, final
 
 
@@ -331,6 +353,7 @@ def not_improved_flags(kept: str, costs: dict) -> list[str]:
 
 
 __all__ = ["DIFF_STEP", "MAX_RK4_SUBSTEPS", "MIN_COHERENCE", "StageResult", "channel_weights", "default_workers",
-           "fit_frequency", "fit_options", "fit_time", "forward_jacobian", "frequency_targets", "jacobian_at",
+           "checked_options", "fit_frequency", "fit_options", "fit_time", "forward_jacobian", "frequency_targets",
+           "jacobian_at",
            "best", "keep_best", "not_improved_flags", "time_costs",
            "linear_response", "records_peak_velocity", "time_residual"]

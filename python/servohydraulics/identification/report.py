@@ -11,6 +11,18 @@ def _v(x) -> str:
     return "-" if x is None else f"{x:.5g}"
 
 
+def checks_markdown(checks) -> list[str]:
+    """The plausibility checks as a markdown section (nothing without checks)."""
+    if not checks:
+        return []
+    out = ["## Checks of the records and runs (docs/lab-records.md, 'Checks')", "",
+           "| level | code | file | channel | finding |", "|---|---|---|---|---|"]
+    for c in checks:
+        level = f"{c.level} (acknowledged)" if c.acknowledged else c.level
+        out.append(f"| {level} | `{c.code}` | {c.file} | {c.channel or '-'} | {c.message} |")
+    return out + [""]
+
+
 def identification_markdown(ident) -> str:
     d = ident.to_dict()
     start = "the generic rig scaled from the first record (docs/lab-records.md)" if ident.generic_start \
@@ -24,6 +36,13 @@ def identification_markdown(ident) -> str:
              "determined (smallest relative standard error) to the worst.", "",
              "| key | unit | start | stage 1 | identified | status | 95 % interval | rel. std. error |",
              "|---|---|---|---|---|---|---|---|"]
+    if d["field"] is not None:
+        f = d["field"]
+        values = ", ".join(f"{v:g}" for v in f["values"])
+        lines[3:3] = [f"MR damper field law `{f['law']}` fitted across the records at {f['input']}s {values} "
+                      f"{f['unit']} (in the records' order; each record simulated at its own {f['input']}, one "
+                      f"actuator loop for all; the law identified on {f['range'][0]:g} ... {f['range'][1]:g} "
+                      f"{f['unit']}: specimen.mr_law_min/max).", ""]
     params = d["parameters"]
     keys = list(params)
     rel = [params[k]["std"] / abs(params[k]["value"]) if params[k]["value"] else np.inf for k in keys]
@@ -49,13 +68,13 @@ def identification_markdown(ident) -> str:
     lines += [f"- {f}" for f in ident.flags] or ["- nothing: every key is determined and no pair has |corr| > 0.95"]
     lines += ["", "## Records (NRMSE = 100 rms(sim - measured) / std(measured), %)", "",
               "| record | channel | start | identified | plots |", "|---|---|---|---|---|"]
-    for b, a in zip(ident.before, ident.after):
+    label = (lambda i, a: a.name) if ident.field_input is None else \
+        (lambda i, a: f"{a.name} ({ident.field_input.values[i]:g} {ident.field_input.unit})")
+    for i, (b, a) in enumerate(zip(ident.before, ident.after)):
         for c in a.channels:
-            lines.append(f"| {a.name} | {c} | {b.nrmse(c):.2f} | {a.nrmse(c):.2f} | "
-                         f"[overlay](overlay_{a.name}.png), [FRF](frf_{a.name}.png) |")
-    notes = [f"- {a.name}: {w}" for a in ident.after for w in a.warnings]
-    if notes:
-        lines += ["", "## Warnings of the identified rig's runs", "", *notes]
+            lines.append(f"| {label(i, a)} | {c} | {b.nrmse(c):.2f} | {a.nrmse(c):.2f} | "
+                         + ", ".join(f"[{n}]({n}_{a.name}.png)" for n in a.figure_names()) + " |")
+    lines += [""] + checks_markdown(ident.checks)
     rt = ", ".join(f"{k} {v:.1f} s" for k, v in ident.runtime_s.items())
     lines += ["", f"Run time: {rt}; evaluations: {ident.nfev}.", ""]
     return "\n".join(lines)

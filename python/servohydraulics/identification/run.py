@@ -10,7 +10,9 @@ linearly interpolated back onto the record's times.  A command ``delay`` [s]
 shifts the command by whole and fractional samples (linear interpolation,
 holding the first value before the record starts).  :func:`simulate_record`
 starts at rest at the record's initial displacement (the median of its first 20
-samples, which averages the sensor noise).
+samples, which averages the sensor noise).  A record made at other settings of the rig
+(``Response.settings``, e.g. an MR damper's coil current) runs with them over the rig's
+(:func:`record_rig`).
 """
 
 from __future__ import annotations
@@ -133,12 +135,26 @@ def simulate_command(rig: Rig, mode: str, command: np.ndarray, record_dt: float,
     return Response(data, kind="plant", mode=mode, dt=record_dt, rig=rig, work=res.work)
 
 
+def record_rig(rig: Rig, record: Response) -> Rig:
+    """The rig the record was made with: ``rig``, or a copy with the record's ``settings`` (rig
+    keys, e.g. ``{"mr_current": 0.5}``) over it."""
+    settings = getattr(record, "settings", None)
+    if not settings:
+        return rig
+    import copy
+
+    out = copy.copy(rig)
+    for key, value in settings.items():
+        setattr(out, key, value)
+    return out
+
+
 def simulate_record(rig: Rig, record: Response, mode: str, dt: float | None = None, options=None,
                     x0: float | None = None, delay: float = 0.0) -> Response:
     """:func:`simulate_command` of the record's command from its initial displacement (``x0``
-    overrides it)."""
+    overrides it), through :func:`record_rig` (the record's own settings over the rig)."""
     start = initial_displacement(record) if x0 is None else float(x0)
-    return simulate_command(rig, mode, record.command, record.dt, start, options, dt, delay)
+    return simulate_command(record_rig(rig, record), mode, record.command, record.dt, start, options, dt, delay)
 
 
 def nrmse_pct(simulated: np.ndarray, measured: np.ndarray) -> float:
@@ -159,4 +175,4 @@ def nrmse_demeaned_pct(simulated: np.ndarray, measured: np.ndarray) -> float:
 
 __all__ = ["CHANNELS", "MAX_ABS", "REQUIRED_CHANNELS", "SimulationError", "check_record", "controller_ratio",
            "delayed", "initial_displacement", "nrmse_demeaned_pct", "nrmse_pct",
-           "record_name", "simulate_command", "simulate_record"]
+           "record_name", "record_rig", "simulate_command", "simulate_record"]

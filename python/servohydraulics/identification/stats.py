@@ -101,14 +101,19 @@ PREWHITEN_CAP = 0.97
 
 def _bartlett(S: np.ndarray, L: int) -> np.ndarray:
     """sum_{|l| <= L} (1 - |l| / (L + 1)) Gamma_l of the rows of S (Gamma_l = sum_t S_{t+l} S_t')."""
-    m = S.shape[0]
+    m, p = S.shape
+    iu, ju = np.triu_indices(p)
     nfft = 1 << int(math.ceil(math.log2(max(2 * m, 2))))
     F = np.fft.rfft(S, n=nfft, axis=0)
-    # C[l, i, j] = sum_t S[t + l, i] S[t, j], every lag at once
-    C = np.fft.irfft(F[:, :, None] * np.conj(F[:, None, :]), n=nfft, axis=0)[: L + 1]
+    # the circular cross-correlation of each pair i <= j, every lag at once: index l holds
+    # C[l, i, j] = sum_t S[t + l, i] S[t, j], index nfft - l holds C[l, j, i] (no wrap: nfft >= 2m)
+    c = np.fft.irfft(F[:, iu] * np.conj(F[:, ju]), n=nfft, axis=0)
     w = 1.0 - np.arange(1, L + 1) / (L + 1)
-    G = np.einsum("l,lij->ij", w, C[1:])
-    return C[0] + G + G.T
+    C0, G = np.zeros((p, p)), np.zeros((p, p))
+    C0[iu, ju] = C0[ju, iu] = c[0]
+    G[iu, ju] = w @ c[1:L + 1]
+    G[ju, iu] = w @ c[nfft - L:][::-1]
+    return C0 + G + G.T
 
 
 def prewhitening_matrix(S: np.ndarray) -> np.ndarray:
@@ -280,6 +285,14 @@ def precision_order(relative_sd: ArrayLike, status: list[str] | None = None) -> 
     return [i for *_, i in sorted(key)]
 
 
+def noise_sigma(y: np.ndarray) -> float:
+    """Noise standard deviation of a record channel from its third differences
+    (robust MAD; smooth signal content sampled well above its bandwidth cancels)."""
+    d3 = np.diff(y, 3)
+    return float(1.4826 * np.median(np.abs(d3 - np.median(d3))) / math.sqrt(20.0))
+
+
 __all__ = ["LEVEL", "MAX_CORRELATION", "NULL_LOADING", "RCOND", "STATUS_WORDS", "Covariance", "ar1_coefficient",
            "ar1_effective_n", "bartlett_bandwidth", "bound_status", "covariance", "inseparable_groups",
-           "lag1_autocorrelation", "long_run_covariance", "precision_order", "prewhitening_matrix", "quantile"]
+           "lag1_autocorrelation", "long_run_covariance", "noise_sigma", "precision_order", "prewhitening_matrix",
+           "quantile"]

@@ -134,12 +134,22 @@ def load_controller(spec: str):
     arguments, checked to be a tracking controller.  Every failure is a ValueError naming
     ``spec`` and what failed (module not found, class not found, constructor failure, not a
     controller)."""
+    obj = build_user_object(spec, sorted(CONTROLLERS))
+    try:
+        return as_controller(obj)
+    except TypeError as e:
+        raise ValueError(f"invalid controller = {spec!r}: {e}") from e
+
+
+def build_user_object(spec: str, builtins: list[str]):
+    """The object of a user's ``"module:Class"``: the module imported from PYTHONPATH, the class built
+    with no arguments (``builtins``: the built-in names, for the message).  Every failure is a ValueError
+    naming ``spec`` and what failed (module not found, class not found, constructor failure)."""
     import importlib
 
     module_name, _, class_name = spec.partition(":")
     if not module_name or not class_name or ":" in class_name:
-        raise ValueError(f"invalid controller = {spec!r}: expected a built-in name {sorted(CONTROLLERS)} "
-                         "or 'module:Class'")
+        raise ValueError(f"invalid controller = {spec!r}: expected a built-in name {builtins} or 'module:Class'")
     try:
         module = importlib.import_module(module_name)
     except ModuleNotFoundError as e:
@@ -158,13 +168,9 @@ def load_controller(spec: str):
         raise ValueError(f"invalid controller = {spec!r}: {module_name}.{class_name} is a "
                          f"{type(cls).__name__}, not a class")
     try:
-        obj = cls()
+        return cls()
     except Exception as e:  # noqa: BLE001 - a user's constructor: any failure is reported with its type
         raise ValueError(f"invalid controller = {spec!r}: {class_name}() raised {type(e).__name__}: {e}") from e
-    try:
-        return as_controller(obj)
-    except TypeError as e:
-        raise ValueError(f"invalid controller = {spec!r}: {e}") from e
 
 
 def as_controller(controller):

@@ -1,5 +1,6 @@
 """The whole benchmark for a set of cases: results.json, a markdown report
-with the J table, tracking and J plots (matplotlib Figures saved to files)."""
+with the J table, tracking, synchronisation and criteria plots (``rths.figures``:
+matplotlib Figures saved to files)."""
 
 from __future__ import annotations
 
@@ -8,8 +9,6 @@ import math
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 from ..atomic import FileSet
 from ..workers import check_workers, default_workers, process_pool
@@ -143,43 +142,16 @@ def j_table(results: dict[str, Any]) -> str:
 
 
 def _plots(run: dict[str, Any], out: Path, files_out: FileSet) -> list[str]:
-    from matplotlib.figure import Figure
-    files = []
-    trials = run["trials"]
-    fig = Figure(figsize=(9, 2.4 * len(trials)))
-    for i, (n, t) in enumerate(trials.items()):
-        s = t.signals
-        ax = fig.add_subplot(len(trials), 1, i + 1)
-        tt = s["time"]
-        k = int(np.argmax(np.abs(s["numerical"][:, 0])))
-        win = (tt > tt[k] - 1.0) & (tt < tt[k] + 1.0)
-        ax.plot(tt[win], 1e3 * s["numerical"][win, 0], label="desired y_n(1)")
-        ax.plot(tt[win], 1e3 * s["measured"][win], label="measured x_m", lw=0.8)
-        ax.plot(tt[win], 1e3 * s["reference"][win, 0], "--", label="reference floor 1", lw=0.8)
-        ax.set_ylabel(f"case {n}\n[mm]")
-        if i == 0:
-            ax.legend(loc="upper right", fontsize=7)
-    fig.axes[-1].set_xlabel("time [s]")
-    fig.tight_layout()
-    fig.savefig(files_out.path(out / "tracking.png"), dpi=110)
-    files.append("tracking.png")
-    fig = Figure(figsize=(9, 3.5))
-    ax = fig.add_subplot(1, 1, 1)
-    cases = list(run["results"]["cases"].items())
-    width = 0.8 / max(1, len(cases))
-    x = np.arange(1, 9)
-    for j, (n, e) in enumerate(cases):
-        mean = np.array(e["perturbed"]["J_mean"][1:]) if "perturbed" in e else np.array(e["nominal"]["J"][1:])
-        std = np.array(e["perturbed"]["J_std"][1:]) if "perturbed" in e else None
-        ax.bar(x + (j - (len(cases) - 1) / 2) * width, mean, width, yerr=std, label=f"case {n}")
-    ax.set_xticks(x)
-    ax.set_xticklabels([f"J{i}" for i in range(2, 10)])
-    ax.set_ylabel("[%]")
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(files_out.path(out / "criteria.png"), dpi=110)
-    files.append("criteria.png")
-    return files
+    """tracking.png, synchronization.png and criteria.png (``rths.figures``) into ``out``."""
+    from .figures import criteria_figure, synchronization_figure, tracking_figure
+
+    meta = run["results"].get("meta", {})
+    figs = {"tracking.png": tracking_figure(run["trials"], meta),
+            "synchronization.png": synchronization_figure(run["trials"], meta),
+            "criteria.png": criteria_figure(run["results"])}
+    for name, fig in figs.items():
+        fig.savefig(files_out.path(out / name), dpi=110)
+    return list(figs)
 
 
 def write_outputs(run: dict[str, Any], out: str | Path) -> Path:
@@ -216,5 +188,6 @@ def _write_all(run: dict[str, Any], out: Path, files: FileSet) -> None:
     if "perturbed_stable" in meta:
         lines += [f"Perturbed trials that were stable (ran to the end with J2 < 100 %), per case: "
                   f"{meta['perturbed_stable']}; that ran to the end: {meta.get('perturbed_ran_to_end', {})}."]
-    lines += ["", "![tracking](tracking.png)", "", "![criteria](criteria.png)", ""]
+    lines += ["", "![tracking](tracking.png)", "", "![synchronization](synchronization.png)", "",
+              "![criteria](criteria.png)", ""]
     files.write_text(out / "report.md", "\n".join(lines))

@@ -78,9 +78,11 @@ inline void copy_rows(const Algebra& g, int offset, int count, int n, int ku, Ja
 }  // namespace servohydraulics
 
 //! Instantiates E::eval for every gradient width Dynamics dispatches on (kNumStates + 1 ..
-//! kMaxStates + 1); one line at the end of each element's .cpp.
+//! kMaxStates + 1) and for width 0 (the values alone: Dynamics::rhs, no gradient entry written);
+//! one line at the end of each element's .cpp.
 #define SH_ELEMENT_EVAL_WIDTHS(E)                                                  \
   static_assert(::servohydraulics::kGradientCapacity == 17, "one width per case"); \
+  template void E::eval<0>(const double*, int, Algebra&) const noexcept;           \
   template void E::eval<7>(const double*, int, Algebra&) const noexcept;           \
   template void E::eval<8>(const double*, int, Algebra&) const noexcept;           \
   template void E::eval<9>(const double*, int, Algebra&) const noexcept;           \

@@ -1,13 +1,10 @@
-#include "servohydraulics/rths/substructure.hpp"
+#include "servohydraulics/ground_motion.hpp"
 
-#include <algorithm>
 #include <cmath>
-#include <string>
 
 #include "servohydraulics/error.hpp"
 
-namespace servohydraulics::rths {
-
+namespace servohydraulics {
 
 GroundMotion::GroundMotion(std::vector<double> time, std::vector<double> acceleration, double scale)
     : t_(std::move(time)), a_(std::move(acceleration)), scale_(scale) {
@@ -30,4 +27,4 @@ double GroundMotion::operator()(double t) const noexcept {
   return scale_ * (a_[i] + w * (a_[i + 1] - a_[i]));
 }
 
-}  // namespace servohydraulics::rths
+}  // namespace servohydraulics

@@ -1,0 +1,316 @@
+"""How long identification and diagnosis of lab records take (issue 25, item 6), and where the time goes.
+
+    python benchmarks/lab_speed.py [--cases identify,diagnose10,diagnose10sim,sweep1A] [--json FILE]
+                                   [--profile] [--label NAME]
+    python benchmarks/lab_speed.py --table benchmarks/lab_speed.json
+
+The cases (records from ../shared/real-data/utfsm-mts-mrdamper, or $SH_SHARED_DIR/real-data/...):
+
+* ``identify``: ``servohydraulics identify chirp20Hz_0A.csv --mode displacement --specimen mr_damper
+  --out DIR`` (the UTFSM identification as docs/lab-records.md runs it, 61.5 s at 1 kHz), run
+  in-process through ``cli.main`` (the interpreter's start and ``import servohydraulics`` are not
+  counted: about 1 s on this machine), writing its report and plots.
+* ``diagnose10``: ``sh.diagnose`` of the first 10 s of ``chirp20Hz_1A`` (1 A) against the rig
+  identified at 0 A (``evaluation/utfsm_rig_0A.toml``), displacement control, every candidate.
+* ``diagnose10sim``: ``sh.diagnose`` of the diagnosis evaluation's 10 s, 2 kHz runtime record
+  (evaluation/diagnose_eval/generate.py: 300 N of hidden Coulomb friction, SNR 30 dB, made by the
+  independent simulator) against its nominal rig.
+* ``sweep1A``: ``sh.diagnose`` of the whole ``sweep15Hz_1A`` (51.9 s) against the 0 A rig.
+
+For each: the wall time, the load average before and after (the machine is shared), the process' CPU
+time (user + system over its threads: half of it bounds the wall time on an idle 2-core machine from
+below, and it moves little with the others' load), the number of
+simulations (calls into the core's record runs: a segment of a record counts as one), of Jacobian
+evaluations and of least-squares calls, iterations (Jacobian evaluations inside them) and residual
+evaluations, the time spent inside the core's runs (summed over threads), and what the run found
+(NRMSE of the identified rig; the diagnosis' verdict, effects and gaps) so that a speed-up that
+changes a result shows.  ``--profile`` adds cProfile's top functions (the main thread's) per case.
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import io
+import json
+import os
+import platform
+import pstats
+import sys
+import tempfile
+import threading
+import time
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = Path(os.environ.get("SH_SHARED_DIR", ROOT.parent / "shared")) / "real-data" / "utfsm-mts-mrdamper"
+CASES = ("identify", "diagnose10", "diagnose10sim", "sweep1A")
+#: the targets of issue 25, item 6 [s]
+TARGETS = {"identify": 10.0, "diagnose10": 15.0, "diagnose10sim": 15.0, "sweep1A": 60.0}
+
+
+class Counters:
+    """Counts (thread-safe) the core's record runs and the least-squares work while installed."""
+
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.reset()
+
+    def reset(self) -> None:
+        self.sims = 0
+        self.sim_seconds = 0.0
+        self.lsq_calls = 0
+        self.lsq_nfev = 0
+        self.lsq_njev = 0
+        self.jacobians_outside = 0
+
+    def as_dict(self) -> dict:
+        return {"simulations": self.sims, "simulation_s": self.sim_seconds, "least_squares_calls": self.lsq_calls,
+                "least_squares_iterations": self.lsq_njev, "least_squares_residuals": self.lsq_nfev,
+                "jacobian_evaluations": self.lsq_njev + self.jacobians_outside}
+
+
+def _timed(counter: Counters, fn):
+    def wrapper(*a, **k):
+        t0 = time.perf_counter()
+        try:
+            return fn(*a, **k)
+        finally:
+            dt = time.perf_counter() - t0
+            with counter.lock:
+                counter.sims += 1
+                counter.sim_seconds += dt
+    return wrapper
+
+
+@contextmanager
+def instrumented(counter: Counters):
+    """Wraps the core's record runs and every ``least_squares`` the fits call."""
+    from servohydraulics import _core
+    from servohydraulics.diagnosis import engine
+    from servohydraulics.identification import fit
+
+    saved = []
+
+    def patch(obj, name, new):
+        saved.append((obj, name, getattr(obj, name)))
+        setattr(obj, name, new)
+
+    patch(_core, "run_record", _timed(counter, _core.run_record))
+
+    def counting(lsq):
+        def wrapper(*a, **k):
+            res = lsq(*a, **k)
+            with counter.lock:
+                counter.lsq_calls += 1
+                counter.lsq_nfev += int(res.nfev)
+                counter.lsq_njev += int(res.njev or 0)
+            return res
+        return wrapper
+
+    mods = {m for m in (fit, engine) if hasattr(m, "least_squares")}
+    for mod in sys.modules.values():  # any module of the package that imported least_squares by name
+        if getattr(mod, "__name__", "").startswith("servohydraulics") and hasattr(mod, "least_squares"):
+            mods.add(mod)
+    for mod in mods:
+        patch(mod, "least_squares", counting(mod.least_squares))
+    if hasattr(fit, "jacobian_at"):
+        inner = fit.jacobian_at
+
+        def jacobian_at(*a, **k):
+            with counter.lock:
+                counter.jacobians_outside += 1
+            return inner(*a, **k)
+        patch(fit, "jacobian_at", jacobian_at)
+    try:
+        yield counter
+    finally:
+        for obj, name, old in reversed(saved):
+            setattr(obj, name, old)
+
+
+def _record(name: str, end: float | None = None):
+    from servohydraulics.records import Record, read_record
+
+    path = DATA / f"{name}.csv"
+    if not path.exists():
+        raise SystemExit(f"record {path} is absent: the UTFSM data live in ../shared/real-data (its README); "
+                         "set SH_SHARED_DIR to the folder that holds real-data/")
+    rec = read_record(path)
+    if end is None:
+        return rec
+    n = int(round(end / rec.dt)) + 1
+    return Record({k: np.asarray(v)[:n] for k, v in rec.channels.items()})
+
+
+def _simulated_record():
+    """The diagnosis evaluation's 10 s runtime record and its nominal rig (made here, as generate.py does)."""
+    sys.path.insert(0, str(ROOT / "evaluation" / "diagnose_eval"))
+    import generate as gen
+
+    from servohydraulics.records import Record
+
+    items = gen.plan("default", "all")
+    item = {"kind": "single", "effects": [("coulomb", 300.0)], "mode": "displacement", "cmd": "std",
+            "snr": 30, "duration": 10.0, "runtime_check": True}
+    rec, man, key = gen.make_record((len(items), item, 2003, 4.0))
+    rig = gen.nominal_rig(man["mode"], key["rig"])
+    return Record(rec), rig, man["mode"], key
+
+
+def _diagnosis_summary(d) -> dict:
+    js = d.to_dict()
+    return {"verdict": js["verdict"], "effects": {e["name"]: {k: p["value"] for k, p in e["parameters"].items()}
+                                                  for e in js["effects"]},
+            "gap_before": js["gap_before"], "gap_after": js["gap_after"], "summary": js["summary"]}
+
+
+class _Clock:
+    """Wall and process CPU time [s] of the timed part of a case."""
+
+    def __enter__(self):
+        self.t0, self.c0 = time.perf_counter(), _cpu_seconds()
+        return self
+
+    def __exit__(self, *exc):
+        self.wall, self.cpu = time.perf_counter() - self.t0, _cpu_seconds() - self.c0
+
+
+def run_case(case: str) -> dict:
+    """One case; ``wall_s`` and ``cpu_s`` time the identification or the diagnosis alone (not the
+    reading or the making of its record)."""
+    import servohydraulics as sh
+    from servohydraulics import cli
+
+    if case == "identify":
+        with tempfile.TemporaryDirectory() as tmp:
+            argv = ["identify", str(DATA / "chirp20Hz_0A.csv"), "--mode", "displacement", "--specimen",
+                    "mr_damper", "--out", tmp, "--quiet"]
+            with _Clock() as clock, _quiet():
+                code = cli.main(argv)
+            if code != 0:
+                raise SystemExit(f"identify exited {code}")
+            js = json.loads((Path(tmp) / "identification.json").read_text())
+        return {"wall_s": clock.wall, "cpu_s": clock.cpu,
+                "result": {"values": {k: p["value"] for k, p in js["parameters"].items()},
+                           "std": {k: p["std"] for k, p in js["parameters"].items()},
+                           "nrmse_after": js["records"][0]["after"], "kept": js["kept"], "costs": js["costs"],
+                           "runtime_s": js["runtime_s"], "nfev": js["nfev"], "runs": js.get("runs")}}
+    if case in ("diagnose10", "sweep1A", "diagnose10sim"):
+        if case == "diagnose10sim":
+            rec, rig, mode, key = _simulated_record()
+        else:
+            rec = _record("chirp20Hz_1A", 10.0) if case == "diagnose10" else _record("sweep15Hz_1A")
+            rig, mode = sh.load_rig(ROOT / "evaluation" / "utfsm_rig_0A.toml"), "displacement"
+        with _Clock() as clock:
+            d = sh.diagnose([rec], rig, mode=mode, progress=False)
+        out = _diagnosis_summary(d)
+        if case == "diagnose10sim":
+            out["truth"] = key["answers"]
+        return {"wall_s": clock.wall, "cpu_s": clock.cpu, "result": out}
+    raise SystemExit(f"unknown case {case!r}: expected one of {CASES}")
+
+
+def _cpu_seconds() -> float:
+    """The process' CPU time so far [s], user and system, summed over its threads: on a shared machine
+    the wall time grows with the others' load, this much less (cache and frequency effects only)."""
+    import resource
+
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
+
+
+@contextmanager
+def _quiet():
+    old = sys.stdout
+    sys.stdout = io.StringIO()
+    try:
+        yield
+    finally:
+        sys.stdout = old
+
+
+def _summary(case: str, res: dict) -> str:
+    """What the case found, for the table: the identified NRMSE, or the verdict and effects."""
+    r = res["result"]
+    if case == "identify":
+        n = r["nrmse_after"]
+        return f"NRMSE x {n['displacement']:.4f} %, F {n['force']:.4f} %"
+    names = ", ".join(r["effects"]) or "-"
+    return f"{r['verdict']}: {names}"
+
+
+def table(path: Path, labels: list[str] | None = None) -> str:
+    """The saved runs (``--json``) as a markdown table, one row per label and case."""
+    saved = json.loads(path.read_text())
+    rows = ["| case | run | wall [s] | load (1 min) | CPU [s] | simulations | least-squares iterations / residuals "
+            "| result |", "|---|---|---|---|---|---|---|---|"]
+    for case in CASES:
+        for label in labels or list(saved):
+            res = saved.get(label, {}).get("cases", {}).get(case)
+            if res is None:
+                continue
+            load = f"{res['load_before'][0]:.1f} -> {res['load_after'][0]:.1f}"
+            rows.append(f"| {case} | {label} | {res['wall_s']:.1f} | {load} | {res['cpu_s']:.1f} "
+                        f"| {res['simulations']} | {res['least_squares_iterations']} / "
+                        f"{res['least_squares_residuals']} | {_summary(case, res)} |")
+    return "\n".join(rows)
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--cases", default=",".join(CASES), help=f"comma-separated, of {', '.join(CASES)}")
+    p.add_argument("--json", help="write the results here (appended under --label)")
+    p.add_argument("--label", default="run", help="name of this run in the JSON (e.g. before, after)")
+    p.add_argument("--profile", action="store_true", help="cProfile's top functions per case (main thread)")
+    p.add_argument("--table", metavar="FILE", help="print the runs saved in FILE (--json) as a markdown table")
+    a = p.parse_args()
+    if a.table:
+        print(table(Path(a.table)))
+        return
+    import servohydraulics as sh
+
+    cases = [c.strip() for c in a.cases.split(",") if c.strip()]
+    out = {"label": a.label, "python": platform.python_version(), "cpus": os.cpu_count(),
+           "command": "python benchmarks/lab_speed.py " + " ".join(sys.argv[1:]), "cases": {}}
+    counter = Counters()
+    for case in cases:
+        counter.reset()
+        load0 = os.getloadavg()
+        prof = cProfile.Profile() if a.profile else None
+        with instrumented(counter):
+            if prof:
+                prof.enable()
+            res = run_case(case)
+            if prof:
+                prof.disable()
+        load1 = os.getloadavg()
+        res.update(counter.as_dict())
+        res["load_before"], res["load_after"] = [round(v, 2) for v in load0], [round(v, 2) for v in load1]
+        res["target_s"] = TARGETS[case]
+        out["cases"][case] = res
+        print(f"{case}: {res['wall_s']:.1f} s (target {TARGETS[case]:g} s; load {load0[0]:.1f} -> {load1[0]:.1f}); "
+              f"CPU {res['cpu_s']:.1f} s (an idle 2-core machine: >= {res['cpu_s'] / 2:.1f} s); "
+              f"{res['simulations']} simulations ({res['simulation_s']:.1f} s summed over threads), "
+              f"{res['jacobian_evaluations']} Jacobians, {res['least_squares_calls']} least-squares calls, "
+              f"{res['least_squares_iterations']} iterations, {res['least_squares_residuals']} residuals",
+              flush=True)
+        print("   ", json.dumps(res["result"], default=float)[:2000], flush=True)
+        if prof:
+            s = io.StringIO()
+            pstats.Stats(prof, stream=s).sort_stats("cumulative").print_stats(30)
+            res["profile"] = s.getvalue()
+            print(s.getvalue())
+    if a.json:
+        path = Path(a.json)
+        saved = json.loads(path.read_text()) if path.exists() else {}
+        saved[a.label] = out
+        path.write_text(json.dumps(saved, indent=1, default=float) + "\n")
+    del sh
+
+
+if __name__ == "__main__":
+    main()
