@@ -166,9 +166,9 @@ def test_identify_report_lists_the_best_determined_first_and_groups_what_it_cann
                          "status": "identified", "interval": [0.54, 0.66]}}
     corr = np.array([[1, 0.2, np.nan, 0.1], [0.2, 1, np.nan, 0.97], [np.nan] * 4, [0.1, 0.97, np.nan, 1]], float)
     ident = types.SimpleNamespace(
-        to_dict=lambda: {"level": 0.95, "parameters": params, "derived": {}}, generic_start=True,
+        to_dict=lambda: {"level": 0.95, "parameters": params, "derived": {}, "field": None}, generic_start=True,
         mode="displacement", kept="time", rho1=0.9, n_eff=100.0, keys=tuple(params), correlation=corr, flags=[],
-        before=[], after=[], runtime_s={}, nfev={})
+        before=[], after=[], field_input=None, checks=[], runtime_s={}, nfev={})
     md = identification_markdown(ident)
     rows = [ln for ln in md.splitlines() if ln.startswith("| `")][:4]
     assert [r.split("`")[1] for r in rows] == ["f_v", "zeta_v", "G_p", "m"]
