@@ -128,7 +128,8 @@ def run_options(search: bool):
     1e-6: its differences are clean, 1e-2 of a column at worst on the UTFSM chirp against rtol
     1e-9); every run a decision reads (the channel statistics of the BIC, the held-out error, the
     gaps) uses the core's default (rtol 1e-8).  A search run costs 1.5 (a friction rig) to 23 (the
-    UTFSM MR damper, whose default run turns stiff) times less.  No run is checked by the pair's
+    UTFSM MR damper, whose default run turns stiff) times less; a fit's own runs go on RK4 where
+    that agrees with this pair (``search_options``).  No run is checked by the pair's
     shadow (``stiff_check``: the diagnosis reads no flag; the results are the same to the bit)."""
     from ..identification.fit import FIT_RTOL
 
@@ -162,7 +163,8 @@ def simulate_case(rig: Rig, case: Case, tau: float, x0: float, search: bool = Fa
 #: the RK4 substep counts a fit's runs may use (``search_options``), fewest first
 SEARCH_RK4_SUBSTEPS = (3, 4, 6, 8)
 #: the counts a diverged RK4 run tries next (each stable up to a larger damping); beyond 12 the
-#: search's pair costs less (the UTFSM MR damper rig: pair 0.045 s, RK4 0.02 s at 8, 0.035 s at 12)
+#: search's pair costs less (studies/diagnose_run_costs.py: the UTFSM rig with its MR damper's c0 at
+#: 1e6 N s/m diverges below 8 substeps; pair 0.034 s, RK4 0.023 s at 8, 0.030 s at 12 for 10 s)
 SEARCH_RK4_LADDER = (6, 8, 12)
 
 
