@@ -127,25 +127,99 @@ def run_options(search: bool):
     1e-6: its differences are clean, 1e-2 of a column at worst on the UTFSM chirp against rtol
     1e-9); every run a decision reads (the channel statistics of the BIC, the held-out error, the
     gaps) uses the core's default (rtol 1e-8).  A search run costs 1.5 (a friction rig) to 23 (the
-    UTFSM MR damper, whose default run turns stiff) times less.  No run is checked by the pair's
+    UTFSM MR damper, whose default run turns stiff) times less; a fit's own runs go on RK4 where
+    that agrees with this pair (``search_options``).  No run is checked by the pair's
     shadow (``stiff_check``: the diagnosis reads no flag; the results are the same to the bit)."""
     from ..identification.fit import FIT_RTOL
 
     return solver_options(rtol=FIT_RTOL if search else None, stiff_check=False)
 
 
-def simulate_case(rig: Rig, case: Case, tau: float, x0: float, search: bool = False) -> Sim:
+def simulate_case(rig: Rig, case: Case, tau: float, x0: float, search: bool = False, options=None) -> Sim:
     """The model's channels for the record's command delayed by ``tau`` [s]
     from the initial displacement ``x0`` [m] (None if the run fails).
     The default error-controlled pair (dopri5, CVODE for its stiff samples; ``search``: at the
-    search's tolerance, ``run_options``); CVODE alone if that run fails."""
-    for opts in (run_options(search), solver_options(method="cvode")):
+    search's tolerance, ``run_options``), or ``options`` where given (a fit's ``search_options``;
+    where that is RK4 and its run diverges, as it does where a fit made the rig stiffer (a larger
+    damping), RK4 at the next counts of ``SEARCH_RK4_LADDER``, then the search's pair: a diverging
+    run stops within milliseconds of its start); CVODE alone if that run fails."""
+    if options is not None and options.rk4_substeps > 0:
+        from ..identification.fit import rk4_options
+
+        chain = (options, *(rk4_options(n) for n in SEARCH_RK4_LADDER if n > options.rk4_substeps),
+                 run_options(True))
+    else:
+        chain = (options if options is not None else run_options(search),)
+    for opts in (*chain, solver_options(method="cvode")):
         try:
             r = simulate_command(rig, case.mode, case.u, case.dt, float(x0), opts, dt=case.controller_dt, delay=tau)
         except (SimulationError, ValueError):
             continue
         return {c: r.channels[c] for c in SIM_CHANNELS}
     return None
+
+
+#: the RK4 substep counts a fit's runs may use (``search_options``), fewest first
+SEARCH_RK4_SUBSTEPS = (3, 4, 6, 8)
+#: the counts a diverged RK4 run tries next (each stable up to a larger damping); beyond 12 the
+#: search's pair costs less (studies/diagnose_run_costs.py: the UTFSM rig with its MR damper's c0 at
+#: 1e6 N s/m diverges below 8 substeps; pair 0.034 s, RK4 0.023 s at 8, 0.030 s at 12 for 10 s)
+SEARCH_RK4_LADDER = (6, 8, 12)
+
+
+def agreement(sim: Sim, ref: Sim, case: Case) -> tuple[float, float]:
+    """How far the run ``sim`` is from the run ``ref`` over the record's compared channels: (the
+    largest difference, the largest rms difference of a channel), each as a fraction of the measured
+    channel's standard deviation ((inf, inf) when either run failed)."""
+    if sim is None or ref is None:
+        return math.inf, math.inf
+    worst, rms = 0.0, 0.0
+    for c, y in case.meas.items():
+        d = (np.asarray(sim[c]) - np.asarray(ref[c])) / max(float(np.std(y)), 1e-300)
+        worst, rms = max(worst, float(np.max(np.abs(d)))), max(rms, float(np.sqrt(np.mean(d ** 2))))
+    return (worst, rms) if math.isfinite(worst) and math.isfinite(rms) else (math.inf, math.inf)
+
+
+def search_options(rig: Rig, cases: list[Case], tau: float, x0s) -> list:
+    """The integrator of a fit's runs, per record, chosen as ``sh.identify`` chooses its time stage's
+    (``identification.fit.RK4_SUBSTEPS``): RK4 at the fewest substeps of ``SEARCH_RK4_SUBSTEPS`` whose
+    run of ``rig`` (the fit's start: a candidate's parameters change the rig's stiffness, so each fit
+    checks its own) agrees with the search's error-controlled pair (``run_options(True)``) to
+    ``segments.AGREEMENT`` (largest) and ``AGREEMENT_RMS`` (rms) of each channel's standard
+    deviation; the pair where none does (a Coulomb friction's switch, which a fixed step straddles).
+    A fixed step also keeps the residual a smooth function of the parameters (clean difference
+    columns).  ``fit`` checks the result again (``agrees``)."""
+    from ..identification.fit import rk4_options
+    from ..identification.segments import AGREEMENT, AGREEMENT_RMS
+
+    out = []
+    for case, x0 in zip(cases, x0s):
+        pair = run_options(True)
+        ref = simulate_case(rig, case, tau, x0, options=pair)
+        chosen = pair
+        if ref is not None:
+            for n in SEARCH_RK4_SUBSTEPS:
+                worst, rms = agreement(simulate_case(rig, case, tau, x0, options=rk4_options(n)), ref, case)
+                if worst <= AGREEMENT and rms <= AGREEMENT_RMS:
+                    chosen = rk4_options(n)
+                    break
+        out.append(chosen)
+    return out
+
+
+def agrees(rig: Rig, cases: list[Case], tau: float, x0s, options: list) -> bool:
+    """Whether the runs of ``rig`` by ``options`` (per record) agree with the search's pair
+    (``search_options``' test); true where a record's option is the pair itself."""
+    from ..identification.segments import AGREEMENT, AGREEMENT_RMS
+
+    for case, x0, opts in zip(cases, x0s, options):
+        if opts.rk4_substeps == 0:  # the pair itself
+            continue
+        worst, rms = agreement(simulate_case(rig, case, tau, x0, options=opts),
+                               simulate_case(rig, case, tau, x0, search=True), case)
+        if not (worst <= AGREEMENT and rms <= AGREEMENT_RMS):
+            return False
+    return True
 
 
 def residuals(sims: list, cases: list[Case], which: str = "all", weights: dict | None = None) -> np.ndarray:
@@ -383,10 +457,12 @@ class JointSpace:
         return rig, tau
 
 
-def simulate_all(rig: Rig, cases: list[Case], tau: float, x0s, search: bool = False) -> list[Sim]:
+def simulate_all(rig: Rig, cases: list[Case], tau: float, x0s, search: bool = False, options=None) -> list[Sim]:
     """``simulate_case`` of every record, each from its initial displacement in ``x0s`` [m]
-    (``search``: at the search's tolerance, ``run_options``)."""
-    return [simulate_case(rig, c, tau, x0, search) for c, x0 in zip(cases, x0s)]
+    (``search``: at the search's tolerance, ``run_options``; ``options``: per record, a fit's
+    ``search_options``)."""
+    opts = [None] * len(cases) if options is None else options
+    return [simulate_case(rig, c, tau, x0, search, o) for c, x0, o in zip(cases, x0s, opts)]
 
 
 _POOL = None
@@ -478,7 +554,11 @@ def fit(space: Space, cases: list[Case], z0: np.ndarray, base_tau: float, which:
     an initial state refined against the model without the effect is biased
     towards hiding it (in a free decay a 40 um offset is a third of F_c / k).
     The result's ``jac`` and ``nuisance_scale`` include the x0 columns (for the
-    intervals).  ``weights``: per (record, channel) factors of the residual (``residuals``)."""
+    intervals).  ``weights``: per (record, channel) factors of the residual (``residuals``).
+
+    The runs use ``search_options`` at the start (RK4 at the fewest agreeing substeps, else the
+    search's pair); when the RK4 runs of the result no longer agree with the pair's (the fit moved
+    the candidate somewhere stiffer), the fit goes on from there on the pair's runs."""
     sd = np.array([max(c.x0_sd, 1e-8) for c in cases])
     cen = np.array([c.x0_data for c in cases])
     lo = np.concatenate([space.lo, cen - 4 * sd])
@@ -487,14 +567,25 @@ def fit(space: Space, cases: list[Case], z0: np.ndarray, base_tau: float, which:
     zs = np.concatenate([np.asarray(z0, float), np.clip(np.asarray(x0s, float), cen - 4 * sd, cen + 4 * sd)])
     zs = np.clip(zs, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
 
-    def fun(z):
-        rig, tau = space.rig_and_tau(z[:p], base_tau)
-        return residuals(simulate_all(rig, cases, tau, z[p:], search=True), cases, which, weights)
+    def run(zs: np.ndarray, options: list):
+        def fun(z):
+            rig, tau = space.rig_and_tau(z[:p], base_tau)
+            return residuals(simulate_all(rig, cases, tau, z[p:], options=options), cases, which, weights)
 
-    res = least_squares(fun, zs, bounds=(lo, hi), x_scale=np.concatenate([space.scale, sd]), diff_step=1e-3,
-                        max_nfev=max_nfev, method="trf", xtol=1e-6, ftol=1e-8, workers=workers())
+        return least_squares(fun, zs, bounds=(lo, hi), x_scale=np.concatenate([space.scale, sd]), diff_step=1e-3,
+                             max_nfev=max_nfev, method="trf", xtol=1e-6, ftol=1e-8, workers=workers())
+
+    rig0, tau0 = space.rig_and_tau(zs[:p], base_tau)
+    options = search_options(rig0, cases, tau0, zs[p:])
+    res = run(zs, options)
+    nfev = int(res.nfev)
+    if any(o.rk4_substeps > 0 for o in options):
+        rig1, tau1 = space.rig_and_tau(res.x[:p], base_tau)
+        if not agrees(rig1, cases, tau1, res.x[p:], options):
+            res = run(np.clip(res.x, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo)), [run_options(True)] * len(cases))
+            nfev += int(res.nfev)
     return FitResult(z=res.x[:p].copy(), x0=res.x[p:].copy(), jac=res.jac, fun=res.fun, nuisance_scale=sd,
-                     nfev=int(res.nfev))
+                     nfev=nfev)
 
 
 def series_lengths(cases: list[Case], which: str = "all") -> list[int]:

@@ -1,0 +1,139 @@
+"""The diagnosis' fits on RK4 (``engine.search_options``, ``engine.fit``): RK4 at the fewest
+substeps whose run agrees with the search's error-controlled pair, chosen per fit start; a diverged
+RK4 run retried at larger counts, then on the pair; the pair where no count agrees.  The oracles:
+whole runs of the error-controlled pair (at the search's rtol and at the core's default), the
+fixed-step run at the count the ladder lands on, and the same fit run on the pair alone."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import servohydraulics as sh
+from servohydraulics.diagnosis import engine, workflow
+from servohydraulics.diagnosis.effects import LIBRARY
+from servohydraulics.identification.fit import rk4_options
+from servohydraulics.identification.run import simulate_command
+from servohydraulics.identification.segments import AGREEMENT, AGREEMENT_RMS
+from servohydraulics.records import Record
+from servohydraulics.simulate import SimulationError
+
+RIG = Path(__file__).resolve().parents[2] / "evaluation" / "utfsm_rig_0A.toml"
+DT = 1e-3
+
+
+def _rig() -> sh.Rig:
+    """The UTFSM rig identified at 0 A (an MR damper specimen: its damping sets RK4's stability)."""
+    return sh.load_rig(RIG)
+
+
+def _record(rig: sh.Rig, c0: float | None = None) -> Record:
+    """3 s of a 0.5-8 Hz chirp (8 mm) through ``rig`` (the damper's c0 [N s/m] raised to ``c0``:
+    the hidden effect) by the core's default pair at rtol 1e-8, with 40 dB of noise."""
+    truth = copy.copy(rig) if c0 is None else LIBRARY["mr_damper"].apply(
+        rig, np.array([sh._core.mr_damper_law(rig)["alpha"], c0]))
+    t = np.arange(int(3.0 / DT) + 1) * DT
+    u = np.minimum(t / 0.3, 1.0) * 0.008 * np.sin(2 * np.pi * (0.5 + 2.5 * t) * t)
+    r = simulate_command(truth, "displacement", u, DT, 0.0, None)
+    rng = np.random.default_rng(11)
+    ch = {"time": t, "command": u}
+    for c in ("displacement", "force"):
+        y = np.asarray(r.channels[c], float)
+        ch[c] = y + rng.normal(0.0, 0.01 * float(np.sqrt(np.mean(y ** 2))), y.size)
+    return Record(ch)
+
+
+def _case(rec: Record) -> engine.Case:
+    return engine.make_case(rec, "displacement", "chirp")
+
+
+def _within(sim, ref, case) -> bool:
+    worst, rms = engine.agreement(sim, ref, case)
+    return worst <= AGREEMENT and rms <= AGREEMENT_RMS
+
+
+def test_rk4_where_it_agrees_with_the_pair():
+    rig = _rig()
+    case = _case(_record(rig))
+    opts = engine.search_options(rig, [case], 0.0, [case.x0_data])[0]
+    assert opts.rk4_substeps in engine.SEARCH_RK4_SUBSTEPS and opts.rk4_flag_rtol == 0.0
+    run = engine.simulate_case(rig, case, 0.0, case.x0_data, options=opts)
+    # the oracles: the search's pair (rtol 1e-6) and the decisions' (the core's default rtol 1e-8)
+    assert _within(run, engine.simulate_case(rig, case, 0.0, case.x0_data, search=True), case)
+    assert _within(run, engine.simulate_case(rig, case, 0.0, case.x0_data), case)
+    # the fewest: one count fewer does not agree (or is not tried: 3 is the first)
+    i = engine.SEARCH_RK4_SUBSTEPS.index(opts.rk4_substeps)
+    if i > 0:
+        fewer = engine.simulate_case(rig, case, 0.0, case.x0_data,
+                                     options=rk4_options(engine.SEARCH_RK4_SUBSTEPS[i - 1]))
+        assert not _within(fewer, engine.simulate_case(rig, case, 0.0, case.x0_data, search=True), case)
+
+
+def test_a_diverged_rk4_run_climbs_the_ladder():
+    """A damper 400 times the identified one: RK4 at 3 substeps diverges within milliseconds; the
+    run is RK4 at the ladder's first count that holds (bit for bit that run), near the pair's (a
+    stable run, not a diverging one), and ``agrees`` (the fit's end check) says whether it is within
+    ``AGREEMENT`` of it (where not, the fit goes on from there on the pair)."""
+    rig = _rig()
+    case = _case(_record(rig))
+    stiff = LIBRARY["mr_damper"].apply(rig, np.array([sh._core.mr_damper_law(rig)["alpha"], 1e6]))
+    with pytest.raises(SimulationError, match="diverged"):
+        simulate_command(stiff, "displacement", case.u, case.dt, case.x0_data, rk4_options(3))
+    run = engine.simulate_case(stiff, case, 0.0, case.x0_data, options=rk4_options(3))
+    held = None
+    for n in engine.SEARCH_RK4_LADDER:
+        try:
+            held = simulate_command(stiff, "displacement", case.u, case.dt, case.x0_data, rk4_options(n))
+            break
+        except SimulationError:
+            continue
+    assert held is not None
+    for c in engine.SIM_CHANNELS:
+        np.testing.assert_array_equal(run[c], held.channels[c])
+    pair = engine.simulate_case(stiff, case, 0.0, case.x0_data, search=True)
+    worst, rms = engine.agreement(run, pair, case)
+    assert worst <= 10 * AGREEMENT and rms <= 10 * AGREEMENT_RMS
+    assert engine.agrees(stiff, [case], 0.0, [case.x0_data], [rk4_options(3)]) == _within(run, pair, case)
+
+
+def test_the_pair_where_no_count_agrees():
+    """Coulomb friction's switch: a fixed step straddles the reversals (the force differs by a
+    fraction of its std), so the fit keeps the pair."""
+    rig = _rig()
+    case = _case(_record(rig))
+    coulomb = LIBRARY["coulomb_friction"].apply(rig, np.array([700.0]))
+    ref = engine.simulate_case(coulomb, case, 0.0, case.x0_data, search=True)
+    assert not _within(engine.simulate_case(coulomb, case, 0.0, case.x0_data,
+                                            options=rk4_options(engine.SEARCH_RK4_SUBSTEPS[-1])), ref, case)
+    opts = engine.search_options(coulomb, [case], 0.0, [case.x0_data])[0]
+    assert opts.rk4_substeps == 0 and opts.rtol == engine.run_options(True).rtol
+
+
+def test_the_fit_on_rk4_lands_where_the_fit_on_the_pair_does(monkeypatch):
+    """The MR damper candidate fitted to a record with a damper 20 % stronger than the nominal one:
+    the fit on RK4 and the same fit on the search's pair alone end within a tenth of a standard
+    error of each other (the HAC intervals), both near the truth."""
+    rig = _rig()
+    c0_true = 1.2 * sh._core.mr_damper_law(rig)["c0"]
+    rec = _record(rig, c0_true)
+    setup = workflow._prepare([rec], rig, "displacement", ["mr_damper"], 1, False, False)
+    x0 = tuple(c.x0_data for c in setup.cases)
+    sims = engine.simulate_all(rig, setup.cases, 0.0, x0)
+    ctx = workflow._context(setup, workflow._State(rig=rig, tau=0.0, x0=x0, sims=sims))
+    space = engine.Space(LIBRARY["mr_damper"], ctx, ())
+    start = space.absent.copy()
+    lengths = engine.series_lengths(setup.cases)
+    rig0, tau0 = space.rig_and_tau(start, 0.0)
+    chosen = engine.search_options(rig0, setup.cases, tau0, x0)
+    assert all(o.rk4_substeps > 0 for o in chosen)
+    rk4 = engine.fit(space, setup.cases, start, 0.0, "all", x0)
+    monkeypatch.setattr(engine, "search_options", lambda rig, cases, tau, x0s: [engine.run_options(True)] * len(cases))
+    pair = engine.fit(space, setup.cases, start, 0.0, "all", x0)
+    sd = np.sqrt(np.diag(engine.covariance(space, pair, lengths)))
+    assert np.all(np.isfinite(sd))
+    assert np.all(np.abs(rk4.z - pair.z) <= 0.1 * sd)
+    c0 = space.to_external(rk4.z)[1]
+    assert abs(c0 / c0_true - 1.0) < 0.05
