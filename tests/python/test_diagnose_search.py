@@ -34,7 +34,7 @@ def _record(rig: sh.Rig, c0: float | None = None) -> Record:
     """3 s of a 0.5-8 Hz chirp (8 mm) through ``rig`` (the damper's c0 [N s/m] raised to ``c0``:
     the hidden effect) by the core's default pair at rtol 1e-8, with 40 dB of noise."""
     truth = copy.copy(rig) if c0 is None else LIBRARY["mr_damper"].apply(
-        rig, np.array([sh._core.mr_damper_law(rig)["alpha"], c0]))
+        rig, np.array([sh._core.mr_damper_law(rig)["alpha"], c0, sh._core.mr_damper_law(rig)["c1"]]))
     t = np.arange(int(3.0 / DT) + 1) * DT
     u = np.minimum(t / 0.3, 1.0) * 0.008 * np.sin(2 * np.pi * (0.5 + 2.5 * t) * t)
     r = simulate_command(truth, "displacement", u, DT, 0.0, None)
@@ -79,7 +79,8 @@ def test_a_diverged_rk4_run_climbs_the_ladder():
     ``AGREEMENT`` of it (where not, the fit goes on from there on the pair)."""
     rig = _rig()
     case = _case(_record(rig))
-    stiff = LIBRARY["mr_damper"].apply(rig, np.array([sh._core.mr_damper_law(rig)["alpha"], 1e6]))
+    law = sh._core.mr_damper_law(rig)
+    stiff = LIBRARY["mr_damper"].apply(rig, np.array([law["alpha"], 1e6, law["c1"]]))
     with pytest.raises(SimulationError, match="diverged"):
         simulate_command(stiff, "displacement", case.u, case.dt, case.x0_data, rk4_options(3))
     run = engine.simulate_case(stiff, case, 0.0, case.x0_data, options=rk4_options(3))
