@@ -97,14 +97,14 @@ class Server:
     def serve(self, max_clients: int | None = None, on_ready: Callable[[], None] | None = None) -> ServerStats:
         """Serves clients one after the other until ``max_clients`` have been served (None: until
         Ctrl-C, which closes everything and re-raises KeyboardInterrupt)."""
-        log.info("serving %s actuator(s) on %s:%d (one client at a time, timeout %g s)",
-                 self.site.n, *self.address, self.timeout)
-        if not self._loopback():
-            log.warning("listening beyond this machine (%s): whoever reaches this port drives the actuator",
-                        self.address[0])
-        if on_ready:
-            on_ready()
-        try:
+        try:  # from the first line on: a Ctrl-C right after "serving" is still logged as a stop
+            log.info("serving %s actuator(s) on %s:%d (one client at a time, timeout %g s)",
+                     self.site.n, *self.address, self.timeout)
+            if not self._loopback():
+                log.warning("listening beyond this machine (%s): whoever reaches this port drives the actuator",
+                            self.address[0])
+            if on_ready:
+                on_ready()
             while max_clients is None or self.stats.clients < max_clients:
                 self._sel.select()  # only the listener is registered here
                 conn = self._accept()
