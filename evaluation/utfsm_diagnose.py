@@ -198,7 +198,7 @@ def main() -> None:
     given = [("run", a.run)] if a.run else [("rig", a.rig), ("record", a.record)]
     given += [("end", a.end), ("max-effects", a.max_effects), ("out", table or a.out)]
     given += [] if a.run else [("label", a.label)]
-    args = " ".join(f"--{k} {v}" for k, v in given if v)
+    args = " ".join(f"--{k} {v:g}" if k == "end" else f"--{k} {v}" for k, v in given if v is not None and v != "")
     args += "".join(f" --effect-off {e}" for e in a.effect_off)
     cmd = f"PYTHONPATH=python python evaluation/utfsm_diagnose.py {args}"
     (out / "utfsm_diagnose.json").write_text(json.dumps({"command": cmd, "nominal": how, "identify_s": t_ident,
