@@ -9,12 +9,11 @@ not the core's Pade approximant; its own Bouc-Wen law), never by the core.
 
 from __future__ import annotations
 
-import sys
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
+from independent_records import DT, gen, independent_record
 
 import servohydraulics as sh
 from servohydraulics.cli import main
@@ -23,25 +22,11 @@ from servohydraulics.diagnosis.confirm import fit_space
 from servohydraulics.diagnosis.effects import Context
 from servohydraulics.records import Record
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "evaluation" / "diagnose_eval"))
-import generate as gen  # noqa: E402
-import independent_plant as ip  # noqa: E402
-
-DT = 5e-4
-
 
 def _record(mode: str = "displacement", rig: str = "paper", duration: float = 4.0, seed: int = 3, snr: float = 30,
             **truth) -> Record:
     """A record of the independent simulator: the evaluation's command for the rig, white noise at ``snr`` dB."""
-    u, _ = gen.command(mode, "std", duration, np.random.default_rng(seed))
-    u = u * gen.RIGS[rig][1 if mode == "displacement" else 2]
-    ch = ip.simulate(replace(gen.base_truth(mode, rig), **truth), mode, u, DT, substeps=4)
-    rng = np.random.default_rng(seed + 100)
-    rec = {"time": ch["time"], "command": ch["command"]}
-    for c in ("displacement", "force"):
-        y = ch[c]
-        rec[c] = y + rng.normal(0.0, float(np.sqrt(np.mean(y ** 2))) * 10 ** (-snr / 20), y.size)
-    return Record(rec)
+    return independent_record(mode, rig, duration, seed, snr, noise_seed=seed + 100, **truth)
 
 
 def _names(d) -> list[str]:

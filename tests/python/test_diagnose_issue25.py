@@ -17,36 +17,18 @@ workflow now passes, the hidden truth as the oracle.
 
 from __future__ import annotations
 
-import sys
-from dataclasses import replace
-from pathlib import Path
-
-import numpy as np
+from independent_records import gen, independent_record
 
 import servohydraulics as sh
 from servohydraulics.diagnosis import LIBRARY
 from servohydraulics.diagnosis.effects import _a
 from servohydraulics.records import Record
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "evaluation" / "diagnose_eval"))
-import generate as gen  # noqa: E402
-import independent_plant as ip  # noqa: E402
-
-DT = 5e-4
-
 
 def _record(rig: str, duration: float, seed: int, snr: float, scale: float = 1.0, **truth) -> Record:
     """The evaluation's displacement command for ``rig`` (times ``scale``) through the independent
     simulator with ``truth`` hidden, white noise at ``snr`` dB on displacement and force."""
-    rng = np.random.default_rng(seed)
-    u, _ = gen.command("displacement", "std", duration, rng)
-    u = u * gen.RIGS[rig][1] * scale
-    ch = ip.simulate(replace(gen.base_truth("displacement", rig), **truth), "displacement", u, DT, substeps=4)
-    rec = {"time": ch["time"], "command": ch["command"]}
-    for c in ("displacement", "force"):
-        y = ch[c]
-        rec[c] = y + rng.normal(0.0, float(np.sqrt(np.mean(y ** 2))) * 10 ** (-snr / 20), y.size)
-    return Record(rec)
+    return independent_record("displacement", rig, duration, seed, snr, scale, **truth)
 
 
 def _names(d) -> list[str]:
