@@ -418,20 +418,11 @@ def _fit_target(recs, start, coords, z1, mode, chans, options, dt, workers, befo
         if target.agrees(start, before):
             return target
         target.close()
-    unchecked = _unchecked(options)
-    target = Target.build(recs, mode, chans, unchecked, dt, rig1, workers)
+    target = Target.build(recs, mode, chans, options, dt, rig1, workers)
     if target.agrees(start, before):
         return target
     target.close()
-    return Target(recs, mode, chans, unchecked, dt, [whole(r) for r in recs], workers)
-
-
-def _unchecked(options):
-    """The options without the pair's shadow check (``stiff_check``): the search reads no flag, and
-    the results are the same to the bit."""
-    out = copy.copy(options)
-    out.stiff_check = False
-    return out
+    return Target(recs, mode, chans, options, dt, [whole(r) for r in recs], workers)
 
 
 def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options, dt, max_nfev, progress, workers,
@@ -461,7 +452,7 @@ def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options,
             runs["shift_sd"] = _shift(target, coords.apply(start, kept[3].z), after, kept[2], kept[3], cov)
             if not runs["shift_sd"] <= SHIFT_SD:  # polish on the pair's whole runs
                 target.close()
-                target = Target(recs, mode, chans, _unchecked(options), dt, [whole(r) for r in recs], workers)
+                target = Target(recs, mode, chans, options, dt, [whole(r) for r in recs], workers)
                 runs["polished_on_whole_runs"] = True
                 stages["time"], n = _time_stage(target, start, coords, kept[3].z, mode, chans, max_nfev, bar)
                 nfev += n
