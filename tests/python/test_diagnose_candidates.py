@@ -100,10 +100,10 @@ def test_absent_value_of_every_candidate_reproduces_the_current_model() -> None:
         checked.append(name)
     assert {"command_delay", "loop_delay", "bouc_wen_hysteresis", "coulomb_friction", "servovalve_dynamics"} \
         <= set(checked), checked
-    # the model's load-pressure term is re-fitted with the force candidates (over its whole range): "absent"
-    # holds it at its value
+    # the model's load terms (the load-pressure term, and in displacement control the actuator's size) are
+    # re-fitted with the force candidates (over their whole range, reciprocal coordinates): "absent" holds them
     space = dict(_spaces(ctx, interacting=True))["coulomb_friction"]
-    assert [k for k, _ in space.interacting] == ["c", "p_s"] and space.rec[-1]
+    assert [k for k, _ in space.interacting] == ["c", "p_s", "A"] and space.rec[-2:].all()
 
 
 @pytest.mark.slow  # minutes: excluded from scripts/run.sh test, run by scripts/run.sh test-all

@@ -13,6 +13,8 @@ workflow now passes, the hidden truth as the oracle.
 * A wrong load-pressure term in the nominal model (the UTFSM rig identified at 0 A) made every
   force candidate cost displacement, so none passed: the force candidates now re-fit the model's
   load-pressure term with them over its whole range ("off" included).
+* An actuator the model believes too small (the generic start's, sized from a record at low force)
+  makes a force cost the displacement too much: the force candidates re-fit the actuator's size too.
 """
 
 from __future__ import annotations
@@ -95,4 +97,24 @@ def test_a_wrong_load_pressure_term_no_longer_blocks_the_force_candidate() -> No
     assert abs(_param(d, "coulomb_friction", "F_c")["value"] - 800.0) < 0.1 * 800.0
     p_s = _param(d, "coulomb_friction", "p_s")["value"]
     assert p_s is None or p_s > 10e6, p_s  # None: infinite, the term switched off
+    assert d.gap_after["displacement"] <= d.gap_before["displacement"]
+
+
+def test_an_actuator_the_model_believes_too_small_is_re_sized_with_the_force_candidate() -> None:
+    """rigC with 800 N of Coulomb friction; the model's actuator is eight times too small (A, K_v, K_a,
+    C_l and F_cap divided by 8: the same no-load loop, eight times the cost of a force to the displacement,
+    the way the generic start sizes an actuator from a record at low force).  The friction is named within
+    10 % of 800 N, the actuator re-fitted with it (the load term A) to within 15 % of the truth, and the
+    displacement gap does not grow.  (Without the load term A the friction is named at 71 N and the force gap
+    stays at 86 %; with it, F_c 801 N, A 8.02 times the model's, gaps 5.8 % -> 1.0 % and 94 % -> 1.3 %.)"""
+    from servohydraulics.diagnosis.effects import apply_area
+
+    rec = _record("rigC", 2.0, 5, 40.0, friction="coulomb", F_c=800.0)
+    truth = gen.nominal_rig("displacement", "rigC")
+    nominal = apply_area(truth, truth.A / 8.0)
+    d = sh.diagnose(rec, nominal, mode="displacement", progress=False,
+                    candidates=["coulomb_friction", "viscous_damping", "load_pressure"], max_effects=1)
+    assert _names(d)[:1] == ["coulomb_friction"], d.summary
+    assert abs(_param(d, "coulomb_friction", "F_c")["value"] - 800.0) < 0.1 * 800.0
+    assert abs(_param(d, "coulomb_friction", "A")["value"] - truth.A) < 0.15 * truth.A
     assert d.gap_after["displacement"] <= d.gap_before["displacement"]

@@ -152,18 +152,55 @@ class LoadTerm:
     #: the rig with the term at a value (an infinite value switches the term off)
     apply: Callable[[Rig, float], Rig]
     rig_key: str
+    modes: tuple[str, ...] = ("displacement", "force")  #: the modes it is re-fitted in
 
 
 def _apply_supply(rig: Rig, p_s: float) -> Rig:
     return _apply_load_pressure(rig, np.array([p_s]))
 
 
+#: a scale factor within this of 1 leaves the rig as it is: an apply whose parameter is the rig's own value back from
+#: fitting coordinates (round-off) rebuilds the rig exactly (the joint and loop re-fits check that they do)
+REBUILD_RTOL = 1e-12
+
+#: range of the actuator-size load term: from half the user's piston area (no smaller than keeps the peak load
+#: pressure within the load-pressure term's own range, p_s >= SUPPLY_MIN_RATIO times it) to AREA_MAX_RATIO times it
+AREA_MAX_RATIO = 30.0
+
+
+def _area_bounds(ctx: Context) -> tuple[float, float]:
+    A, A_user = ctx.rig.A, ctx.nominal.A
+    lo = 0.5 * A_user
+    if ctx.rig.effects.load_pressure:
+        lo = max(lo, A * SUPPLY_MIN_RATIO * ctx.peak_pressure / ctx.rig.p_s)  # the supply's own lower bound
+    return min(lo, A), max(AREA_MAX_RATIO * A_user, A)
+
+
+def apply_area(rig: Rig, A: float) -> Rig:
+    """``rig`` (a copy) with the piston area ``A`` and the loop's no-load response kept: the flow gain K_v, the
+    oil column's compliance K_a (V_t = 2 A stroke), the leakage C_l and the capacity F_cap scale with A, so that
+    the no-load velocity per drive K_v / A and the closed-loop corner G_p C_F K_s K_v / A are unchanged, while
+    what a force F costs the loop (the compliance flow K_a F' / A^2, the leakage C_l F / A^2, the load pressure
+    F / A of Eq 3) falls as 1 / A."""
+    q = float(A) / rig.A
+    if abs(q - 1.0) <= REBUILD_RTOL:  # the rig's own size back from fitting coordinates: the rig itself
+        return _with(rig)
+    return _with(rig, A=rig.A * q, K_v=rig.K_v * q, K_a=rig.K_a * q, C_l=rig.C_l * q, F_cap=rig.F_cap * q)
+
+
 #: the load-dependent loop terms, by rig key: the load-pressure term of Eq (3), from just above the
-#: current model's peak load pressure to "off"
+#: current model's peak load pressure to "off"; and (displacement control) the actuator's size, which sets what a
+#: force costs the loop's displacement: a rig identified on a record at low force (an MR damper at 0 A) has it
+#: from the generic start (a capacity of ten times that record's peak force), not from the records
+#: (docs/diagnose.md, issue 25)
 LOAD_TERMS: dict[str, LoadTerm] = {
     "p_s": LoadTerm("p_s", "Pa", True, lambda rig: bool(rig.effects.load_pressure),
                     lambda ctx: (_supply_min(ctx), math.inf), _apply_supply,
                     "re-fitted nominal load term: actuator.p_s of Eq (3) (infinite: effects.load_pressure off)"),
+    "A": LoadTerm("A", "m^2", True, lambda rig: rig.A > 0.0, _area_bounds, apply_area,
+                  "re-fitted nominal load term: actuator.A, with K_v, K_a, C_l and F_cap scaled with it (the "
+                  "loop's no-load response kept, what a force costs it scaled by 1 / A)",
+                  modes=("displacement",)),
 }
 
 
@@ -171,7 +208,7 @@ def load_terms(rig: Rig, mode: str) -> tuple[tuple[str, str], ...]:
     """The load-dependent loop terms that are on in ``rig`` (key, unit); none in free mode."""
     if mode == "free":
         return ()
-    return tuple((t.key, t.unit) for t in LOAD_TERMS.values() if t.on(rig))
+    return tuple((t.key, t.unit) for t in LOAD_TERMS.values() if mode in t.modes and t.on(rig))
 
 
 def interacting(cand: Candidate, rig: Rig, mode: str) -> tuple[tuple[str, str], ...]:
@@ -391,25 +428,42 @@ def _mr_exercised(ctx: Context) -> str | None:
     return None
 
 
+def _mr_yield(rig: Rig, law: dict) -> float:
+    """The damper's Bouc-Wen yield displacement (A / (beta + gamma))^(1/n) at the rig's field input [m]."""
+    return (rig.mr_A / max(law["beta"] + law["gamma"], 1e-300)) ** (1.0 / rig.mr_n)
+
+
 def _apply_mr(rig: Rig, th: np.ndarray) -> Rig:
-    # theta = (alpha [N/m], c0 [N s/m], c1 [N s/m]) at the rig's field input: the field-dependent parameters of
-    # Spencer's model; the field-dependent parts of its law (the core's mr_damper_law) stay, the a-terms take the rest
+    # theta = (alpha [N/m], c0 [N s/m], c1 [N s/m], and optionally z_y [m]) at the rig's field input: the
+    # field-dependent parameters of Spencer's model and the Bouc-Wen yield displacement, which the thesis' law makes
+    # field-dependent too (beta(i) = gamma(i)); the field-dependent parts of the law (the core's mr_damper_law)
+    # stay, the a-terms take the rest, and beta and gamma are scaled together (their ratio kept)
     law = _core.mr_damper_law(rig)
-    return _with(rig, mr_alpha_a=max(th[0] - (law["alpha"] - rig.mr_alpha_a), 0.0),
-                 mr_c0_a=max(th[1] - (law["c0"] - rig.mr_c0_a), 1e-6),
-                 mr_c1_a=max(th[2] - (law["c1"] - rig.mr_c1_a), 1e-6))
+    values = dict(mr_alpha_a=max(th[0] - (law["alpha"] - rig.mr_alpha_a), 0.0),
+                  mr_c0_a=max(th[1] - (law["c0"] - rig.mr_c0_a), 1e-6),
+                  mr_c1_a=max(th[2] - (law["c1"] - rig.mr_c1_a), 1e-6))
+    if len(th) > 3:
+        q = (_mr_yield(rig, law) / max(float(th[3]), 1e-12)) ** rig.mr_n
+        if abs(q - 1.0) > REBUILD_RTOL:
+            values.update(mr_beta=rig.mr_beta * q, mr_gamma=rig.mr_gamma * q)
+    return _with(rig, **values)
 
 
 def _mr_absent(ctx: Context) -> np.ndarray:
     law = _core.mr_damper_law(ctx.rig)
-    return _a(law["alpha"], law["c0"], law["c1"])
+    return _a(law["alpha"], law["c0"], law["c1"], _mr_yield(ctx.rig, law))
+
+
+#: the damper's yield displacement ranges over MR_YIELD_SPAN either side of the model's (the UTFSM damper's
+#: identified yield is 9 mm at 0 A and 65 mm at 1 A: evaluation/utfsm_rigs/)
+MR_YIELD_SPAN = 20.0
 
 
 def _mr_bounds(ctx: Context) -> tuple[np.ndarray, np.ndarray]:
-    alpha, c0, c1 = _mr_absent(ctx)
+    alpha, c0, c1, z_y = _mr_absent(ctx)
     fs = force_scale(ctx)
-    return _a(0.0, 1e-3, 1e-3), _a(max(50 * alpha, 20 * fs / 0.01), max(50 * c0, 20 * fs / 0.1),
-                                   max(50 * c1, 200 * fs / 0.1))
+    return _a(0.0, 1e-3, 1e-3, z_y / MR_YIELD_SPAN), _a(max(50 * alpha, 20 * fs / 0.01), max(50 * c0, 20 * fs / 0.1),
+                                                          max(50 * c1, 200 * fs / 0.1), z_y * MR_YIELD_SPAN)
 
 
 def _apply_valve(rig: Rig, th: np.ndarray) -> Rig:
@@ -667,14 +721,18 @@ CANDIDATES: tuple[Candidate, ...] = (
                rig_key="specimen.mr_c0_a (+ the field terms of mr_law): the damper's viscous coefficient"),
          Param("c1", unit="N s/m", tests_absent=False,
                rig_key="specimen.mr_c1_a (+ the field terms of mr_law): the dashpot in series that sets the "
-                       "damper's roll-off at low velocity")),
+                       "damper's roll-off at low velocity"),
+         Param("z_y", unit="m", tests_absent=False,
+               rig_key="specimen.mr_beta and mr_gamma scaled together: the damper's Bouc-Wen yield displacement "
+                       "(mr_A / (beta + gamma))^(1 / mr_n) at the record's current")),
         "the MR damper element's field-dependent force (Spencer et al. 1997): its hysteretic level alpha, viscous "
         "coefficient c0 and series dashpot c1 at the record's current, the three parameters Spencer's model makes "
-        "field-dependent (the rest of the damper as in the model)",
+        "field-dependent, and its Bouc-Wen yield displacement, which the thesis' law (Quiroz 2022: beta(i) = "
+        "gamma(i)) makes field-dependent too (the rest of the damper as in the model)",
         absent=_mr_absent,
         bounds=_mr_bounds,
         probe=lambda ctx: _mr_absent(ctx) * 1.5 + _a(_friction_probe(ctx) / 0.01, _friction_probe(ctx) / 0.1,
-                                                     _friction_probe(ctx) / 0.1),
+                                                     _friction_probe(ctx) / 0.1, 0.0),
         apply=_apply_mr, exercised=_mr_exercised, look_alikes=("bouc_wen_hysteresis",), loads_actuator=True,
         separate="tests at two velocities: the damper's viscous part c0 grows with velocity, its yield level alpha "
                  "does not",

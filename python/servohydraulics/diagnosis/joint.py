@@ -30,10 +30,42 @@ from ..identification.stats import inseparable_groups
 from ..rig import Rig
 from . import engine
 from .confirm import param_report
-from .effects import nominal_value, split_delay
+from .effects import Candidate, Context, Param, nominal_value, split_delay
 from .types import Accepted, Case, FitResult, JointRefit
 
 JOINT_MAX_NFEV = 30  #: most least-squares iterations of the joint re-fit
+
+#: the loop re-fit runs once the diagnosis has re-sized the actuator (the load term ``A``) by more than this
+LOOP_RESIZE_MIN = 0.10
+
+
+def _loop_absent(ctx: Context) -> np.ndarray:
+    r = ctx.rig
+    return np.array([r.K_v, r.f_v, r.zeta_v], float)
+
+
+def _loop_bounds(ctx: Context) -> tuple[np.ndarray, np.ndarray]:
+    kv, fv, zv = _loop_absent(ctx)
+    return np.array([0.5 * kv, 0.25 * fv, 0.1]), np.array([2.0 * kv, 4.0 * fv, max(5.0, zv)])
+
+
+def _apply_loop(rig, th: np.ndarray):
+    import copy
+
+    r = copy.copy(rig)
+    r.K_v, r.f_v, r.zeta_v = float(th[0]), float(th[1]), float(th[2])
+    return r
+
+
+#: the loop's own parameters (not an effect: never screened or named), re-fitted with the accepted effects once
+#: the diagnosis has re-sized the actuator: the identification fitted them with the old size, whose load coupling
+#: (a force's cost to the displacement) took part of the loop's lag; the re-sized loop needs its own
+LOOP = Candidate(
+    "loop", (Param("K_v", "servovalve.K_v"), Param("f_v", "servovalve.f_v"), Param("zeta_v", "servovalve.zeta_v")),
+    "the loop's own flow gain and servovalve dynamics, re-fitted with the effects after the actuator is re-sized",
+    absent=_loop_absent, bounds=_loop_bounds, probe=lambda ctx: 1.1 * _loop_absent(ctx), apply=_apply_loop,
+    modes=("displacement",),
+    active=lambda ctx: (True, bool(ctx.rig.effects.servovalve_dynamics), bool(ctx.rig.effects.servovalve_dynamics)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -163,3 +195,76 @@ def joint_refit(accepted: list[Accepted], parameters: dict, current: Rig, tau: f
                 else "joint BIC worse than the greedy one: kept the greedy fit"), seconds=time.time() - t0)
     return info, (JointModel(rig1, tau1, res.x0, sims1, refit, reports, joint_groups(accepted, js, corr))
                   if keep else None)
+
+
+def loop_refit(accepted: list[Accepted], parameters: dict, current: Rig, nominal: Rig, tau: float,
+               cases: list[Case], x0s, sims: list, rnd: int, ctx: Context) -> tuple[JointRefit | None,
+                                                                                    JointModel | None]:
+    """After round ``rnd``: when the accepted effects' re-fits have re-sized the actuator (``current.A`` off
+    ``nominal.A`` by more than ``LOOP_RESIZE_MIN``, displacement control), the accepted effects' own parameters
+    and the loop's (``LOOP``: K_v, f_v, zeta_v) fitted together, the re-fitted nominal terms (the actuator's size,
+    the supply) held where the effects' fits left them; kept if the BIC with the loop's parameters counted is
+    better than the model's.  (None, None) when not tried."""
+    if ctx.mode not in LOOP.modes or abs(current.A / nominal.A - 1.0) <= LOOP_RESIZE_MIN:
+        return None, None
+    t0 = time.time()
+    k = int(sum(a.z.size for a in accepted))
+    acc, held, shared = _partition(accepted)
+    names = tuple(a.name for a in acc) + ("loop",)
+    info = JointRefit(round=rnd, effects=names, superseded=tuple(held) or None)
+    if shared:
+        return dataclasses.replace(info, reason=f"not tried: effects share the parameter(s) {shared}"), None
+    loop_space = engine.Space(LOOP, ctx, ())
+    own = [engine.Space(a.space.cand, a.space.ctx, ()) for a in acc]  # the effects without their nominal terms
+    js = engine.JointSpace(own + [loop_space], current)
+    z0 = np.concatenate([a.z[: a.space.n_main] for a in acc] + [loop_space.absent])
+    base_tau = tau - sum(split_delay(a.space.to_external(a.z)[0])[1] for a in acc if a.space.cand.delays_command)
+    rig0, tau0 = js.rig_and_tau(z0, base_tau)
+    if rig0 != current or not math.isclose(tau0, tau, rel_tol=1e-9, abs_tol=1e-12):
+        return dataclasses.replace(info, reason="not tried: the model cannot be rebuilt from the effects' "
+                                                "parameters"), None
+    stats0 = engine.channel_stats(sims, cases)
+    neff = engine.n_eff(stats0)
+    # the fit follows the BIC's likelihood (its channel weights): what decides whether the re-fit is kept
+    res = engine.fit(js, cases, z0, base_tau, "all", x0s, max_nfev=JOINT_MAX_NFEV,
+                     weights=engine.likelihood_weights(stats0))
+    rig1, tau1 = js.rig_and_tau(res.z, base_tau)
+    sims1 = engine.simulate_all(rig1, cases, tau1, res.x0)
+    info = dataclasses.replace(info, parameters_fitted=tuple(prm.key for prm in js.params), nfev=res.nfev)
+    if any(s is None for s in sims1):
+        return dataclasses.replace(info, reason="the loop re-fit's simulation fails: kept the model",
+                                   seconds=time.time() - t0), None
+    b0 = engine.bic(stats0, k, neff)
+    b1 = engine.bic(engine.channel_stats(sims1, cases), k + loop_space.n_main, neff)
+    lengths = engine.series_lengths(cases)
+    lo, hi, corr = engine.uncertainty(js, res, lengths)
+    refit, reports, excl = {}, {}, {}
+    for a, sp, blk in zip(acc, own, js.blocks):
+        zf, lof, hif = a.z.copy(), a.lo.copy(), a.hi.copy()
+        zf[: sp.n_main], lof[: sp.n_main], hif[: sp.n_main] = res.z[blk], lo[blk], hi[blk]
+        sub = np.full((zf.size, zf.size), np.nan)
+        sub[: sp.n_main, : sp.n_main] = corr[blk, blk]
+        refit[a.name] = Accepted(a.name, a.space, zf, lof, hif, sub)
+        reports[a.name] = {**parameters[a.name], **param_report(sp, res.z[blk], lo[blk], hi[blk])}
+        mask = np.zeros(res.z.size, bool)
+        mask[blk] = sp.tests_absent[: sp.n_main]
+        outside = (sp.absent[: sp.n_main] < lo[blk]) | (sp.absent[: sp.n_main] > hi[blk])
+        excl[a.name] = bool(np.any(outside & sp.tests_absent[: sp.n_main])) or \
+            engine.joint_excludes_absent(js, res, lengths, mask)[0]
+    lblk = js.blocks[-1]
+    loop_values = {"loop": _values(param_report(loop_space, res.z[lblk], lo[lblk], hi[lblk]))}
+    keep = b1 < b0
+    greedy = {a.name: _values(parameters[a.name]) for a in acc}
+    greedy["loop"] = {key: {"value": float(v), "interval_95": None}
+                      for key, v in zip([p.key for p in loop_space.params], loop_space.to_external(loop_space.absent))}
+    info = dataclasses.replace(
+        info, kept=bool(keep), bic_greedy=b0, bic_joint=b1, delta_bic=b0 - b1, gap_greedy=engine.gap(sims, cases),
+        gap_joint=engine.gap(sims1, cases), parameters_greedy=greedy,
+        parameters_joint={**{n: _values(r) for n, r in reports.items()}, **loop_values}, excludes_absent_joint=excl,
+        reason=(f"loop re-fit after the actuator was re-sized (A x{current.A / nominal.A:.3g}): BIC with the "
+                f"loop's parameters counted {'better: kept' if keep else 'not better: kept the model'}"),
+        seconds=time.time() - t0)
+    if not keep:
+        return info, None
+    return info, JointModel(rig1, tau1, res.x0, sims1, refit, reports, joint_groups(acc + [
+        Accepted("loop", loop_space, res.z[lblk], lo[lblk], hi[lblk], None)], js, corr))

@@ -27,7 +27,7 @@ from ..workers import single_blas_thread
 from . import engine
 from .confirm import confirm, param_groups, param_report
 from .effects import LIBRARY, Context, check_names, interacting, nested, separating_experiment
-from .joint import joint_refit
+from .joint import joint_refit, loop_refit
 from .types import Accepted, CandidateLog, Case, Fit, JointRefit, Round, Screening, Sim
 
 #: acceptance thresholds (documented in docs/diagnose.md)
@@ -526,6 +526,8 @@ def _accept(setup: _Setup, state: _State, outcome: Round) -> None:
                                    np.asarray(fit.lo, float).copy(), np.asarray(fit.hi, float).copy(), fit.corr))
     if setup.joint_refit and len(state.accepted) >= 2:
         _polish(setup, state, outcome.number)
+    if setup.joint_refit:
+        _polish_loop(setup, state, outcome.number)
 
 
 def _polish(setup: _Setup, state: _State, rnd: int) -> None:
@@ -545,6 +547,28 @@ def _polish(setup: _Setup, state: _State, rnd: int) -> None:
     state.joint_groups = new.groups
     state.effects[-1]["gap_after"] = engine.gap(state.sims, setup.cases)
     state.history.append(("joint re-fit", state.effects[-1]["gap_after"]))
+
+
+def _polish_loop(setup: _Setup, state: _State, rnd: int) -> None:
+    """The loop re-fit (``joint.loop_refit``) once the effects have re-sized the actuator; its model replaces
+    the current one if kept."""
+    setup.bar.set_description_str(f"round {rnd}: loop re-fit")
+    parameters = {e["name"]: e["parameters"] for e in state.effects}
+    info, new = loop_refit(state.accepted, parameters, state.rig, setup.nominal, state.tau, setup.cases, state.x0,
+                           state.sims, rnd, _context(setup, state))
+    if info is None:
+        return
+    state.joint_log.append(info)
+    if new is None:
+        return
+    state.rig, state.tau, state.sims = new.rig, new.tau, new.sims
+    state.x0 = tuple(float(v) for v in new.x0)
+    state.accepted = [new.accepted.get(a.name, a) for a in state.accepted]
+    for e in state.effects:
+        e["parameters"] = new.parameters.get(e["name"], e["parameters"])
+    state.joint_groups = new.groups
+    state.effects[-1]["gap_after"] = engine.gap(state.sims, setup.cases)
+    state.history.append(("loop re-fit", state.effects[-1]["gap_after"]))
 
 
 # --- the result ------------------------------------------------------------------------------
