@@ -118,3 +118,25 @@ def test_an_actuator_the_model_believes_too_small_is_re_sized_with_the_force_can
     assert abs(_param(d, "coulomb_friction", "F_c")["value"] - 800.0) < 0.1 * 800.0
     assert abs(_param(d, "coulomb_friction", "A")["value"] - truth.A) < 0.15 * truth.A
     assert d.gap_after["displacement"] <= d.gap_before["displacement"]
+
+
+def test_the_loop_is_re_fitted_once_the_actuator_is_re_sized() -> None:
+    """The same record and too-small actuator, and the model's valve off as well (f_v 0.6 times, zeta_v 1.5
+    times rigC's): once the friction's fit has re-sized the actuator, the loop re-fit (K_v, f_v, zeta_v with
+    the friction) is kept, both channels' gaps fall below the greedy model's, and F_c moves to within 1 % of
+    the hidden 800 N.  The loop's values are nuisance parameters: they are not checked against rigC's (here
+    f_v 49 Hz, zeta_v 0.39 against 120 Hz, 0.8; the independent simulator's valve is not the core's)."""
+    from servohydraulics.diagnosis.effects import apply_area
+
+    rec = _record("rigC", 2.0, 5, 40.0, friction="coulomb", F_c=800.0)
+    truth = gen.nominal_rig("displacement", "rigC")
+    nominal = apply_area(truth, truth.A / 8.0)
+    nominal.f_v, nominal.zeta_v = 0.6 * truth.f_v, 1.5 * truth.zeta_v
+    d = sh.diagnose(rec, nominal, mode="displacement", progress=False,
+                    candidates=["coulomb_friction", "viscous_damping", "load_pressure"], max_effects=1)
+    assert _names(d) == ["coulomb_friction"], d.summary
+    loop = [j for j in d.joint_refit if "loop" in j.effects]
+    assert len(loop) == 1 and loop[0].kept, loop
+    assert all(loop[0].gap_joint[c] < loop[0].gap_greedy[c] for c in ("displacement", "force")), loop[0]
+    assert abs(_param(d, "coulomb_friction", "F_c")["value"] - 800.0) < 0.01 * 800.0
+    assert d.gap_after["displacement"] < d.gap_before["displacement"]
