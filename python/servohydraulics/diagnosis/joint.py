@@ -19,6 +19,7 @@ be rebuilt from their parameters, are not re-fitted.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 import time
@@ -50,8 +51,6 @@ def _loop_bounds(ctx: Context) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _apply_loop(rig, th: np.ndarray):
-    import copy
-
     r = copy.copy(rig)
     r.K_v, r.f_v, r.zeta_v = float(th[0]), float(th[1]), float(th[2])
     return r

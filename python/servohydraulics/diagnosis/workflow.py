@@ -536,17 +536,7 @@ def _polish(setup: _Setup, state: _State, rnd: int) -> None:
     parameters = {e["name"]: e["parameters"] for e in state.effects}
     info, new = joint_refit(state.accepted, parameters, state.rig, state.tau, setup.cases, state.x0, state.sims,
                             rnd)
-    state.joint_log.append(info)
-    if new is None:
-        return
-    state.rig, state.tau, state.sims = new.rig, new.tau, new.sims
-    state.x0 = tuple(float(v) for v in new.x0)
-    state.accepted = [new.accepted.get(a.name, a) for a in state.accepted]
-    for e in state.effects:
-        e["parameters"] = new.parameters.get(e["name"], e["parameters"])
-    state.joint_groups = new.groups
-    state.effects[-1]["gap_after"] = engine.gap(state.sims, setup.cases)
-    state.history.append(("joint re-fit", state.effects[-1]["gap_after"]))
+    _adopt(setup, state, info, new, "joint re-fit")
 
 
 def _polish_loop(setup: _Setup, state: _State, rnd: int) -> None:
@@ -556,6 +546,11 @@ def _polish_loop(setup: _Setup, state: _State, rnd: int) -> None:
     parameters = {e["name"]: e["parameters"] for e in state.effects}
     info, new = loop_refit(state.accepted, parameters, state.rig, setup.nominal, state.tau, setup.cases, state.x0,
                            state.sims, rnd, _context(setup, state))
+    _adopt(setup, state, info, new, "loop re-fit")
+
+
+def _adopt(setup: _Setup, state: _State, info, new, label: str) -> None:
+    """Logs a re-fit (``info``; None: not tried) and, if it was kept (``new``), makes its model the current one."""
     if info is None:
         return
     state.joint_log.append(info)
@@ -568,7 +563,7 @@ def _polish_loop(setup: _Setup, state: _State, rnd: int) -> None:
         e["parameters"] = new.parameters.get(e["name"], e["parameters"])
     state.joint_groups = new.groups
     state.effects[-1]["gap_after"] = engine.gap(state.sims, setup.cases)
-    state.history.append(("loop re-fit", state.effects[-1]["gap_after"]))
+    state.history.append((label, state.effects[-1]["gap_after"]))
 
 
 # --- the result ------------------------------------------------------------------------------
