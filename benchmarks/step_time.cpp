@@ -312,6 +312,7 @@ const char* method_name(sh::SolverOptions::Method m) {
     case M::Rk4: return "rk4";
     case M::ArkodeErk: return "arkode_erk";
     case M::ArkodeDirk: return "arkode_dirk";
+    case M::Ros2: return "ros2";
     case M::CvodeBdf: break;
   }
   return "cvode_bdf";
@@ -385,6 +386,12 @@ sh::SolverOptions rk4(int substeps) {
   return o;
 }
 
+sh::SolverOptions ros2(int substeps) {
+  sh::SolverOptions o = with_method(sh::SolverOptions::Method::Ros2);
+  o.ros2_substeps = substeps;
+  return o;
+}
+
 sh::SolverOptions rk4_no_check() {
   sh::SolverOptions o = with_method(sh::SolverOptions::Method::Rk4);
   o.rk4_flag_rtol = 0.0;
@@ -418,6 +425,8 @@ int main(int argc, char** argv) {
         {"rk4_auto_no_check", "plant", "RK4, automatic substeps, no check (rk4_flag_rtol = 0)", rk4_no_check()},
         {"arkode_erk", "plant", "ARKODE ARKStep ERK Dormand-Prince rtol 1e-8", with_method(M::ArkodeErk)},
         {"arkode_dirk", "plant", "ARKODE ARKStep SDIRK 5(3)4 rtol 1e-8", with_method(M::ArkodeDirk)},
+        {"ros2_4", "plant", "ROS2, 4 substeps (the default; linearly implicit, L-stable)", ros2(4)},
+        {"ros2_16", "plant", "ROS2, 16 substeps", ros2(16)},
         {"cvode_default_rtol", "plant", "CVODE BDF rtol 1e-8 (the default rtol), restart on input change, max order 5",
          cvode(1e-8, R::OnInputChange, 5)},
         {"cvode_on_change_q5", "plant", "CVODE BDF rtol 1e-6, restart on input change, max order 5 (former default)",

@@ -15,6 +15,7 @@
 #include "detail/dopri5_integrator.hpp"
 #include "detail/ode_system.hpp"
 #include "detail/rk4_integrator.hpp"
+#include "detail/ros2_integrator.hpp"
 #include "servohydraulics/error.hpp"
 
 namespace servohydraulics {
@@ -482,14 +483,14 @@ MultiRigLinearModel linearize(const MultiRig& rig, const MultiRig::State& y0, co
 
 namespace {
 using MultiIntegrator = std::variant<detail::BasicDopri5Integrator<MultiRig>, detail::BasicCvodeIntegrator<MultiRig>,
-                                     detail::BasicRk4Integrator<MultiRig>>;
+                                     detail::BasicRk4Integrator<MultiRig>, detail::BasicRos2Integrator<MultiRig>>;
 
 SolverOptions checked_options(const SolverOptions& o, double dt) {
   require(std::isfinite(dt) && dt > 0.0, "dt", dt, "the loop's sample time must be finite and > 0 [s]");
   o.validate();
   const bool arkode = o.method == SolverOptions::Method::ArkodeErk || o.method == SolverOptions::Method::ArkodeDirk;
   require(!arkode, "method", static_cast<double>(o.method),
-          "ARKODE is a reference of the single-actuator plant; the coupled rig takes dopri5, cvode or rk4");
+          "ARKODE is a reference of the single-actuator plant; the coupled rig takes dopri5, cvode, rk4 or ros2");
   return o;
 }
 
@@ -499,6 +500,8 @@ MultiIntegrator make_integrator(const MultiRig& rig, double dt, const SolverOpti
   if (opt.method == M::CvodeBdf)
     return MultiIntegrator(std::in_place_type<detail::BasicCvodeIntegrator<MultiRig>>, rig, dt, opt, y0);
   if (opt.method == M::Rk4) return MultiIntegrator(std::in_place_type<detail::BasicRk4Integrator<MultiRig>>, rig, dt, opt);
+  if (opt.method == M::Ros2)
+    return MultiIntegrator(std::in_place_type<detail::BasicRos2Integrator<MultiRig>>, rig, dt, opt);
   return MultiIntegrator(std::in_place_type<detail::BasicDopri5Integrator<MultiRig>>, rig, dt, opt, y0, opt.stiff_check);
 }
 }  // namespace

@@ -15,6 +15,7 @@
 #include "detail/cvode_integrator.hpp"
 #include "detail/dopri5_integrator.hpp"
 #include "detail/rk4_integrator.hpp"
+#include "detail/ros2_integrator.hpp"
 
 namespace servohydraulics {
 
@@ -23,7 +24,14 @@ using detail::kMaxDisplacement;   // the divergence guard (detail/ode_system.hpp
 using detail::kMaxPressureRatio;
 
 using Integrator = std::variant<detail::Dopri5Integrator, detail::CvodeIntegrator, detail::Rk4Integrator,
-                                detail::ArkodeIntegrator>;
+                                detail::ArkodeIntegrator, detail::Ros2Integrator>;
+
+// The fixed-step integrators' substeps per sample (RK4, ROS2), 0 for the error-controlled ones.
+int fixed_substeps(const Integrator& integ) noexcept {
+  if (const auto* rk4 = std::get_if<detail::Rk4Integrator>(&integ)) return rk4->substeps();
+  if (const auto* ros2 = std::get_if<detail::Ros2Integrator>(&integ)) return ros2->substeps();
+  return 0;
+}
 
 SolverOptions checked(const SolverOptions& o, double dt) {
   require(std::isfinite(dt) && dt > 0.0, "dt", dt, "controller sample time must be finite and > 0 [s]");
@@ -72,6 +80,7 @@ Integrator make_integrator(const Dynamics& dyn, double dt, const SolverOptions& 
   switch (opt.method) {
     case M::CvodeBdf: return Integrator(std::in_place_type<detail::CvodeIntegrator>, dyn, dt, opt, y0);
     case M::Rk4: return Integrator(std::in_place_type<detail::Rk4Integrator>, dyn, dt, opt);
+    case M::Ros2: return Integrator(std::in_place_type<detail::Ros2Integrator>, dyn, dt, opt);
     case M::ArkodeErk:
     case M::ArkodeDirk:
       return Integrator(std::in_place_type<detail::ArkodeIntegrator>, dyn, dt, opt, y0, opt.method == M::ArkodeDirk);
@@ -107,12 +116,12 @@ struct Plant::Impl {
     force_delay = sample_delay("measurement_delay_force", r.measurement_delay_force, dt);
   }
 
-  // Integrate from t to t_end with input `in`; RK4 takes `substeps` (0: its own count).
+  // Integrate from t to t_end with input `in`; RK4 and ROS2 take `substeps` (0: their own count).
   Status advance(const Dynamics::Input& in, double t_end, int substeps) noexcept {
     return std::visit(
         [&](auto& integ) {
           using T = std::decay_t<decltype(integ)>;
-          if constexpr (std::is_same_v<T, detail::Rk4Integrator>)
+          if constexpr (std::is_same_v<T, detail::Rk4Integrator> || std::is_same_v<T, detail::Ros2Integrator>)
             return integ.advance(dyn, in, y, t, t_end, substeps);
           else
             return integ.advance(dyn, in, y, t, t_end);
@@ -174,7 +183,7 @@ void Plant::reset_state(const State& y0, double t0) {
 
 // With a command delay of (D + f) samples, command j holds over [t_j + (D + f) dt, t_(j+1) + (D + f) dt):
 // over sample k the held value is command k-D-1 until t_k + f dt, then command k-D.  Both parts are
-// integrated exactly as any sample (CVODE stops at the switch; RK4 shares its substeps between them).
+// integrated exactly as any sample (CVODE stops at the switch; RK4 and ROS2 share their substeps between them).
 Status Plant::Impl::advance_delayed(double t_next) noexcept {
   const long j = k - cmd_delay.whole;
   if (cmd_delay.frac == 0.0) {
@@ -183,8 +192,7 @@ Status Plant::Impl::advance_delayed(double t_next) noexcept {
   }
   const double t_switch = (static_cast<double>(k) + cmd_delay.frac) * dt;  // local time
   int n1 = 0, n2 = 0;
-  if (const auto* rk4 = std::get_if<detail::Rk4Integrator>(&integ)) {
-    const int n = rk4->substeps();
+  if (const int n = fixed_substeps(integ); n > 0) {
     n1 = std::max(1, static_cast<int>(std::lround(cmd_delay.frac * n)));
     n2 = std::max(1, n - n1);
   }

@@ -11,8 +11,8 @@ namespace servohydraulics {
 
 void SolverOptions::validate() const {
   const int m = static_cast<int>(method), r = static_cast<int>(restart);
-  require(m >= static_cast<int>(Method::Dopri5) && m <= static_cast<int>(Method::ArkodeDirk), "method", m,
-          "is not a SolverOptions::Method (0 dopri5, 1 cvode, 2 rk4, 3 arkode_erk, 4 arkode_dirk)");
+  require(m >= static_cast<int>(Method::Dopri5) && m <= static_cast<int>(Method::Ros2), "method", m,
+          "is not a SolverOptions::Method (0 dopri5, 1 cvode, 2 rk4, 3 arkode_erk, 4 arkode_dirk, 5 ros2)");
   require(r >= static_cast<int>(Restart::OnInputChange) && r <= static_cast<int>(Restart::Never), "restart", r,
           "is not a SolverOptions::Restart (0 on_input_change, 1 never)");
   require(std::isfinite(rtol) && rtol > 0.0 && rtol < 1.0, "rtol", rtol, "must be in (0, 1)");
@@ -34,6 +34,8 @@ void SolverOptions::validate() const {
           rk4_flag_rtol, "must be in [0, 1) (a fraction of the run's peaks; 0 = no check)");
   require(rk4_max_refinements >= 0 && rk4_max_refinements <= 16, "rk4_max_refinements", rk4_max_refinements,
           "must be in 0..16 (each doubles the substeps of the rest of the run)");
+  require(ros2_substeps >= 1 && ros2_substeps <= kMaxSubsteps, "ros2_substeps", ros2_substeps,
+          "must be in 1..100000");
 }
 
 double state_scale(const Dynamics& dyn, int i) noexcept {

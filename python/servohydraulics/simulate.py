@@ -17,7 +17,8 @@ MAX_X0 = 100.0
 
 # Names from the core's tables (enum_name.hpp), in the enum's order.  Integrators: dopri5 (the
 # default: error-controlled, fast, CVODE for stiff samples), cvode (the reference), rk4 (the
-# real-time option: fixed cost, flagged by its error estimate), arkode_erk, arkode_dirk.
+# real-time option: fixed cost, flagged by its error estimate), arkode_erk, arkode_dirk, ros2 (fixed
+# cost on a stiff rig: the diagnosis' fits where RK4 would need too many substeps).
 MODES = dict(_core.CONTROL_MODE_NAMES)
 METHODS = dict(_core.METHOD_NAMES)
 RESTARTS = dict(_core.RESTART_NAMES)
@@ -32,7 +33,7 @@ def solver_options(method: str = DEFAULT_METHOD, rtol: float | None = None, rest
                    stiff_fallback: bool | None = None, stiff_steps: int | None = None,
                    stiff_check: bool | None = None, rk4_flag_rtol: float | None = None,
                    rk4_max_refinements: int | None = None,
-                   max_internal_step: float | None = None) -> _core.SolverOptions:
+                   max_internal_step: float | None = None, ros2_substeps: int | None = None) -> _core.SolverOptions:
     """Builds solver options; see ``SolverOptions`` in solver_options.hpp (one keyword per row of
     its field table, ``_core.SOLVER_OPTION_FIELDS``).
 
@@ -43,7 +44,9 @@ def solver_options(method: str = DEFAULT_METHOD, rtol: float | None = None, rest
     checked by a companion run at twice the substeps that flags where the two differ by more than
     ``rk4_flag_rtol`` of the peaks (0: no check), the rest of the run at doubled substeps from a
     flagged sample up to ``rk4_max_refinements`` times), ``"cvode"`` (BDF, the reference), ``"arkode_erk"``,
-    ``"arkode_dirk"`` (SUNDIALS ARKODE references).  Absolute tolerances scale with the rig:
+    ``"arkode_dirk"`` (SUNDIALS ARKODE references), ``"ros2"`` (Verwer's linearly implicit, L-stable
+    second-order method at ``ros2_substeps`` fixed substeps per sample, the analytic Jacobian each
+    substep: a fixed cost on a rig too stiff for RK4; no error estimate).  Absolute tolerances scale with the rig:
     ``rtol * atol_fraction * state_scale`` (``_core.absolute_tolerances``).  A keyword left at None
     keeps the core's default."""
     if method not in METHODS:
@@ -58,7 +61,7 @@ def solver_options(method: str = DEFAULT_METHOD, rtol: float | None = None, rest
             stiff_fallback=None if stiff_fallback is None else bool(stiff_fallback), stiff_steps=stiff_steps,
             stiff_check=None if stiff_check is None else bool(stiff_check), rk4_flag_rtol=rk4_flag_rtol,
             rk4_max_refinements=rk4_max_refinements,
-            max_internal_step=max_internal_step)
+            max_internal_step=max_internal_step, ros2_substeps=ros2_substeps)
     o.validate()
     return o
 

@@ -38,6 +38,7 @@ const char* method_name(const SolverOptions& o) {
     case SolverOptions::Method::Dopri5: return "dopri5";
     case SolverOptions::Method::ArkodeErk: return "arkode-erk";
     case SolverOptions::Method::ArkodeDirk: return "arkode-dirk";
+    case SolverOptions::Method::Ros2: return "ros2";
     case SolverOptions::Method::CvodeBdf: break;
   }
   return o.restart == SolverOptions::Restart::Never ? "cvode/never" : "cvode/on-input-change";
@@ -161,14 +162,17 @@ int main() {
   SolverOptions erk, dirk;
   erk.method = SolverOptions::Method::ArkodeErk;
   dirk.method = SolverOptions::Method::ArkodeDirk;
+  SolverOptions ros2;
+  ros2.method = SolverOptions::Method::Ros2;
   for (ControlMode mode : {ControlMode::Displacement, ControlMode::Force, ControlMode::Free})
-    for (const SolverOptions* o : {&dopri5, &cvode, &never, &rk4, &erk, &dirk}) check_plant(mode, *o);
+    for (const SolverOptions* o : {&dopri5, &cvode, &never, &rk4, &erk, &dirk, &ros2}) check_plant(mode, *o);
   // A small installed mass with sharp friction: the pair turns stiff and CVODE takes those samples.
   Rig light = zhao2003();
   light.m = 2.0;
   light.m_p = 1.0;
   light.v_stick = 1e-6;
   check_plant(ControlMode::Displacement, dopri5, light);
+  check_plant(ControlMode::Displacement, ros2, light);  // the LU of the stiff matrix: fixed capacity
   for (auto m : {SolverOptions::Method::CvodeBdf, SolverOptions::Method::Dopri5, SolverOptions::Method::ArkodeErk})
     check_overrun(m);
   return sh_test::report("test_allocations");

@@ -101,3 +101,33 @@ def test_rk4_automatic_substeps_follow_the_stiffness():
     one = sh.simulate(stiff, "displacement", u, dt, options=sh.solver_options(method="rk4", rk4_substeps=1))
     assert np.max(np.abs(rk.velocity - ref.velocity)) < 1e-5 * v_scale
     assert np.max(np.abs(one.velocity - ref.velocity)) > 100 * np.max(np.abs(rk.velocity - ref.velocity))
+
+
+def test_ros2_is_l_stable_where_one_rk4_substep_is_not():
+    """ROS2 (method="ros2", Verwer's linearly implicit second-order method) on the stiff rig of the
+    test above.  At rest after the step (from 0.5 s) the friction mode is live, h lambda = -4.4 a
+    sample, outside RK4's stability interval: RK4 at one substep rings there (bounded by tanh's
+    saturation), ROS2 at one substep (L-stable) settles with CVODE at rtol 1e-9, a thousand times
+    closer.  In the step's transient ROS2 is second order: its error falls about fourfold per
+    doubling of the substeps (the C++ test measures 4.01-4.04 on the preset) and needs 16 substeps
+    for 1e-2 of the peak force that RK4 meets at 5."""
+    dt = 5e-4
+    stiff = sh.zhao2003(actuator_attached=False)
+    stiff.m = 54.0
+    u = np.full(2000, 0.002)
+    ref = sh.simulate(stiff, "displacement", u, dt, options=sh.solver_options(method="cvode", rtol=1e-9))
+    v_scale, f_scale = np.max(np.abs(ref.velocity)), np.max(np.abs(ref.force))
+
+    def errors(**kw):
+        r = sh.simulate(stiff, "displacement", u, dt, options=sh.solver_options(**kw))
+        ev, ef = np.abs(r.velocity - ref.velocity) / v_scale, np.abs(r.force - ref.force) / f_scale
+        return float(ev[1000:].max()), float(ef.max())  # at rest; the force over the whole run
+
+    rest_ros2, _ = errors(method="ros2", ros2_substeps=1)
+    rest_rk4, _ = errors(method="rk4", rk4_substeps=1, rk4_flag_rtol=0.0)
+    assert rest_ros2 < 1e-5 and rest_ros2 < rest_rk4 / 1000
+    e8, e16, e32 = (errors(method="ros2", ros2_substeps=n)[1] for n in (8, 16, 32))
+    assert 3 < e8 / e16 < 5 and 3 < e16 / e32 < 5
+    assert e16 < 1e-2
+    with pytest.raises(ValueError, match="ros2_substeps"):
+        sh.solver_options(method="ros2", ros2_substeps=0)

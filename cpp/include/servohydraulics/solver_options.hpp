@@ -20,6 +20,8 @@ struct SolverOptions {
                  //!< run at twice the substeps that flags a sample (real-time option: fixed cost)
     ArkodeErk,   //!< SUNDIALS ARKODE ARKStep, explicit table (Dormand-Prince 5(4)), error-controlled (reference)
     ArkodeDirk,  //!< SUNDIALS ARKODE ARKStep, implicit DIRK table, Newton with the analytic Jacobian (reference)
+    Ros2,        //!< Verwer's ROS2, fixed-step linearly implicit (L-stable, second order), ros2_substeps per
+                 //!< sample, the analytic Jacobian each substep: a fixed cost on rigs too stiff for RK4
   };
   enum class Restart {
     OnInputChange,  //!< CVodeReInit when the held command changes (ZOH jump): safest
@@ -74,6 +76,9 @@ struct SolverOptions {
   //! substeps (the companion too), up to this many times (0 = flag only: fixed cost); the flagged
   //! sample stays flagged.  Bounded by kMaxSubsteps substeps per sample.
   int rk4_max_refinements = 0;
+  //! Ros2: substeps per sample.  No error estimate: its accuracy on a rig is judged against an
+  //! error-controlled run (the diagnosis' search_options picks the fewest that agree).
+  int ros2_substeps = 4;
 
   static constexpr int kMaxSubsteps = 100000;  //!< cap on RK4 substeps per sample (work per call)
 
@@ -88,6 +93,7 @@ inline constexpr EnumName<SolverOptions::Method> kMethodNames[] = {
     {SolverOptions::Method::Rk4, "rk4", "Rk4"},
     {SolverOptions::Method::ArkodeErk, "arkode_erk", "ArkodeErk"},
     {SolverOptions::Method::ArkodeDirk, "arkode_dirk", "ArkodeDirk"},
+    {SolverOptions::Method::Ros2, "ros2", "Ros2"},
 };
 static_assert(in_enum_order(kMethodNames), "kMethodNames: one row per enumerator, in order");
 inline constexpr EnumName<SolverOptions::Restart> kRestartNames[] = {
@@ -130,6 +136,7 @@ inline constexpr SolverOptionField kSolverOptionFields[] = {
      "RK4: flag where a run at twice the substeps departs by more than this of the peaks (0 = no check)"},
     {"rk4_max_refinements", &SolverOptions::rk4_max_refinements, "",
      "RK4: times a flagged sample switches the rest of the run to twice the substeps"},
+    {"ros2_substeps", &SolverOptions::ros2_substeps, "", "ROS2 substeps per sample"},
 };
 
 //! The magnitude of state i of this rig, the unit of its absolute tolerance: x: the half-stroke;

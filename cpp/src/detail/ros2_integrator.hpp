@@ -1,0 +1,67 @@
+// Internal: the plant's fixed-step linearly implicit integrator (Verwer's ROS2), for the runs
+// that need a fixed cost and a residual smooth in the parameters on a rig that is stiff for RK4
+// (an MR damper's or a LuGre bristle's fast states, a re-sized actuator's oil column).
+#pragma once
+
+#include <Eigen/Dense>
+
+#include "detail/ode_system.hpp"
+#include "servohydraulics/dynamics.hpp"
+#include "servohydraulics/solver_options.hpp"
+#include "servohydraulics/status.hpp"
+
+namespace servohydraulics::detail {
+
+//! ROS2 (Verwer, Spee, Blom and Hundsdorfer 1999, SIAM J. Sci. Comput. 20(4)) over a system of the
+//! OdeSystem interface, ros2_substeps equal substeps per sample.  Within a sample the held input
+//! makes the system autonomous; each substep of size h solves two linear systems with
+//! W = I - gamma h J, J the analytic Jacobian at the substep's start, gamma = 1 + 1/sqrt(2):
+//!
+//!     W k1 = f(y),   W k2 = f(y + h k1) - 2 k1,   y+ = y + h (3 k1 + k2) / 2
+//!
+//! Second order (for any J: a W-method) and L-stable (the stability function vanishes at
+//! infinity): a stiff state is damped, never amplified, whatever h.  The Jacobian is refreshed
+//! every substep (a regularised Coulomb law's slope changes by orders of magnitude within a
+//! sample at a velocity reversal).  There is no error estimate: a caller that needs one compares with an
+//! error-controlled run (the diagnosis' search_options).  No heap allocation: the matrices have
+//! the system's fixed capacity.
+template <class System>
+class BasicRos2Integrator {
+ public:
+  using Sys = OdeSystem<System>;
+  using State = typename Sys::State;
+  using Input = typename Sys::Input;
+  static constexpr int kCap = Sys::kCapacity;
+  using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kCap, kCap>;
+  using Vector = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kCap, 1>;
+
+  BasicRos2Integrator(const System& sys, double dt, const SolverOptions& options);
+
+  void reset(const State& y0, double) noexcept;
+  //! substeps() equal substeps from t to t_next (`substeps` > 0 replaces the configured count: the
+  //! plant passes a share of it for each part of a sample split by a command delay).
+  Status advance(const System& sys, const Input& in, State& y, double& t, double t_next,
+                 int substeps = 0) noexcept;
+
+  int substeps() const noexcept { return substeps_; }
+  long total_steps() const noexcept { return steps_done_; }
+  long total_rhs_evals() const noexcept { return rhs_done_; }
+  long total_restarts() const noexcept { return 0; }
+  long total_flagged() const noexcept { return 0; }
+
+  static constexpr double kGamma = 1.7071067811865475;  //!< 1 + 1/sqrt(2)
+
+ private:
+  int n_;
+  int substeps_;
+  Matrix J_, W_;
+  Eigen::PartialPivLU<Matrix> lu_;
+  Vector f_, k1_, k2_;
+  State tmp_{};
+  long steps_done_ = 0, rhs_done_ = 0;
+};
+
+//! The single-actuator plant's linearly implicit fixed-step integrator.
+using Ros2Integrator = BasicRos2Integrator<Dynamics>;
+
+}  // namespace servohydraulics::detail
