@@ -5,10 +5,11 @@
 The first 10 s of the UTFSM chirp at 1 A (benchmarks/lab_speed.py's ``diagnose10`` record) through
 the 0 A rig (evaluation/utfsm_rig_0A.toml) and through it with a candidate the diagnosis fits there
 (LuGre friction at sigma_0 = 3e6 N/m, F_c = 733 N; Coulomb friction at 700 N; the MR damper's c0 at
-1e6 N s/m): the CPU seconds of the search's pair (dopri5 at rtol 1e-6, ``engine.run_options(True)``)
-and of RK4 at 3 to 32 substeps, and each RK4 run's largest difference from the pair's as a fraction
-of the measured channel's standard deviation (``engine.agreement``; ``segments.AGREEMENT`` = 1e-3
-is the fits' test), or "diverged".
+1e6 N s/m; the actuator re-sized 30 times by the load term ``A``, its upper bound): the CPU seconds of
+the search's pair (dopri5 at rtol 1e-6, ``engine.run_options(True)``), of RK4 at 3 to 32 substeps and
+of ROS2 at 8, 16 and 32 (``engine.ros2_options``), and each fixed-step run's largest difference from
+the pair's as a fraction of the measured channel's standard deviation (``engine.agreement``;
+``segments.AGREEMENT`` = 1e-3 is the fits' test), or "diverged".
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ def main() -> None:
 
     import servohydraulics as sh
     from servohydraulics.diagnosis import engine
-    from servohydraulics.diagnosis.effects import LIBRARY
+    from servohydraulics.diagnosis.effects import LIBRARY, apply_area
     from servohydraulics.identification.fit import rk4_options
     from servohydraulics.identification.run import simulate_command
     from servohydraulics.simulate import SimulationError
@@ -36,10 +37,12 @@ def main() -> None:
     rec = lab_speed._record("chirp20Hz_1A", 10.0)
     rig = sh.load_rig(ROOT / "evaluation" / "utfsm_rig_0A.toml")
     case = engine.make_case(rec, "displacement", "chirp20Hz_1A[0, 10 s]")
-    alpha = sh._core.mr_damper_law(rig)["alpha"]
+    law = sh._core.mr_damper_law(rig)
+    alpha = law["alpha"]
     rigs = {"0 A rig": rig, "LuGre sigma_0 3e6, F_c 733": LIBRARY["lugre_friction"].apply(rig, np.array([3e6, 733.0])),
             "Coulomb F_c 700": LIBRARY["coulomb_friction"].apply(rig, np.array([700.0])),
-            "MR damper c0 1e6": LIBRARY["mr_damper"].apply(rig, np.array([alpha, 1e6]))}
+            "MR damper c0 1e6": LIBRARY["mr_damper"].apply(rig, np.array([alpha, 1e6, law["c1"]])),
+            "actuator A x30": apply_area(rig, 30.0 * rig.A)}
 
     def run(r, opts):
         t = time.thread_time()
@@ -49,16 +52,17 @@ def main() -> None:
             return None, time.thread_time() - t
         return {c: s.channels[c] for c in engine.SIM_CHANNELS}, time.thread_time() - t
 
-    print("| rig | pair (rtol 1e-6) [s] | " + " | ".join(f"RK4 {n} [s] / gap" for n in (3, 4, 6, 8, 12, 32)) + " |")
-    print("|---|---|" + "---|" * 6)
+    columns = [(f"RK4 {n}", rk4_options(n)) for n in (3, 4, 6, 8, 12, 32)] + \
+              [(f"ROS2 {n}", engine.ros2_options(n)) for n in (8, 16, 32)]
+    print("| rig | pair (rtol 1e-6) [s] | " + " | ".join(f"{c} [s] / gap" for c, _ in columns) + " |")
+    print("|---|---|" + "---|" * len(columns))
     for name, r in rigs.items():
         ref, tp = run(r, engine.run_options(True))
         cells = []
-        for n in (3, 4, 6, 8, 12, 32):
-            s, t = run(r, rk4_options(n))
+        for _, opts in columns:
+            s, t = run(r, opts)
             cells.append("diverged" if s is None else f"{t:.3f} / {engine.agreement(s, ref, case)[0]:.1e}")
         print(f"| {name} | {tp:.3f} | " + " | ".join(cells) + " |")
-
 
 if __name__ == "__main__":
     main()

@@ -24,7 +24,7 @@ from ..identification.run import simulate_command
 from ..identification.stats import LEVEL, ar1_coefficient, ar1_effective_n, noise_sigma, quantile
 from ..identification.stats import covariance as hac_covariance
 from ..rig import Rig
-from ..simulate import MODES, SimulationError, solver_options
+from ..simulate import METHODS, MODES, SimulationError, solver_options
 from .effects import INTERACT_SPAN, LOAD_TERMS, Candidate, Context, nominal_value, set_nominal, split_delay
 from .types import Case, FitResult, Screening, Sim
 
@@ -143,11 +143,13 @@ def simulate_case(rig: Rig, case: Case, tau: float, x0: float, search: bool = Fa
     where that is RK4 and its run diverges, as it does where a fit made the rig stiffer (a larger
     damping), RK4 at the next counts of ``SEARCH_RK4_LADDER``, then the search's pair: a diverging
     run stops within milliseconds of its start); CVODE alone if that run fails."""
-    if options is not None and options.rk4_substeps > 0:
+    if fixed_step(options) and options.rk4_substeps > 0:
         from ..identification.fit import rk4_options
 
         chain = (options, *(rk4_options(n) for n in SEARCH_RK4_LADDER if n > options.rk4_substeps),
                  run_options(True))
+    elif fixed_step(options):  # ROS2: L-stable, it does not diverge where a fit made the rig stiffer
+        chain = (options, run_options(True))
     else:
         chain = (options if options is not None else run_options(search),)
     for opts in (*chain, solver_options(method="cvode")):
@@ -161,6 +163,21 @@ def simulate_case(rig: Rig, case: Case, tau: float, x0: float, search: bool = Fa
 
 #: the RK4 substep counts a fit's runs may use (``search_options``), fewest first
 SEARCH_RK4_SUBSTEPS = (3, 4, 6, 8)
+#: the ROS2 substep counts a fit's runs may use where no RK4 count agrees (``search_options``): a rig made
+#: stiff by a fast state (a regularised Coulomb law's slope F_c / v_stick, a re-sized oil column), where RK4
+#: diverges or needs hundreds of substeps and the search's pair hands most samples to CVODE
+SEARCH_ROS2_SUBSTEPS = (8, 16)
+
+
+def fixed_step(options) -> bool:
+    """Whether ``options`` is a fixed-step integrator (RK4 or ROS2): a run whose accuracy a fit checks
+    against the search's pair (``agrees``), not the pair itself."""
+    return options is not None and options.method in (METHODS["rk4"], METHODS["ros2"])
+
+
+def ros2_options(substeps: int):
+    """ROS2 at ``substeps`` per sample (``simulate.solver_options``)."""
+    return solver_options(method="ros2", ros2_substeps=int(substeps))
 #: the counts a diverged RK4 run tries next (each stable up to a larger damping); beyond 12 the
 #: search's pair costs less (studies/diagnose_run_costs.py: the UTFSM rig with its MR damper's c0 at
 #: 1e6 N s/m diverges below 8 substeps; pair 0.034 s, RK4 0.023 s at 8, 0.030 s at 12 for 10 s)
@@ -198,10 +215,11 @@ def search_options(rig: Rig, cases: list[Case], tau: float, x0s) -> list:
         ref = simulate_case(rig, case, tau, x0, options=pair)
         chosen = pair
         if ref is not None:
-            for n in SEARCH_RK4_SUBSTEPS:
-                worst, rms = agreement(simulate_case(rig, case, tau, x0, options=rk4_options(n)), ref, case)
+            ladder = [rk4_options(n) for n in SEARCH_RK4_SUBSTEPS] + [ros2_options(n) for n in SEARCH_ROS2_SUBSTEPS]
+            for opts in ladder:
+                worst, rms = agreement(simulate_case(rig, case, tau, x0, options=opts), ref, case)
                 if worst <= AGREEMENT and rms <= AGREEMENT_RMS:
-                    chosen = rk4_options(n)
+                    chosen = opts
                     break
         out.append(chosen)
     return out
@@ -213,7 +231,7 @@ def agrees(rig: Rig, cases: list[Case], tau: float, x0s, options: list) -> bool:
     from ..identification.segments import AGREEMENT, AGREEMENT_RMS
 
     for case, x0, opts in zip(cases, x0s, options):
-        if opts.rk4_substeps == 0:  # the pair itself
+        if not fixed_step(opts):  # the pair itself
             continue
         worst, rms = agreement(simulate_case(rig, case, tau, x0, options=opts),
                                simulate_case(rig, case, tau, x0, search=True), case)
@@ -579,7 +597,7 @@ def fit(space: Space, cases: list[Case], z0: np.ndarray, base_tau: float, which:
     options = search_options(rig0, cases, tau0, zs[p:])
     res = run(zs, options)
     nfev = int(res.nfev)
-    if any(o.rk4_substeps > 0 for o in options):
+    if any(fixed_step(o) for o in options):
         rig1, tau1 = space.rig_and_tau(res.x[:p], base_tau)
         if not agrees(rig1, cases, tau1, res.x[p:], options):
             res = run(np.clip(res.x, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo)), [run_options(True)] * len(cases))
