@@ -105,8 +105,7 @@ def test_an_actuator_the_model_believes_too_small_is_re_sized_with_the_force_can
     C_l and F_cap divided by 8: the same no-load loop, eight times the cost of a force to the displacement,
     the way the generic start sizes an actuator from a record at low force).  The friction is named within
     10 % of 800 N, the actuator re-fitted with it (the load term A) to within 15 % of the truth, and the
-    displacement gap does not grow.  (Without the load term A the friction is named at 71 N and the force gap
-    stays at 86 %; with it, F_c 801 N, A 8.02 times the model's, gaps 5.8 % -> 1.0 % and 94 % -> 1.3 %.)"""
+    displacement gap does not grow."""
     from servohydraulics.diagnosis.effects import apply_area
 
     rec = _record("rigC", 2.0, 5, 40.0, friction="coulomb", F_c=800.0)
