@@ -3,7 +3,7 @@
 // (an MR damper's or a LuGre bristle's fast states, a re-sized actuator's oil column).
 #pragma once
 
-#include <Eigen/Dense>
+#include <array>
 
 #include "detail/ode_system.hpp"
 #include "servohydraulics/dynamics.hpp"
@@ -24,7 +24,8 @@ namespace servohydraulics::detail {
 //! every substep (a regularised Coulomb law's slope changes by orders of magnitude within a
 //! sample at a velocity reversal).  There is no error estimate: a caller that needs one compares with an
 //! error-controlled run (the diagnosis' search_options).  No heap allocation: the matrices have
-//! the system's fixed capacity.
+//! the system's fixed capacity.  A singular W (a pivot of 0) makes the state non-finite, which
+//! the plant's guard reports (Status::NonFinite).
 template <class System>
 class BasicRos2Integrator {
  public:
@@ -32,8 +33,6 @@ class BasicRos2Integrator {
   using State = typename Sys::State;
   using Input = typename Sys::Input;
   static constexpr int kCap = Sys::kCapacity;
-  using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kCap, kCap>;
-  using Vector = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kCap, 1>;
 
   BasicRos2Integrator(const System& sys, double dt, const SolverOptions& options);
 
@@ -54,10 +53,12 @@ class BasicRos2Integrator {
  private:
   int n_;
   int substeps_;
-  Matrix J_, W_;
-  Eigen::PartialPivLU<Matrix> lu_;
-  Vector f_, k1_, k2_;
-  State tmp_{};
+  // W = I - gamma h J in place of J (column-major n x n, leading dimension n), then its LU factors;
+  // fixed capacity: no allocation.  A small hand-written LU: Eigen's dynamic-size one spent more
+  // than the right-hand sides on these 6-16-state systems (perf on the UTFSM rig).
+  std::array<double, static_cast<std::size_t>(kCap) * kCap> W_{};
+  std::array<int, kCap> piv_{};
+  State f_{}, k1_{}, tmp_{};
   long steps_done_ = 0, rhs_done_ = 0;
 };
 
