@@ -1,6 +1,7 @@
 """The diagnosis' fits on RK4 (``engine.search_options``, ``engine.fit``): RK4 at the fewest
 substeps whose run agrees with the search's error-controlled pair, chosen per fit start; a diverged
-RK4 run retried at larger counts, then on the pair; the pair where no count agrees.  The oracles:
+RK4 run retried at larger counts, then on the pair; where no RK4 count agrees, ROS2 (linearly
+implicit, L-stable) at the fewest of its counts that agrees; the pair where none does.  The oracles:
 whole runs of the error-controlled pair (at the search's rtol and at the core's default), the
 fixed-step run at the count the ladder lands on, and the same fit run on the pair alone."""
 
@@ -19,7 +20,7 @@ from servohydraulics.identification.fit import rk4_options
 from servohydraulics.identification.run import simulate_command
 from servohydraulics.identification.segments import AGREEMENT, AGREEMENT_RMS
 from servohydraulics.records import Record
-from servohydraulics.simulate import SimulationError
+from servohydraulics.simulate import METHODS, SimulationError
 
 RIG = Path(__file__).resolve().parents[2] / "evaluation" / "utfsm_rig_0A.toml"
 DT = 1e-3
@@ -101,16 +102,50 @@ def test_a_diverged_rk4_run_climbs_the_ladder():
 
 
 def test_the_pair_where_no_count_agrees():
-    """Coulomb friction's switch: a fixed step straddles the reversals (the force differs by a
-    fraction of its std), so the fit keeps the pair."""
+    """Coulomb friction's switch on an 8 mm chirp to 8 Hz: a fixed step straddles the reversals (the
+    force differs by a fraction of its std at RK4's and ROS2's largest counts alike), so the fit keeps
+    the pair."""
     rig = _rig()
     case = _case(_record(rig))
     coulomb = LIBRARY["coulomb_friction"].apply(rig, np.array([700.0]))
     ref = engine.simulate_case(coulomb, case, 0.0, case.x0_data, search=True)
     assert not _within(engine.simulate_case(coulomb, case, 0.0, case.x0_data,
                                             options=rk4_options(engine.SEARCH_RK4_SUBSTEPS[-1])), ref, case)
+    assert not _within(engine.simulate_case(coulomb, case, 0.0, case.x0_data,
+                                            options=engine.ros2_options(engine.SEARCH_ROS2_SUBSTEPS[-1])), ref, case)
     opts = engine.search_options(coulomb, [case], 0.0, [case.x0_data])[0]
-    assert opts.rk4_substeps == 0 and opts.rtol == engine.run_options(True).rtol
+    assert not engine.fixed_step(opts) and opts.rtol == engine.run_options(True).rtol
+
+
+def test_ros2_where_no_rk4_count_agrees():
+    """The first 10 s of the UTFSM chirp at 1 A (±2 mm) through the 0 A rig with 700 N of Coulomb
+    friction (benchmarks/lab_speed.py's diagnose10 record; studies/diagnose_run_costs.py): no RK4 count
+    agrees with the pair (the tanh law's slope F_c / (m v_stick) is outside RK4's stability region),
+    ROS2 at the fewest of its counts that does is chosen, the count below it does not agree, and the
+    chosen run stays within the fits' test of the pair's at the core's default tolerance too."""
+    from servohydraulics.records import Record, read_record
+
+    from shared_data import shared_path
+
+    full = read_record(shared_path("real-data/utfsm-mts-mrdamper/chirp20Hz_1A.csv"))
+    n = int(round(10.0 / full.dt)) + 1
+    case = _case(Record({k: np.asarray(v)[:n] for k, v in full.channels.items()}))
+    coulomb = LIBRARY["coulomb_friction"].apply(_rig(), np.array([700.0]))
+    ref = engine.simulate_case(coulomb, case, 0.0, case.x0_data, search=True)
+    for k in engine.SEARCH_RK4_SUBSTEPS:
+        assert not _within(engine.simulate_case(coulomb, case, 0.0, case.x0_data, options=rk4_options(k)), ref, case)
+    opts = engine.search_options(coulomb, [case], 0.0, [case.x0_data])[0]
+    assert opts.method == METHODS["ros2"] and opts.ros2_substeps in engine.SEARCH_ROS2_SUBSTEPS
+    run = engine.simulate_case(coulomb, case, 0.0, case.x0_data, options=opts)
+    assert _within(run, ref, case)
+    assert engine.agrees(coulomb, [case], 0.0, [case.x0_data], [opts])
+    i = engine.SEARCH_ROS2_SUBSTEPS.index(opts.ros2_substeps)
+    if i > 0:
+        fewer = engine.ros2_options(engine.SEARCH_ROS2_SUBSTEPS[i - 1])
+        assert not _within(engine.simulate_case(coulomb, case, 0.0, case.x0_data, options=fewer), ref, case)
+    tight = engine.simulate_case(coulomb, case, 0.0, case.x0_data)  # the core's default, rtol 1e-8
+    worst, rms = engine.agreement(run, tight, case)
+    assert worst <= 2 * AGREEMENT and rms <= 2 * AGREEMENT_RMS
 
 
 def test_the_fit_on_rk4_lands_where_the_fit_on_the_pair_does(monkeypatch):
