@@ -123,9 +123,9 @@ def test_ros2_where_no_rk4_count_agrees():
     agrees with the pair (the tanh law's slope F_c / (m v_stick) is outside RK4's stability region),
     ROS2 at the fewest of its counts that does is chosen, the count below it does not agree, and the
     chosen run stays within the fits' test of the pair's at the core's default tolerance too."""
-    from servohydraulics.records import Record, read_record
-
     from shared_data import shared_path
+
+    from servohydraulics.records import Record, read_record
 
     full = read_record(shared_path("real-data/utfsm-mts-mrdamper/chirp20Hz_1A.csv"))
     n = int(round(10.0 / full.dt)) + 1
