@@ -64,5 +64,6 @@ def main() -> None:
             cells.append("diverged" if s is None else f"{t:.3f} / {engine.agreement(s, ref, case)[0]:.1e}")
         print(f"| {name} | {tp:.3f} | " + " | ".join(cells) + " |")
 
+
 if __name__ == "__main__":
     main()

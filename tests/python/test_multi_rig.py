@@ -349,3 +349,35 @@ def test_replace_marked_keeps_the_rest(tmp_path):
     assert page.read_text() == "head\n<!-- t -->\nnew\n<!-- /t -->\ntail\n"
     with pytest.raises(ValueError, match="marker <!-- u -->"):
         replace_marked(page, "u", "x")
+
+
+def test_ros2_on_the_coupled_rig_is_second_order_and_stable_where_rk4_is_not():
+    """ROS2 (the linearly implicit fixed-step method) on the coupled rig.  Two actuators of different
+    gains, sines, a 2,048 Hz loop: against CVODE at rtol 1e-12 its error over every actuator's
+    stroke and force falls about fourfold per doubling of the substeps (second order; at a coarse
+    loop sample the stiff modes make it fall more slowly first, the order reduction of any
+    Rosenbrock method).  Light pistons with sharp friction (the pair turns stiff there): at four
+    substeps ROS2 is more than three times closer to CVODE than RK4 at four."""
+    a = sh.zhao2003()
+    b = sh.copy_rig(a)
+    b.G_p = 1.5 * a.G_p
+    rig, dt = _two(a, b), 1 / 2048
+    t = np.arange(2048) * dt
+    u = np.c_[0.01 * np.sin(2 * np.pi * 3 * t), 0.008 * np.sin(2 * np.pi * 2 * t)]
+    ref = sh.simulate_multi(rig, u, dt, options=sh.solver_options("cvode", rtol=1e-12, max_steps_per_sample=1000000))
+    errs = [_multi_error(sh.simulate_multi(rig, u, dt, options=sh.solver_options("ros2", ros2_substeps=n)), ref)
+            for n in (16, 32, 64)]
+    assert 3.3 < errs[0] / errs[1] < 4.7 and 3.3 < errs[1] / errs[2] < 4.7, errs
+
+    a = sh.zhao2003()
+    a.F_c, a.m_p = 400.0, 5.0
+    sp = node_specimen(M=[[8.0, 0.0], [0.0, 0.8]], K=[[2.3e6, 8.6e5], [8.6e5, 1.1e6]], C=[[500.0, 0.0], [0.0, 20.0]])
+    rig = MultiActuatorRig([a, a], [MARTHS_ARM] * 2, MARTHS_ANGLES, sp)
+    k = np.arange(600)
+    u = np.c_[0.005 * np.sin(2 * np.pi * 2 * k / 1024), 0.004 * np.sin(2 * np.pi * 3 * k / 1024)]
+    ref = sh.simulate_multi(rig, u, 1 / 1024, options=sh.solver_options("cvode", rtol=1e-10,
+                                                                        max_steps_per_sample=1000000))
+    ros2 = _multi_error(sh.simulate_multi(rig, u, 1 / 1024, options=sh.solver_options("ros2", ros2_substeps=4)), ref)
+    rk4 = _multi_error(sh.simulate_multi(rig, u, 1 / 1024, options=sh.solver_options("rk4", rk4_substeps=4,
+                                                                                       rk4_flag_rtol=0.0)), ref)
+    assert 3 * ros2 < rk4, (ros2, rk4)

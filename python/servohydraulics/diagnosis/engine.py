@@ -142,7 +142,8 @@ def simulate_case(rig: Rig, case: Case, tau: float, x0: float, search: bool = Fa
     search's tolerance, ``run_options``), or ``options`` where given (a fit's ``search_options``;
     where that is RK4 and its run diverges, as it does where a fit made the rig stiffer (a larger
     damping), RK4 at the next counts of ``SEARCH_RK4_LADDER``, then the search's pair: a diverging
-    run stops within milliseconds of its start); CVODE alone if that run fails."""
+    run stops within milliseconds of its start; where it is ROS2, which is L-stable, the pair next);
+    CVODE alone if that run fails."""
     if fixed_step(options) and options.rk4_substeps > 0:
         from ..identification.fit import rk4_options
 
@@ -163,6 +164,10 @@ def simulate_case(rig: Rig, case: Case, tau: float, x0: float, search: bool = Fa
 
 #: the RK4 substep counts a fit's runs may use (``search_options``), fewest first
 SEARCH_RK4_SUBSTEPS = (3, 4, 6, 8)
+#: the counts a diverged RK4 run tries next (each stable up to a larger damping); beyond 12 the
+#: search's pair costs less (studies/diagnose_run_costs.py: the UTFSM rig with its MR damper's c0 at
+#: 1e6 N s/m diverges below 8 substeps; pair 0.034 s, RK4 0.023 s at 8, 0.030 s at 12 for 10 s)
+SEARCH_RK4_LADDER = (6, 8, 12)
 #: the ROS2 substep counts a fit's runs may use where no RK4 count agrees (``search_options``): a rig made
 #: stiff by a fast state (a regularised Coulomb law's slope F_c / v_stick, a re-sized oil column), where RK4
 #: diverges or needs hundreds of substeps and the search's pair hands most samples to CVODE
@@ -178,10 +183,6 @@ def fixed_step(options) -> bool:
 def ros2_options(substeps: int):
     """ROS2 at ``substeps`` per sample (``simulate.solver_options``)."""
     return solver_options(method="ros2", ros2_substeps=int(substeps))
-#: the counts a diverged RK4 run tries next (each stable up to a larger damping); beyond 12 the
-#: search's pair costs less (studies/diagnose_run_costs.py: the UTFSM rig with its MR damper's c0 at
-#: 1e6 N s/m diverges below 8 substeps; pair 0.034 s, RK4 0.023 s at 8, 0.030 s at 12 for 10 s)
-SEARCH_RK4_LADDER = (6, 8, 12)
 
 
 def agreement(sim: Sim, ref: Sim, case: Case) -> tuple[float, float]:
@@ -203,7 +204,9 @@ def search_options(rig: Rig, cases: list[Case], tau: float, x0s) -> list:
     run of ``rig`` (the fit's start: a candidate's parameters change the rig's stiffness, so each fit
     checks its own) agrees with the search's error-controlled pair (``run_options(True)``) to
     ``segments.AGREEMENT`` (largest) and ``AGREEMENT_RMS`` (rms) of each channel's standard
-    deviation; the pair where none does (a Coulomb friction's switch, which a fixed step straddles).
+    deviation; else ROS2 at the fewest of ``SEARCH_ROS2_SUBSTEPS`` that agrees (a rig too stiff for
+    RK4: a regularised Coulomb law, a re-sized oil column); the pair where none does (a Coulomb
+    friction's switch that a fixed step straddles on a large, fast record).
     A fixed step also keeps the residual a smooth function of the parameters (clean difference
     columns).  ``fit`` checks the result again (``agrees``)."""
     from ..identification.fit import rk4_options
