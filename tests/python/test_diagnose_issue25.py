@@ -139,3 +139,37 @@ def test_the_loop_is_re_fitted_once_the_actuator_is_re_sized() -> None:
     assert all(loop[0].gap_joint[c] < loop[0].gap_greedy[c] for c in ("displacement", "force")), loop[0]
     assert abs(_param(d, "coulomb_friction", "F_c")["value"] - 800.0) < 0.01 * 800.0
     assert d.gap_after["displacement"] < d.gap_before["displacement"]
+
+
+def test_the_loop_alone_re_fitted_on_the_displacement_restores_the_tracking() -> None:
+    """``joint.loop_refit_displacement`` (tried where the joint loop re-fit was refused): rigC with 800 N of
+    Coulomb friction, the model right about the friction but its valve off (f_v 0.6 times, zeta_v 1.5 times
+    rigC's).  The loop alone, fitted on the displacement channel with the friction held, is kept; the
+    displacement gap falls below the model's and to no more than the model with rigC's own valve values
+    gives (the oracle: the fit can reach them), and the force gap is not worse."""
+    import copy
+
+    import numpy as np
+
+    from servohydraulics.diagnosis import engine
+    from servohydraulics.diagnosis.effects import Context
+    from servohydraulics.diagnosis.joint import loop_refit_displacement
+
+    rec = _record("rigC", 2.0, 5, 40.0, friction="coulomb", F_c=800.0)
+    truth = LIBRARY["coulomb_friction"].apply(gen.nominal_rig("displacement", "rigC"), np.array([800.0]))
+    model = copy.copy(truth)
+    model.f_v, model.zeta_v = 0.6 * truth.f_v, 1.5 * truth.zeta_v
+    cases = [engine.make_case(rec, "displacement", "rec")]
+    x0s = engine.refine_x0(model, cases, 0.0)
+    sims = engine.simulate_all(model, cases, 0.0, x0s)
+    ctx = Context(rig=model, nominal=model, mode="displacement", peak_spool=1.0, peak_pressure=1.0,
+                  peak_x=float(np.max(np.abs(cases[0].meas["displacement"]))), rms_v=0.1, dt=rec.dt)
+    info, new = loop_refit_displacement(model, model, 0.0, cases, x0s, sims, 1, 1, ctx)
+    assert info.kept and new is not None, info.reason
+    oracle = engine.gap(engine.simulate_all(truth, cases, 0.0, engine.refine_x0(truth, cases, 0.0)), cases)
+    g0, g1 = info.gap_greedy, info.gap_joint
+    assert g1["displacement"] < g0["displacement"] and g1["force"] <= g0["force"], info
+    print(f"displacement {100 * g0['displacement']:.3g} -> {100 * g1['displacement']:.3g} % (rigC's valve: "
+          f"{100 * oracle['displacement']:.3g} %); force {100 * g0['force']:.2g} -> {100 * g1['force']:.2g} %")
+    assert g1["displacement"] <= 1.02 * oracle["displacement"], (g1, oracle)
+    assert engine.gap(new.sims, cases) == g1

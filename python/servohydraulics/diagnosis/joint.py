@@ -78,7 +78,8 @@ class JointModel:
     sims: list
     accepted: dict  #: name -> the re-fitted ``Accepted``
     parameters: dict  #: name -> its parameters as diagnosis.json writes them
-    groups: list = field(default_factory=list)  #: parameters ("effect: key") the records cannot tell apart
+    #: parameters ("effect: key") the records cannot tell apart (None: as they were)
+    groups: list | None = field(default_factory=list)
 
 
 def _partition(accepted: list[Accepted]) -> tuple[list[Accepted], list[str], list[str]]:
@@ -274,3 +275,46 @@ def loop_refit(accepted: list[Accepted], parameters: dict, current: Rig, nominal
         return info, None
     return info, JointModel(rig1, tau1, res.x0, sims1, refit, reports, joint_groups(acc + [
         Accepted("loop", loop_space, res.z[lblk], lo[lblk], hi[lblk], None)], js, corr))
+
+
+def loop_refit_displacement(current: Rig, nominal: Rig, tau: float, cases: list[Case], x0s, sims: list, k: int,
+                            rnd: int, ctx: Context) -> tuple[JointRefit, JointModel | None]:
+    """The loop alone (``LOOP``: K_v, f_v, zeta_v) re-fitted on the displacement channel, the effects held, after
+    round ``rnd``'s joint loop re-fit (``loop_refit``) was refused: as ``sh.identify`` fits the loop's keys on the
+    displacement and the specimen's on the force (displacement control: the loop makes the displacement, the
+    specimen answers with the force), so that the loop restores the no-load tracking the re-sizing took from it
+    without trading it for the force.  ``k``: the model's fitted parameters.  Kept on the joint re-fit's rule: the
+    BIC with the loop's parameters counted better than the model's and no channel's gap worse."""
+    t0 = time.time()
+    loop_space = engine.Space(LOOP, ctx, ())
+    info = JointRefit(round=rnd, effects=("loop (displacement)",),
+                      parameters_fitted=tuple(prm.key for prm in loop_space.params))
+    stats0 = engine.channel_stats(sims, cases)
+    neff = engine.n_eff(stats0)
+    weights = {(c.name, ch): 0.0 for c in cases for ch in c.meas if ch != "displacement"}
+    res = engine.fit(loop_space, cases, loop_space.absent, tau, "all", x0s, max_nfev=JOINT_MAX_NFEV, weights=weights)
+    rig1, tau1 = loop_space.rig_and_tau(res.z, tau)
+    sims1 = engine.simulate_all(rig1, cases, tau1, res.x0)
+    info = dataclasses.replace(info, nfev=res.nfev)
+    if any(s is None for s in sims1):
+        return dataclasses.replace(info, reason="the loop's simulation fails: kept the model",
+                                   seconds=time.time() - t0), None
+    b0 = engine.bic(stats0, k, neff)
+    b1 = engine.bic(engine.channel_stats(sims1, cases), k + loop_space.n_main, neff)
+    lo, hi, _ = engine.uncertainty(loop_space, res, engine.series_lengths(cases))
+    g0, g1 = engine.gap(sims, cases), engine.gap(sims1, cases)
+    worse = [c for c in g0 if g1[c] > g0[c]]
+    keep = b1 < b0 and not worse
+    start = {key: {"value": float(v), "interval_95": None}
+             for key, v in zip([p.key for p in loop_space.params], loop_space.to_external(loop_space.absent))}
+    info = dataclasses.replace(
+        info, kept=bool(keep), bic_greedy=b0, bic_joint=b1, delta_bic=b0 - b1, gap_greedy=g0, gap_joint=g1,
+        parameters_greedy={"loop": start},
+        parameters_joint={"loop": _values(param_report(loop_space, res.z, lo, hi))},
+        reason=(f"the loop alone on the displacement channel (A x{current.A / nominal.A:.3g}): "
+                + ("BIC with the loop's parameters counted better and no channel worse: kept" if keep else
+                   f"the {' and '.join(worse)} gap worse: kept the model" if worse else
+                   "BIC with the loop's parameters counted not better: kept the model")),
+        seconds=time.time() - t0)
+    return info, (JointModel(rig1, tau1, res.x0, sims1, {}, {}, None) if keep else None)
+

@@ -27,7 +27,7 @@ from ..workers import single_blas_thread
 from . import engine
 from .confirm import confirm, param_groups, param_report
 from .effects import LIBRARY, Context, check_names, interacting, nested, separating_experiment
-from .joint import joint_refit, loop_refit
+from .joint import joint_refit, loop_refit, loop_refit_displacement
 from .types import Accepted, CandidateLog, Case, Fit, JointRefit, Round, Screening, Sim
 
 #: acceptance thresholds (documented in docs/diagnose.md)
@@ -541,12 +541,19 @@ def _polish(setup: _Setup, state: _State, rnd: int) -> None:
 
 def _polish_loop(setup: _Setup, state: _State, rnd: int) -> None:
     """The loop re-fit (``joint.loop_refit``) once the effects have re-sized the actuator; its model replaces
-    the current one if kept."""
+    the current one if kept.  Where it was refused, the loop alone on the displacement channel
+    (``joint.loop_refit_displacement``), kept on the same rule."""
     setup.bar.set_description_str(f"round {rnd}: loop re-fit")
     parameters = {e["name"]: e["parameters"] for e in state.effects}
     info, new = loop_refit(state.accepted, parameters, state.rig, setup.nominal, state.tau, setup.cases, state.x0,
                            state.sims, rnd, _context(setup, state))
     _adopt(setup, state, info, new, "loop re-fit")
+    if info is not None and info.gap_joint is not None and not info.kept:  # tried, refused: the loop alone
+        setup.bar.set_description_str(f"round {rnd}: loop re-fit on the displacement")
+        k = int(sum(a.z.size for a in state.accepted))
+        info, new = loop_refit_displacement(state.rig, setup.nominal, state.tau, setup.cases, state.x0, state.sims,
+                                            k, rnd, _context(setup, state))
+        _adopt(setup, state, info, new, "loop re-fit (displacement)")
 
 
 def _adopt(setup: _Setup, state: _State, info, new, label: str) -> None:
@@ -561,7 +568,8 @@ def _adopt(setup: _Setup, state: _State, info, new, label: str) -> None:
     state.accepted = [new.accepted.get(a.name, a) for a in state.accepted]
     for e in state.effects:
         e["parameters"] = new.parameters.get(e["name"], e["parameters"])
-    state.joint_groups = new.groups
+    if new.groups is not None:  # the loop alone re-fitted on the displacement leaves the effects' groups
+        state.joint_groups = new.groups
     state.effects[-1]["gap_after"] = engine.gap(state.sims, setup.cases)
     state.history.append((label, state.effects[-1]["gap_after"]))
 
