@@ -509,7 +509,8 @@ def main() -> None:
                else f"python evaluation/diagnose_eval/generate.py --out {a.data}")
     cmd = (f"{gen_cmd} --jobs {a.jobs}\n"
            f"python evaluation/diagnose_eval/evaluate.py --data {a.data} --jobs {a.jobs}"
-           + (f" --only '{a.only}' --doc {a.doc}" if a.only else "")
+           + (f" --only '{a.only}'" if a.only else "")
+           + (f" --doc {a.doc}" if a.only or a.doc != "docs/diagnose_eval.md" else "")
            + (f" --cache {a.cache} --cached-only: {len(manifest)} records of the set" if a.cached_only else ""))
     write_doc(m, results, key, doc, cmd, wall, a.jobs, before)
     doc.with_suffix(".json").write_text(json.dumps({"metrics": m, "records": results, "command": cmd,
