@@ -144,7 +144,8 @@ def test_the_loop_is_re_fitted_once_the_actuator_is_re_sized() -> None:
 def test_the_loop_alone_re_fitted_on_the_displacement_restores_the_tracking() -> None:
     """``joint.loop_refit_displacement`` (tried where the joint loop re-fit was refused): rigC with 800 N of
     Coulomb friction, the model right about the friction but its valve off (f_v 0.6 times, zeta_v 1.5 times
-    rigC's).  The loop alone, fitted on the displacement channel with the friction held, is kept; the
+    rigC's).  The loop alone, fitted on the displacement channel with the friction held, is kept (BIC better
+    by at least the workflow's DELTA_BIC_MIN); the
     displacement gap falls below the model's and to no more than the model with rigC's own valve values
     gives (the oracle: the fit can reach them), and the force gap is not worse."""
     import copy
@@ -154,6 +155,7 @@ def test_the_loop_alone_re_fitted_on_the_displacement_restores_the_tracking() ->
     from servohydraulics.diagnosis import engine
     from servohydraulics.diagnosis.effects import Context
     from servohydraulics.diagnosis.joint import loop_refit_displacement
+    from servohydraulics.diagnosis.workflow import DELTA_BIC_MIN
 
     rec = _record("rigC", 2.0, 5, 40.0, friction="coulomb", F_c=800.0)
     truth = LIBRARY["coulomb_friction"].apply(gen.nominal_rig("displacement", "rigC"), np.array([800.0]))
@@ -164,7 +166,7 @@ def test_the_loop_alone_re_fitted_on_the_displacement_restores_the_tracking() ->
     sims = engine.simulate_all(model, cases, 0.0, x0s)
     ctx = Context(rig=model, nominal=model, mode="displacement", peak_spool=1.0, peak_pressure=1.0,
                   peak_x=float(np.max(np.abs(cases[0].meas["displacement"]))), rms_v=0.1, dt=rec.dt)
-    info, new = loop_refit_displacement(model, model, 0.0, cases, x0s, sims, 1, 1, ctx)
+    info, new = loop_refit_displacement(model, model, 0.0, cases, x0s, sims, 1, 1, ctx, DELTA_BIC_MIN)
     assert info.kept and new is not None, info.reason
     oracle = engine.gap(engine.simulate_all(truth, cases, 0.0, engine.refine_x0(truth, cases, 0.0)), cases)
     g0, g1 = info.gap_greedy, info.gap_joint

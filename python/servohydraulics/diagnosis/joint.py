@@ -278,13 +278,15 @@ def loop_refit(accepted: list[Accepted], parameters: dict, current: Rig, nominal
 
 
 def loop_refit_displacement(current: Rig, nominal: Rig, tau: float, cases: list[Case], x0s, sims: list, k: int,
-                            rnd: int, ctx: Context) -> tuple[JointRefit, JointModel | None]:
+                            rnd: int, ctx: Context, dbic_min: float) -> tuple[JointRefit, JointModel | None]:
     """The loop alone (``LOOP``: K_v, f_v, zeta_v) re-fitted on the displacement channel, the effects held, after
     round ``rnd``'s joint loop re-fit (``loop_refit``) was refused: as ``sh.identify`` fits the loop's keys on the
     displacement and the specimen's on the force (displacement control: the loop makes the displacement, the
     specimen answers with the force), so that the loop restores the no-load tracking the re-sizing took from it
-    without trading it for the force.  ``k``: the model's fitted parameters.  Kept on the joint re-fit's rule: the
-    BIC with the loop's parameters counted better than the model's and no channel's gap worse."""
+    without trading it for the force.  ``k``: the model's fitted parameters.  Kept when the BIC with the loop's
+    three parameters counted is better than the model's by at least ``dbic_min`` (the evidence the workflow asks
+    of an effect's parameters, ``workflow.DELTA_BIC_MIN``: the re-fit adds as many) and no channel's gap is
+    worse."""
     t0 = time.time()
     loop_space = engine.Space(LOOP, ctx, ())
     info = JointRefit(round=rnd, effects=("loop (displacement)",),
@@ -304,7 +306,7 @@ def loop_refit_displacement(current: Rig, nominal: Rig, tau: float, cases: list[
     lo, hi, _ = engine.uncertainty(loop_space, res, engine.series_lengths(cases))
     g0, g1 = engine.gap(sims, cases), engine.gap(sims1, cases)
     worse = [c for c in g0 if g1[c] > g0[c]]
-    keep = b1 < b0 and not worse
+    keep = b0 - b1 >= dbic_min and not worse
     start = {key: {"value": float(v), "interval_95": None}
              for key, v in zip([p.key for p in loop_space.params], loop_space.to_external(loop_space.absent))}
     info = dataclasses.replace(
@@ -312,9 +314,11 @@ def loop_refit_displacement(current: Rig, nominal: Rig, tau: float, cases: list[
         parameters_greedy={"loop": start},
         parameters_joint={"loop": _values(param_report(loop_space, res.z, lo, hi))},
         reason=(f"the loop alone on the displacement channel (A x{current.A / nominal.A:.3g}): "
-                + ("BIC with the loop's parameters counted better and no channel worse: kept" if keep else
+                + (f"BIC with the loop's parameters counted better by {b0 - b1:.1f} >= {dbic_min:g} and no channel "
+                   "worse: kept" if keep else
                    f"the {' and '.join(worse)} gap worse: kept the model" if worse else
-                   "BIC with the loop's parameters counted not better: kept the model")),
+                   f"BIC with the loop's parameters counted better by {b0 - b1:.1f} < {dbic_min:g}: kept the "
+                   "model")),
         seconds=time.time() - t0)
     return info, (JointModel(rig1, tau1, res.x0, sims1, {}, {}, None) if keep else None)
 

@@ -552,7 +552,7 @@ def _polish_loop(setup: _Setup, state: _State, rnd: int) -> None:
         setup.bar.set_description_str(f"round {rnd}: loop re-fit on the displacement")
         k = int(sum(a.z.size for a in state.accepted))
         info, new = loop_refit_displacement(state.rig, setup.nominal, state.tau, setup.cases, state.x0, state.sims,
-                                            k, rnd, _context(setup, state))
+                                            k, rnd, _context(setup, state), DELTA_BIC_MIN)
         _adopt(setup, state, info, new, "loop re-fit (displacement)")
 
 
