@@ -321,4 +321,3 @@ def loop_refit_displacement(current: Rig, nominal: Rig, tau: float, cases: list[
                    "model")),
         seconds=time.time() - t0)
     return info, (JointModel(rig1, tau1, res.x0, sims1, {}, {}, None) if keep else None)
-

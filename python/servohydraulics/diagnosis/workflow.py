@@ -542,7 +542,8 @@ def _polish(setup: _Setup, state: _State, rnd: int) -> None:
 def _polish_loop(setup: _Setup, state: _State, rnd: int) -> None:
     """The loop re-fit (``joint.loop_refit``) once the effects have re-sized the actuator; its model replaces
     the current one if kept.  Where it was refused, the loop alone on the displacement channel
-    (``joint.loop_refit_displacement``), kept on the same rule."""
+    (``joint.loop_refit_displacement``), kept on the evidence an effect needs (``DELTA_BIC_MIN``) with no
+    channel worse."""
     setup.bar.set_description_str(f"round {rnd}: loop re-fit")
     parameters = {e["name"]: e["parameters"] for e in state.effects}
     info, new = loop_refit(state.accepted, parameters, state.rig, setup.nominal, state.tau, setup.cases, state.x0,
@@ -602,8 +603,11 @@ def _summary(verdict: str, effects: list, last: Round | None, joint_log: list[Jo
         summary = f"stopped after {len(effects)} effect(s)"
     if joint_log:
         j = joint_log[-1]
-        summary += (f"; joint re-fit of {' + '.join(j.effects)}: "
-                    + (f"kept (BIC better by {j.delta_bic:.1f})" if j.kept else j.reason))
+        if j.effects == ("loop (displacement)",):  # its reason names it and says why kept or not
+            summary += f"; re-fit of {j.reason}"
+        else:
+            summary += (f"; joint re-fit of {' + '.join(j.effects)}: "
+                        + (f"kept (BIC better by {j.delta_bic:.1f})" if j.kept else j.reason))
     amb = list(last.ambiguous_between) if last is not None else []
     head = {"effect_found": "missing effect(s): " + ", ".join(e["name"] for e in effects),
             "no_effect": "no missing effect", "ambiguous": f"ambiguous: {' or '.join(amb)}"}[verdict]
