@@ -238,14 +238,10 @@ def _multi_error(res, ref) -> float:
     return err
 
 
-def test_accuracy_checks_measure_the_coupled_runs_error():
-    """The integrators' accuracy checks on the coupled rig (output_gap.hpp over every actuator's
-    stroke and force; work.error_estimate is the run's gap over the check's bound): against CVODE
-    at rtol 1e-10, the gap is the run's own error.  The default's check of a run that turned stiff
-    (a second dopri5 at rtol / 10, bound 0.5 x 1e-3) and RK4's companion at twice the substeps
-    (bound rk4_flag_rtol) each measure it within a factor 3; RK4 past its bound flags and warns,
-    at its automatic substeps it is silent."""
-    # Sharp friction on light pistons: the pair turns stiff and CVODE takes samples.
+def _stiff_friction_rig():
+    """Sharp friction on light pistons (400 N, 5 kg) on a two-node specimen: the error-controlled pair turns
+    stiff and CVODE takes samples.  Returns the rig, 600 samples of a two-sine command at 1024 Hz and CVODE's
+    run of it at rtol 1e-10 (the reference)."""
     a = sh.zhao2003()
     a.F_c, a.m_p = 400.0, 5.0
     sp = node_specimen(M=[[8.0, 0.0], [0.0, 0.8]], K=[[2.3e6, 8.6e5], [8.6e5, 1.1e6]], C=[[500.0, 0.0], [0.0, 20.0]])
@@ -254,6 +250,17 @@ def test_accuracy_checks_measure_the_coupled_runs_error():
     u = np.c_[0.005 * np.sin(2 * np.pi * 2 * k / 1024), 0.004 * np.sin(2 * np.pi * 3 * k / 1024)]
     ref = sh.simulate_multi(rig, u, 1 / 1024, options=sh.solver_options("cvode", rtol=1e-10,
                                                                         max_steps_per_sample=1000000))
+    return rig, u, ref
+
+
+def test_accuracy_checks_measure_the_coupled_runs_error():
+    """The integrators' accuracy checks on the coupled rig (output_gap.hpp over every actuator's
+    stroke and force; work.error_estimate is the run's gap over the check's bound): against CVODE
+    at rtol 1e-10, the gap is the run's own error.  The default's check of a run that turned stiff
+    (a second dopri5 at rtol / 10, bound 0.5 x 1e-3) and RK4's companion at twice the substeps
+    (bound rk4_flag_rtol) each measure it within a factor 3; RK4 past its bound flags and warns,
+    at its automatic substeps it is silent."""
+    rig, u, ref = _stiff_friction_rig()
     for rtol in (1e-5, 1e-4):
         res = sh.simulate_multi(rig, u, 1 / 1024, options=sh.solver_options(rtol=rtol))
         assert res.work.stiff_samples > 0
@@ -369,14 +376,7 @@ def test_ros2_on_the_coupled_rig_is_second_order_and_stable_where_rk4_is_not():
             for n in (16, 32, 64)]
     assert 3.3 < errs[0] / errs[1] < 4.7 and 3.3 < errs[1] / errs[2] < 4.7, errs
 
-    a = sh.zhao2003()
-    a.F_c, a.m_p = 400.0, 5.0
-    sp = node_specimen(M=[[8.0, 0.0], [0.0, 0.8]], K=[[2.3e6, 8.6e5], [8.6e5, 1.1e6]], C=[[500.0, 0.0], [0.0, 20.0]])
-    rig = MultiActuatorRig([a, a], [MARTHS_ARM] * 2, MARTHS_ANGLES, sp)
-    k = np.arange(600)
-    u = np.c_[0.005 * np.sin(2 * np.pi * 2 * k / 1024), 0.004 * np.sin(2 * np.pi * 3 * k / 1024)]
-    ref = sh.simulate_multi(rig, u, 1 / 1024, options=sh.solver_options("cvode", rtol=1e-10,
-                                                                        max_steps_per_sample=1000000))
+    rig, u, ref = _stiff_friction_rig()
     ros2 = _multi_error(sh.simulate_multi(rig, u, 1 / 1024, options=sh.solver_options("ros2", ros2_substeps=4)), ref)
     rk4 = _multi_error(sh.simulate_multi(rig, u, 1 / 1024, options=sh.solver_options("rk4", rk4_substeps=4,
                                                                                        rk4_flag_rtol=0.0)), ref)

@@ -149,6 +149,12 @@ def joint_groups(accepted: list[Accepted], js: engine.JointSpace, corr: np.ndarr
     return [[names[i] for i in g] for g in inseparable_groups(corr)]
 
 
+def _loop_start(loop_space: engine.Space) -> dict:
+    """The loop's values before a re-fit, as ``joint_refit`` rows report parameters (no interval)."""
+    return {key: {"value": float(v), "interval_95": None}
+            for key, v in zip([p.key for p in loop_space.params], loop_space.to_external(loop_space.absent))}
+
+
 def _values(parameters: dict) -> dict:
     return {kk: {"value": v["value"], "interval_95": v["interval_95"]} for kk, v in parameters.items()}
 
@@ -260,8 +266,7 @@ def loop_refit(accepted: list[Accepted], parameters: dict, current: Rig, nominal
     worse = [c for c in g0 if g1[c] > g0[c]]
     keep = b1 < b0 and not worse
     greedy = {a.name: _values(parameters[a.name]) for a in acc}
-    greedy["loop"] = {key: {"value": float(v), "interval_95": None}
-                      for key, v in zip([p.key for p in loop_space.params], loop_space.to_external(loop_space.absent))}
+    greedy["loop"] = _loop_start(loop_space)
     info = dataclasses.replace(
         info, kept=bool(keep), bic_greedy=b0, bic_joint=b1, delta_bic=b0 - b1, gap_greedy=g0, gap_joint=g1,
         parameters_greedy=greedy,
@@ -307,11 +312,9 @@ def loop_refit_displacement(current: Rig, nominal: Rig, tau: float, cases: list[
     g0, g1 = engine.gap(sims, cases), engine.gap(sims1, cases)
     worse = [c for c in g0 if g1[c] > g0[c]]
     keep = b0 - b1 >= dbic_min and not worse
-    start = {key: {"value": float(v), "interval_95": None}
-             for key, v in zip([p.key for p in loop_space.params], loop_space.to_external(loop_space.absent))}
     info = dataclasses.replace(
         info, kept=bool(keep), bic_greedy=b0, bic_joint=b1, delta_bic=b0 - b1, gap_greedy=g0, gap_joint=g1,
-        parameters_greedy={"loop": start},
+        parameters_greedy={"loop": _loop_start(loop_space)},
         parameters_joint={"loop": _values(param_report(loop_space, res.z, lo, hi))},
         reason=(f"the loop alone on the displacement channel (A x{current.A / nominal.A:.3g}): "
                 + (f"BIC with the loop's parameters counted better by {b0 - b1:.1f} >= {dbic_min:g} and no channel "
