@@ -283,7 +283,8 @@ def loop_refit(accepted: list[Accepted], parameters: dict, current: Rig, nominal
 
 
 def loop_refit_displacement(current: Rig, nominal: Rig, tau: float, cases: list[Case], x0s, sims: list, k: int,
-                            rnd: int, ctx: Context, dbic_min: float) -> tuple[JointRefit, JointModel | None]:
+                            rnd: int, ctx: Context, dbic_min: float, nominal_gap: dict | None = None
+                            ) -> tuple[JointRefit, JointModel | None]:
     """The loop alone (``LOOP``: K_v, f_v, zeta_v) re-fitted on the displacement channel, the effects held, after
     round ``rnd``'s joint loop re-fit (``loop_refit``) was refused: as ``sh.identify`` fits the loop's keys on the
     displacement and the specimen's on the force (displacement control: the loop makes the displacement, the
@@ -291,7 +292,11 @@ def loop_refit_displacement(current: Rig, nominal: Rig, tau: float, cases: list[
     without trading it for the force.  ``k``: the model's fitted parameters.  Kept when the BIC with the loop's
     three parameters counted is better than the model's by at least ``dbic_min`` (the evidence the workflow asks
     of an effect's parameters, ``workflow.DELTA_BIC_MIN``: the re-fit adds as many) and no channel's gap is
-    worse."""
+    worse; or, whatever the BIC, when the model is worse than the nominal one on some channel
+    (``nominal_gap``: the nominal model's gaps) and the re-fit brings every channel back to no worse than the
+    nominal's: the diagnosis does not hand the lab a model that tracks worse than the one it had, where the
+    loop alone can give the tracking back (the BIC weighs the channels by their samples and residuals, so a
+    force channel far from its floor outvotes a displacement restored to the nominal's)."""
     t0 = time.time()
     loop_space = engine.Space(LOOP, ctx, ())
     info = JointRefit(round=rnd, effects=("loop (displacement)",),
@@ -311,14 +316,19 @@ def loop_refit_displacement(current: Rig, nominal: Rig, tau: float, cases: list[
     lo, hi, _ = engine.uncertainty(loop_space, res, engine.series_lengths(cases))
     g0, g1 = engine.gap(sims, cases), engine.gap(sims1, cases)
     worse = [c for c in g0 if g1[c] > g0[c]]
-    keep = b0 - b1 >= dbic_min and not worse
+    restores = (nominal_gap is not None and any(g0[c] > nominal_gap[c] for c in g0)
+                and all(g1[c] <= nominal_gap[c] for c in g1))
+    keep = (b0 - b1 >= dbic_min and not worse) or restores
     info = dataclasses.replace(
         info, kept=bool(keep), bic_greedy=b0, bic_joint=b1, delta_bic=b0 - b1, gap_greedy=g0, gap_joint=g1,
         parameters_greedy={"loop": _loop_start(loop_space)},
         parameters_joint={"loop": _values(param_report(loop_space, res.z, lo, hi))},
         reason=(f"the loop alone on the displacement channel (A x{current.A / nominal.A:.3g}): "
                 + (f"BIC with the loop's parameters counted better by {b0 - b1:.1f} >= {dbic_min:g} and no channel "
-                   "worse: kept" if keep else
+                   "worse: kept" if keep and not restores else
+                   "every channel back to no worse than the nominal model's ("
+                   + ", ".join(f"{c} {100 * g1[c]:.3g} % <= {100 * nominal_gap[c]:.3g} %" for c in g1)
+                   + f"; BIC better by {b0 - b1:.1f}): kept" if restores else
                    f"the {' and '.join(worse)} gap worse: kept the model" if worse else
                    f"BIC with the loop's parameters counted better by {b0 - b1:.1f} < {dbic_min:g}: kept the "
                    "model")),

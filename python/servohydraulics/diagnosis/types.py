@@ -149,6 +149,9 @@ class CandidateLog:
     fit_seconds: float | None = None
     heldout_lr: float | None = None
     fit_gap_to_runner_up: float | None = None
+    #: the largest share of the nominal model's gap above the noise floor the candidate's fit closes on one
+    #: channel (``workflow.share_closed``; the materiality test)
+    share_closed: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {}
@@ -161,7 +164,7 @@ class CandidateLog:
 
 
 #: CandidateLog keys present only once set (a fitted candidate; the best of several passing ones)
-_OPTIONAL_KEYS = ("joint_p_absent", "refit", "fit_seconds", "heldout_lr", "fit_gap_to_runner_up")
+_OPTIONAL_KEYS = ("joint_p_absent", "refit", "fit_seconds", "heldout_lr", "fit_gap_to_runner_up", "share_closed")
 
 
 @dataclass(frozen=True)
