@@ -100,7 +100,9 @@ def test_free_vibration_friction_is_named_and_fitted(free_friction: Path, tmp_pa
     rig = sh.load_rig(tmp_path / "rig_updated.toml")
     assert rig.effects.coulomb_friction and rig.F_c == pytest.approx(p["value"])
     report = (tmp_path / "report.md").read_text()
-    assert "coulomb_friction" in report
+    assert "coulomb_friction" in report and "| share closed |" in report
+    accepted = next(c for c in js["candidates"] if c["accepted"])
+    assert accepted["share_closed"] > 0.5  # the friction closes most of the free vibration's gap
     for png in ("residual_before_after.png", "signature.png", "gap_closing.png"):
         assert (tmp_path / png).stat().st_size > 1000
 

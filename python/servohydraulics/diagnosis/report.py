@@ -210,11 +210,15 @@ def _markdown(d, figs: dict) -> str:
     if d.ambiguous_between:
         L += ["## Ambiguous", "", f"{d.ambiguous_between[0]} or {d.ambiguous_between[1]}: "
               f"{d.separating_experiment}.", ""]
-    L += ["## Candidates", "", "| round | name | screening | balance eq. | ΔBIC | held-out | result |",
-          "|---|---|---|---|---|---|---|"]
+    from .workflow import MATERIAL_MIN
+
+    L += ["## Candidates", "", "Share closed: the largest share of the nominal model's gap above the noise floor the "
+          f"candidate's fit closes on one channel (an effect must close {100 * MATERIAL_MIN:g} %).", "",
+          "| round | name | screening | balance eq. | ΔBIC | held-out | share closed | result |",
+          "|---|---|---|---|---|---|---|---|"]
     for c in d.candidates:
         L.append(f"| {c.round} | {c.name} | {_fmt(c.screening_score)} | {_fmt(c.balance_score)} | "
-                 f"{_fmt(c.delta_bic)} | {_fmt(c.heldout_improvement)} | "
+                 f"{_fmt(c.delta_bic)} | {_fmt(c.heldout_improvement)} | {_fmt(c.share_closed)} | "
                  f"{'accepted' if c.accepted else c.rejection} |")
     L.append("")
     L += ["## Plots", ""]
