@@ -328,7 +328,8 @@ def loop_refit_displacement(current: Rig, nominal: Rig, tau: float, cases: list[
                    "worse: kept" if keep and not restores else
                    "every channel back to no worse than the nominal model's ("
                    + ", ".join(f"{c} {100 * g1[c]:.3g} % <= {100 * nominal_gap[c]:.3g} %" for c in g1)
-                   + f"; BIC better by {b0 - b1:.1f}): kept" if restores else
+                   + (f"; BIC better by {b0 - b1:.1f}" if b0 >= b1 else f"; BIC worse by {b1 - b0:.1f}") + "): kept"
+                   if restores else
                    f"the {' and '.join(worse)} gap worse: kept the model" if worse else
                    f"BIC with the loop's parameters counted better by {b0 - b1:.1f} < {dbic_min:g}: kept the "
                    "model")),
