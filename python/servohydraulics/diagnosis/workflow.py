@@ -390,14 +390,15 @@ def _each(fn, items: list) -> list:
 
 
 def _shortlist(screened: list[_Screened], keep: int) -> list[_Screened]:
-    """The best ``keep`` by screening score, the look-alikes of the best (screening
+    """The best ``keep`` by screening score, the look-alikes of each of them (screening
     by a linearised signature cannot rank effects that differ only far from
-    "absent": a 30 Hz valve vs a delay) and the best structural candidate of the
-    balance-equation screen (if it explains more than 10 %)."""
+    "absent": a 30 Hz valve vs a delay; a heavier piston vs a softer oil column, the
+    third-best on rigC of the evaluation with its 40 kg piston unscreened below it) and the
+    best structural candidate of the balance-equation screen (if it explains more than 10 %)."""
     survivors = screened[:keep]
-    if screened:
-        have = {s.name for s in survivors}
-        for la in LIBRARY[screened[0].name].look_alikes:
+    have = {s.name for s in survivors}
+    for top in list(survivors):
+        for la in LIBRARY[top.name].look_alikes:
             extra = [s for s in screened if s.name == la and s.name not in have]
             survivors += extra
             have |= {s.name for s in extra}
