@@ -184,7 +184,8 @@ def test_a_significant_but_immaterial_third_correction_is_not_named() -> None:
     statistical tests at this noise level (moving_mass, a mass 0.07 % off: BIC better by 1,408) but closes
     under ``MATERIAL_MIN`` of the nominal model's gap above the noise floor (0.28 %), and is reported, not
     named.  Without the materiality test it was named third (the evaluation of stop 35)."""
-    from servohydraulics.diagnosis.workflow import DELTA_BIC_MIN, MATERIAL_MIN
+    from servohydraulics.diagnosis.engine import MATERIAL_MIN
+    from servohydraulics.diagnosis.workflow import DELTA_BIC_MIN
 
     plan = gen.plan_issue25()
     assert plan[21]["effects"] == [("load_pressure", 12e6), ("coulomb", 250.0)], plan[21]

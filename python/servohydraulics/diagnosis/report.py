@@ -12,6 +12,7 @@ from ..atomic import FileSet, WriteError
 from ..identification.report import checks_markdown
 from ..identification.stats import STATUS_WORDS
 from ..rig import save_rig
+from . import engine
 
 
 def _clean(o):
@@ -210,10 +211,8 @@ def _markdown(d, figs: dict) -> str:
     if d.ambiguous_between:
         L += ["## Ambiguous", "", f"{d.ambiguous_between[0]} or {d.ambiguous_between[1]}: "
               f"{d.separating_experiment}.", ""]
-    from .workflow import MATERIAL_MIN
-
     L += ["## Candidates", "", "Share closed: the largest share of the nominal model's gap above the noise floor the "
-          f"candidate's fit closes on one channel (an effect must close {100 * MATERIAL_MIN:g} %).", "",
+          f"candidate's fit closes on one channel (an effect must close {100 * engine.MATERIAL_MIN:g} %).", "",
           "| round | name | screening | balance eq. | ΔBIC | held-out | share closed | result |",
           "|---|---|---|---|---|---|---|---|"]
     for c in d.candidates:

@@ -150,7 +150,7 @@ class CandidateLog:
     heldout_lr: float | None = None
     fit_gap_to_runner_up: float | None = None
     #: the largest share of the nominal model's gap above the noise floor the candidate's fit closes on one
-    #: channel (``workflow.share_closed``; the materiality test)
+    #: channel (``engine.share_closed``; the materiality test)
     share_closed: float | None = None
 
     def to_dict(self) -> dict[str, Any]:

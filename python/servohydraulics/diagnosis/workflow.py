@@ -37,12 +37,6 @@ HELDOUT_MIN = 0.02  #: held-out SSR must fall by at least 2 % ...
 #: ... or, for effects small against the noise, significantly: the held-out -2 log likelihood (effective
 #: sample sizes of the held-out residual before the effect) must fall by at least this much
 HELDOUT_LR_MIN = 10.0
-#: an effect must close at least this share of the nominal model's gap above the noise floor on some channel
-#: (``share_closed``): significant but smaller corrections (a mass 0.07 % off at 55 dB) are not named
-MATERIAL_MIN = 0.01
-#: a channel whose nominal gap is within this factor of its noise floor has no gap to close (left out of
-#: ``share_closed``)
-MATERIAL_FLOOR = 1.1
 KEEP = 3  #: candidates kept by screening for the full fit
 MAX_EFFECTS = 3
 
@@ -427,7 +421,7 @@ def _confirm_all(setup: _Setup, state: _State, ctx: Context, survivors: list[_Sc
     passing = []
     for s, (fit, seconds) in zip(survivors, _each(fit_one, survivors)):
         setup.bar.update(1)
-        share = share_closed(g_now, engine.gap(fit.sims, setup.cases), g_nominal, floor)
+        share = engine.share_closed(g_now, engine.gap(fit.sims, setup.cases), g_nominal, floor)
         reasons = _rejection(fit, share)
         log[s.name] = dataclasses.replace(
             log[s.name], score=fit.dbic, delta_bic=fit.dbic, heldout_improvement=fit.held,
@@ -438,23 +432,12 @@ def _confirm_all(setup: _Setup, state: _State, ctx: Context, survivors: list[_Sc
     return passing
 
 
-def share_closed(now: dict, fitted: dict, nominal: dict, floor: dict) -> float | None:
-    """The largest share of the nominal model's gap above the noise floor that a fit closes on one channel:
-    the largest over the channels of (gap now - gap fitted) / (nominal gap - floor).  A measure of size only
-    (what one channel costs another is the BIC's to weigh); channels whose nominal gap is within
-    ``MATERIAL_FLOOR`` of their floor (nothing to close) are left out; None when none is left."""
-    den = {c: nominal[c] - floor[c] for c in nominal if nominal[c] > MATERIAL_FLOOR * floor[c]}
-    if not den:
-        return None
-    return float(max((now[c] - fitted[c]) / d for c, d in den.items()))
-
-
 def _rejection(fit: Fit, share: float | None = None) -> list[str]:
     """The acceptance tests a confirmed candidate fails: BIC improvement,
     held-out improvement (SSR or -2 log L), "absent" excluded by one tested
     parameter's 95 % interval or (parameters that trade against each other)
-    their joint 95 % region, and materiality: the fit closes at least ``MATERIAL_MIN`` of the nominal
-    model's gap above the noise floor (``share``, ``share_closed``; None: not tested)."""
+    their joint 95 % region, and materiality: the fit closes at least ``engine.MATERIAL_MIN`` of the nominal
+    model's gap above the noise floor (``share``, ``engine.share_closed``; None: not tested)."""
     space, nm = fit.space, fit.space.n_main
     tested = space.tests_absent[:nm]
     outside = (space.absent[:nm] < fit.lo[:nm]) | (space.absent[:nm] > fit.hi[:nm])
@@ -467,9 +450,9 @@ def _rejection(fit: Fit, share: float | None = None) -> list[str]:
                        f"-2 log L by {fit.held_lr:.1f} < {HELDOUT_LR_MIN:g}")
     if not excludes:
         reasons.append("95 % interval (and joint region) includes 'absent'")
-    if not reasons and share is not None and share < MATERIAL_MIN:  # significant, but too small to name
+    if not reasons and share is not None and share < engine.MATERIAL_MIN:  # significant, but too small to name
         reasons.append(f"closes {100 * max(share, 0.0):.2f} % of the nominal model's gap above the noise floor on "
-                       f"any channel < {100 * MATERIAL_MIN:g} %: a correction too small to name")
+                       f"any channel < {100 * engine.MATERIAL_MIN:g} %: a correction too small to name")
     return reasons
 
 
