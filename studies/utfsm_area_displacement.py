@@ -2,6 +2,7 @@
 issue 25 item 2, the May runs).
 
     python studies/utfsm_area_displacement.py [--run may_0A_to_1A] [--out build/utfsm25] [--ratios 1,3.33,33.3]
+                                              [--fit-loop-area 30,5]
 
 Reads the diagnosed rig of an ``evaluation/utfsm_diagnose.py --run LABEL --out OUT`` run (OUT/LABEL/
 rig_updated.toml), re-sizes its actuator by each ratio with the diagnosis' own load term
@@ -10,6 +11,11 @@ the displacement scaled by 1 / A) and prints the displacement and force gaps (rm
 rms(measured), the record's command alone driving the model, the initial displacement refined as the
 diagnosis does) on the run's diagnosed record, beside the nominal rig's.  A ratio of 1 is the diagnosed model
 itself; large ratios take the load coupling away (an ideal displacement source with the same no-load loop).
+
+``--fit-loop-area STARTS``: then the loop (K_v, f_v, zeta_v) and A fitted together on the displacement channel
+alone, the diagnosed damper held, from each start of A (multiples of the nominal rig's A, the loop at the
+diagnosed rig's values), by the diagnosis' own fit (``engine.fit``, the force channel weighted 0): whether any
+setting of the loop and the load term gives the nominal model's displacement back.
 """
 
 from __future__ import annotations
@@ -17,6 +23,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -36,13 +43,22 @@ def main() -> None:
     p.add_argument("--run", default="may_0A_to_1A", choices=[r[0] for r in RUNS])
     p.add_argument("--out", default="build/utfsm25", help="the runs' folder (OUT of utfsm_diagnose.py --run)")
     p.add_argument("--ratios", default="1,3.33,33.3", help="comma-separated multiples of the diagnosed area")
+    p.add_argument("--fit-loop-area", metavar="STARTS", default="",
+                   help="comma-separated starts of A (multiples of the nominal's) for a fit of the loop with A")
     a = p.parse_args()
-    try:
-        ratios = [float(v) for v in a.ratios.split(",")]
-    except ValueError:
-        p.error(f"--ratios {a.ratios!r}: not comma-separated numbers")
-    if not ratios or any(not r > 0 for r in ratios):
-        p.error(f"--ratios {a.ratios!r}: each must be > 0")
+
+    def numbers(flag: str, text: str) -> list[float]:
+        try:
+            out = [float(v) for v in text.split(",")] if text else []
+        except ValueError:
+            p.error(f"{flag} {text!r}: not comma-separated numbers")
+        if any(not v > 0 for v in out):
+            p.error(f"{flag} {text!r}: each must be > 0")
+        return out
+
+    ratios, starts = numbers("--ratios", a.ratios), numbers("--fit-loop-area", a.fit_loop_area)
+    if not ratios:
+        p.error("--ratios '': give at least one ratio")
     label, rig_from, record = next(r for r in RUNS if r[0] == a.run)
     diagnosed = Path(a.out) / label / "rig_updated.toml"
     if not diagnosed.exists():
@@ -67,6 +83,33 @@ def main() -> None:
         g = gaps(r)
         print(f"| diagnosed, A x{q:g} | {r.A / nominal.A:.3g} | {100 * g['displacement']:.2f} | "
               f"{100 * g['force']:.1f} |", flush=True)
+    if starts:
+        fit_loop_area(rig, nominal, cases, starts)
+
+
+def fit_loop_area(rig, nominal, cases: list, starts: list[float]) -> None:
+    """The loop and A fitted on the displacement alone from each start of A (see the module docstring)."""
+    from servohydraulics.diagnosis import engine, workflow
+    from servohydraulics.diagnosis.joint import LOOP
+
+    x0 = engine.refine_x0(rig, cases, 0.0)
+    sims = engine.simulate_all(rig, cases, 0.0, x0)
+    setup = workflow._Setup(nominal, "displacement", cases, [], workflow.KEEP, True, True)
+    ctx = workflow._context(setup, workflow._State(rig=rig, tau=0.0, x0=tuple(x0), sims=sims))
+    space = engine.Space(LOOP, ctx, (("A", "m^2"),))
+    weights = {(c.name, ch): 0.0 for c in cases for ch in c.meas if ch != "displacement"}
+    print("\n| start A / nominal A | fitted A / nominal A (bound) | K_v | f_v [Hz] | zeta_v | displacement | force "
+          "| fit |\n|---|---|---|---|---|---|---|---|")
+    for start in starts:
+        t0 = time.time()
+        z0 = space.absent.copy()
+        z0[-1] = 1.0 / (start * nominal.A)  # A is fitted as 1 / A (its range reaches "no load coupling")
+        res = engine.fit(space, cases, z0, 0.0, "all", x0, max_nfev=30, weights=weights)
+        rig1, tau1 = space.rig_and_tau(res.z, 0.0)
+        g = engine.gap(engine.simulate_all(rig1, cases, tau1, res.x0), cases)
+        print(f"| {start:g} | {rig1.A / nominal.A:.3g} ({1.0 / (space.lo[-1] * nominal.A):.3g}) | {rig1.K_v:.4g} | "
+              f"{rig1.f_v:.4g} | {rig1.zeta_v:.3g} | {100 * g['displacement']:.3f} | {100 * g['force']:.2f} | "
+              f"{time.time() - t0:.0f} s, {res.nfev} evaluations |", flush=True)
 
 
 if __name__ == "__main__":

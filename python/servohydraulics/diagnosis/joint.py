@@ -319,19 +319,21 @@ def loop_refit_displacement(current: Rig, nominal: Rig, tau: float, cases: list[
     restores = (nominal_gap is not None and any(g0[c] > nominal_gap[c] for c in g0)
                 and all(g1[c] <= nominal_gap[c] for c in g1))
     keep = (b0 - b1 >= dbic_min and not worse) or restores
+    if restores:
+        why = ("every channel back to no worse than the nominal model's ("
+               + ", ".join(f"{c} {100 * g1[c]:.3g} % <= {100 * nominal_gap[c]:.3g} %" for c in g1)
+               + (f"; BIC better by {b0 - b1:.1f}" if b0 >= b1 else f"; BIC worse by {b1 - b0:.1f}") + "): kept")
+    elif keep:
+        why = (f"BIC with the loop's parameters counted better by {b0 - b1:.1f} >= {dbic_min:g} and no channel "
+               "worse: kept")
+    elif worse:
+        why = f"the {' and '.join(worse)} gap worse: kept the model"
+    else:
+        why = f"BIC with the loop's parameters counted better by {b0 - b1:.1f} < {dbic_min:g}: kept the model"
     info = dataclasses.replace(
         info, kept=bool(keep), bic_greedy=b0, bic_joint=b1, delta_bic=b0 - b1, gap_greedy=g0, gap_joint=g1,
         parameters_greedy={"loop": _loop_start(loop_space)},
         parameters_joint={"loop": _values(param_report(loop_space, res.z, lo, hi))},
-        reason=(f"the loop alone on the displacement channel (A x{current.A / nominal.A:.3g}): "
-                + (f"BIC with the loop's parameters counted better by {b0 - b1:.1f} >= {dbic_min:g} and no channel "
-                   "worse: kept" if keep and not restores else
-                   "every channel back to no worse than the nominal model's ("
-                   + ", ".join(f"{c} {100 * g1[c]:.3g} % <= {100 * nominal_gap[c]:.3g} %" for c in g1)
-                   + (f"; BIC better by {b0 - b1:.1f}" if b0 >= b1 else f"; BIC worse by {b1 - b0:.1f}") + "): kept"
-                   if restores else
-                   f"the {' and '.join(worse)} gap worse: kept the model" if worse else
-                   f"BIC with the loop's parameters counted better by {b0 - b1:.1f} < {dbic_min:g}: kept the "
-                   "model")),
+        reason=f"the loop alone on the displacement channel (A x{current.A / nominal.A:.3g}): {why}",
         seconds=time.time() - t0)
     return info, (JointModel(rig1, tau1, res.x0, sims1, {}, {}, None) if keep else None)
