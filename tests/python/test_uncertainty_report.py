@@ -59,6 +59,21 @@ def test_hac_intervals_cover_the_truth_of_a_regression_with_known_covariance(phi
     assert np.all(white / reps < 0.85), white / reps
 
 
+@pytest.mark.parametrize("m, p, L", [(2, 1, 1), (9, 3, 4), (400, 5, 60), (1200, 10, 599)])
+def test_the_bartlett_sum_is_the_weighted_sum_of_the_lagged_cross_products(m, p, L):
+    """Oracle: the definition, sum over |l| <= L of (1 - |l| / (L + 1)) Gamma_l with
+    Gamma_l = sum_t S_t+l S_t' summed lag by lag, on persistent (random-walk) scores: the
+    filtered-columns form ``stats._bartlett`` computes agrees to rounding, and it is symmetric (to rounding)."""
+    S = np.random.default_rng(m + p + L).standard_normal((m, p)).cumsum(axis=0)
+    want = S.T @ S
+    for lag in range(1, L + 1):
+        g = S[lag:].T @ S[:-lag]
+        want += (1.0 - lag / (L + 1)) * (g + g.T)
+    got = stats._bartlett(S, L)
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * np.max(np.abs(want)))
+    np.testing.assert_allclose(got, got.T, rtol=0, atol=1e-13 * np.max(np.abs(want)))
+
+
 def test_inseparable_groups_are_the_connected_pairs():
     """a-b and b-c correlated beyond 0.95 make one group {a, b, c} even though a-c is 0.9; d-e is
     a second group; f is alone; NaN entries (a parameter without a finite variance) link nothing."""

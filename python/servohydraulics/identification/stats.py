@@ -100,19 +100,23 @@ PREWHITEN_CAP = 0.97
 
 
 def _bartlett(S: np.ndarray, L: int) -> np.ndarray:
-    """sum_{|l| <= L} (1 - |l| / (L + 1)) Gamma_l of the rows of S (Gamma_l = sum_t S_{t+l} S_t')."""
+    """sum_{|l| <= L} (1 - |l| / (L + 1)) Gamma_l of the rows of S (Gamma_l = sum_t S_{t+l} S_t').
+
+    As Gamma_0 + G + G' with G = sum_{l=1..L} w_l Gamma_l = Y' S, where Y_t = sum_{l=1..L} w_l S_{t+l}
+    is each column of S filtered by the triangular weights (one overlap-add convolution per column):
+    p convolutions and one product instead of a cross-correlation of each of the p (p + 1) / 2 pairs."""
+    from scipy.signal import oaconvolve
+
     m, p = S.shape
-    iu, ju = np.triu_indices(p)
-    nfft = 1 << int(math.ceil(math.log2(max(2 * m, 2))))
-    F = np.fft.rfft(S, n=nfft, axis=0)
-    # the circular cross-correlation of each pair i <= j, every lag at once: index l holds
-    # C[l, i, j] = sum_t S[t + l, i] S[t, j], index nfft - l holds C[l, j, i] (no wrap: nfft >= 2m)
-    c = np.fft.irfft(F[:, iu] * np.conj(F[:, ju]), n=nfft, axis=0)
+    C0 = S.T @ S
+    L = int(min(max(L, 0), m - 1))
+    if L == 0:
+        return C0
     w = 1.0 - np.arange(1, L + 1) / (L + 1)
-    C0, G = np.zeros((p, p)), np.zeros((p, p))
-    C0[iu, ju] = C0[ju, iu] = c[0]
-    G[iu, ju] = w @ c[1:L + 1]
-    G[ju, iu] = w @ c[nfft - L:][::-1]
+    full = oaconvolve(S, w[::-1, None], mode="full", axes=0)  # full[n] = sum_l w_l S[n - L + l]
+    Y = np.zeros_like(S)
+    Y[:-1] = full[L:m + L - 1]
+    G = Y.T @ S
     return C0 + G + G.T
 
 
