@@ -118,3 +118,26 @@ def test_printed_table_one_is_unstable_in_displacement_control(make_rig):
     unstable = [p for p in np.linalg.eigvals(printed.A) if p.real > 0]
     assert len(unstable) == 2
     assert max(p.real for p in np.linalg.eigvals(calibrated.A)) < 0
+
+
+@pytest.mark.parametrize(("mode", "off"), CASES[:2] + CASES[4:])
+def test_the_control_free_plant_matrices_are_the_closed_form_and_linearize_s(make_rig, closed_form, mode, off):
+    """``linear_plant.plant_matrices`` (what the fits linearise with, without python-control): the
+    friction-off rig's matrices are those of ``sh.analysis.linearize`` to the bit, and their
+    (balanced) frequency response is the closed form of Eq (9) / (12) to 1e-9."""
+    from servohydraulics.analysis import linearize
+    from servohydraulics.linear_plant import friction_off, plant_matrices
+
+    rig = make_rig("calibrated", off=off)
+    output = "force" if mode == "force" else "displacement"
+    pm = plant_matrices(friction_off(rig), mode, outputs=(output,))
+    ref = linearize(rig, mode, outputs=(output,))
+    for got, want in zip((pm.A, pm.B, pm.C, pm.D), (ref.A, ref.B, ref.C, ref.D)):
+        np.testing.assert_array_equal(got, np.asarray(want))
+    Ab, T = scipy.linalg.matrix_balance(pm.A, permute=False)
+    d = np.diag(T)
+    sys = ct.ss(Ab, pm.B / d[:, None], pm.C * d, pm.D)
+    h_lin, h_cf = _responses(sys, closed_form(rig, mode))
+    assert np.max(np.abs(h_lin - h_cf) / np.abs(h_cf)) < 1e-9
+    with pytest.raises(ValueError, match="invalid output = 'torque'"):
+        plant_matrices(rig, mode, outputs=("torque",))

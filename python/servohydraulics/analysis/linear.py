@@ -28,11 +28,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import control as ct
-import numpy as np
 
 from .. import _core
+from ..linear_plant import check_arguments, friction_off, plant_matrices
 from ..rig import Rig, copy_rig
-from ..simulate import MODES
 from .closed_form import equivalent_viscous_damping, velocity_feedback_gain
 
 ALPHA = _core.RpsdConfig().alpha  #: constant of the paper's phase-lead networks (Table I), the core's default [-]
@@ -91,12 +90,11 @@ def linear_analysis_rig(rig: Rig, friction: str = "off", friction_amplitude: flo
     """
     if friction not in FRICTION_TREATMENTS:
         raise ValueError(f"invalid friction = {friction!r}: expected one of {list(FRICTION_TREATMENTS)}")
-    r = copy_rig(rig)
     if friction == "tangent":
-        return r
-    if friction == "equivalent" and r.effects.coulomb_friction:
-        r.c = r.c + equivalent_viscous_damping(r, friction_amplitude, friction_frequency)
-    r.effects.coulomb_friction = False
+        return copy_rig(rig)
+    r = friction_off(rig)
+    if friction == "equivalent" and rig.effects.coulomb_friction:
+        r.c = r.c + equivalent_viscous_damping(rig, friction_amplitude, friction_frequency)
     return r
 
 
@@ -124,31 +122,12 @@ def linearize(rig: Rig, mode: str = "displacement", x0: float = 0.0, u0: float |
         inactive states (pressure and spool in Free mode, the spool without
         valve dynamics) dropped, and the compensator states appended.
     """
-    if mode not in MODES:
-        raise ValueError(f"invalid mode = {mode!r}: expected one of {sorted(MODES)}")
-    outs = list(outputs)
-    for o in outs:
-        if o not in OUTPUTS:
-            raise ValueError(f"invalid output = {o!r}: expected one of {list(OUTPUTS)}")
-    if not outs:
-        raise ValueError("invalid outputs = (): name at least one output channel")
-    if not math.isfinite(x0):
-        raise ValueError(f"invalid x0 = {x0!r}: must be finite [m]")
+    outs = list(check_arguments(mode, outputs, x0))
     comp = compensators or Compensation()
     r = linear_analysis_rig(rig, friction, friction_amplitude, friction_frequency)
-    dyn = _core.Dynamics(r, MODES[mode])
-    y0, u_hold = dyn.operating_point(float(x0))
-    lm = _core.linearize_dynamics(dyn, y0, u_hold if u0 is None else float(u0))
-    keep = np.flatnonzero(np.asarray(lm.active, dtype=bool))
     need = list(dict.fromkeys(outs + (["velocity"] if comp.velocity_feedback else [])))
-    rows = [OUTPUTS.index(o) for o in need]
-    A = np.asarray(lm.A)[np.ix_(keep, keep)]
-    B = np.asarray(lm.B).reshape(-1, 1)[keep]
-    C = np.asarray(lm.C)[np.ix_(rows, keep)]
-    D = np.asarray(lm.D).reshape(-1, 1)[rows]
-    names = [s[0] for s in dyn.states]  # the base states, then the switched-on elements' (specimens, loop delay)
-    plant = ct.ss(A, B, C, D, inputs=["u"], outputs=need, states=[names[i] for i in keep],
-                  name="plant")
+    pm = plant_matrices(r, mode, x0, u0, need)
+    plant = ct.ss(pm.A, pm.B, pm.C, pm.D, inputs=["u"], outputs=need, states=list(pm.states), name="plant")
     return _close_compensators(plant, r, mode, comp, outs)
 
 

@@ -493,12 +493,12 @@ def _max_stable(rig: Rig, mode: str, key: str, upper: float) -> float:
     loop, linearised at rest with friction off, is stable (bisection in log scale on
     the largest real part of the active states' eigenvalues); ``upper`` if stable there,
     the current value if the current model is not stable at rest."""
-    from ..analysis import linearize
+    from ..linear_plant import friction_off, plant_matrices
 
     def stable(v: float) -> bool:
         r = copy.copy(rig)
         setattr(r, key, float(v))
-        return bool(np.max(np.linalg.eigvals(linearize(r, mode, friction="off").A).real) < 0.0)
+        return bool(np.max(np.linalg.eigvals(plant_matrices(friction_off(r), mode).A).real) < 0.0)
 
     cur = float(getattr(rig, key))
     if stable(upper):

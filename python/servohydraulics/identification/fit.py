@@ -2,7 +2,7 @@
 
 * :func:`fit_frequency` (stage 1): the H1 estimates channel/command of every
   record (coherence >= 0.9, inside the command's band) fitted by the
-  linearised model (``sh.analysis.linearize``, i.e. ``_core.linearize_dynamics``
+  linearised model (``linear_plant.plant_matrices``, i.e. ``_core.linearize_dynamics``
   about the record's initial displacement) in relative complex least squares
   weighted by the coherence.  Keys that do not change the linear model
   (friction, hysteresis) are left for stage 2.
@@ -34,6 +34,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from .. import _core
+from ..linear_plant import friction_off, plant_matrices
 from ..response import Response
 from ..rig import Error, Rig
 from ..simulate import make_plant, solver_options
@@ -84,10 +85,8 @@ def frequency_targets(records: list[Response], channels: tuple[str, ...]) -> lis
 
 def linear_response(rig: Rig, mode: str, x0: float, channels: tuple[str, ...], f: np.ndarray) -> np.ndarray:
     """Frequency response of the linearised model, rows = channels, columns = f [Hz]."""
-    from ..analysis import linearize
-
-    sys = linearize(rig, mode, x0=x0, outputs=channels)
-    A, B, C, D = (np.asarray(m, dtype=float) for m in (sys.A, sys.B, sys.C, sys.D))
+    pm = plant_matrices(friction_off(rig), mode, x0=x0, outputs=channels)
+    A, B, C, D = (np.asarray(m, dtype=float) for m in (pm.A, pm.B, pm.C, pm.D))
     s = 2j * np.pi * f
     X = np.linalg.solve(s[:, None, None] * np.eye(A.shape[0]) - A, np.broadcast_to(B, (f.size,) + B.shape))
     return (C @ X)[..., 0].T + D

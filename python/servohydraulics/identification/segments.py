@@ -61,10 +61,10 @@ def warmup_seconds(rig: Rig, mode: str, x0: float) -> float | None:
     ``MIN_WARMUP``; None when the linearisation fails or has a mode that does not decay (modes of
     zero rate, states nothing reads such as a damper's internal displacement without its spring,
     are left out)."""
-    from ..analysis import linearize
+    from ..linear_plant import friction_off, plant_matrices
 
     try:
-        lam = np.linalg.eigvals(np.asarray(linearize(rig, mode, x0=x0).A, dtype=float))
+        lam = np.linalg.eigvals(np.asarray(plant_matrices(friction_off(rig), mode, x0=x0).A, dtype=float))
     except (ValueError, np.linalg.LinAlgError):
         return None
     big = float(np.max(np.abs(lam))) if lam.size else 0.0
