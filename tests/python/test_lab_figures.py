@@ -9,7 +9,9 @@ import pytest
 from matplotlib.figure import Figure
 
 from servohydraulics.identification.figures import (
+    ENVELOPE_RUNS,
     MIN_COHERENCE,
+    envelope,
     frf_figure,
     loops_figure,
     overlay_figure,
@@ -47,6 +49,32 @@ def test_zoom_windows_find_where_the_records_part():
     assert isinstance(fig, Figure)
     titles = [ax.get_title() for ax in fig.axes]
     assert sum(ttl[:2] in ("A:", "B:", "C:") for ttl in titles) == 3
+
+
+def test_a_long_trace_is_drawn_through_the_extremes_of_each_run_of_samples():
+    """Oracle: the trace itself.  The envelope drawn for a 61,501-sample chirp with a spike and a
+    NaN is a time-ordered subsequence of it with at most four samples per run; in each run of
+    samples it holds that run's first, last, lowest and highest sample (so the drawn extremes are
+    the trace's, to the sample), and the NaN (the line breaks there); a short trace is drawn whole."""
+    t, y = _chirp(61501)
+    y[123] = 0.05
+    y[40000] = np.nan
+    tt, yy = envelope(t, y)
+    idx = np.searchsorted(t, tt)
+    assert np.all(np.diff(idx) > 0) and np.array_equal(t[idx], tt)
+    np.testing.assert_array_equal(yy, y[idx])
+    assert tt.size <= 4 * ENVELOPE_RUNS
+    edges = np.linspace(0, y.size, ENVELOPE_RUNS + 1).astype(int)
+    for a, b in zip(edges[:-1], edges[1:]):
+        kept = idx[(idx >= a) & (idx < b)]
+        run = y[a:b]
+        assert a in kept and b - 1 in kept
+        if np.isnan(run).any():
+            assert a + int(np.flatnonzero(np.isnan(run))[0]) in kept
+        else:
+            assert y[kept].max() == run.max() and y[kept].min() == run.min()
+    t2, y2 = envelope(t[:400], y[:400])
+    assert np.array_equal(t2, t[:400]) and np.array_equal(y2, y[:400])
 
 
 def test_frf_masks_low_coherence_bands():

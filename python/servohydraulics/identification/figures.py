@@ -27,6 +27,35 @@ MIN_COHERENCE = 0.8
 MEASURED, SIMULATED, DIFFERENCE, SHADE = "0.15", "C1", "C3", "C0"
 
 
+#: a whole-record trace is drawn through the extremes of this many equal runs of its samples (about
+#: two per pixel column of the figures' 11 in at 110 dpi)
+ENVELOPE_RUNS = 2500
+
+
+def envelope(t: np.ndarray, y: np.ndarray, runs: int = ENVELOPE_RUNS) -> tuple[np.ndarray, np.ndarray]:
+    """The samples of a long trace a plot needs: of each of ``runs`` equal runs of samples its first,
+    lowest, highest and last, in time order (the trace as drawn at the figure's resolution: the same
+    ink, its extremes kept); the trace itself when it has at most 4 ``runs`` samples.  A NaN in a run
+    is kept (the line breaks there as it would)."""
+    t, y = np.asarray(t), np.asarray(y)
+    n = y.size
+    if n <= 4 * runs:
+        return t, y
+    edges = np.linspace(0, n, runs + 1).astype(int)
+    starts, size = edges[:-1], np.diff(edges)
+    width = int(size.max())
+    pad = np.full(runs * width, np.nan)
+    cols = np.arange(width)
+    valid = cols[None, :] < size[:, None]
+    blocks = pad.reshape(runs, width)
+    blocks[valid] = y
+    lo = np.where(valid, blocks, np.inf).argmin(axis=1)  # a NaN in the run: its index (argmin's rule)
+    hi = np.where(valid, blocks, -np.inf).argmax(axis=1)
+    idx = np.column_stack([starts, starts + np.minimum(lo, hi), starts + np.maximum(lo, hi), starts + size - 1])
+    idx = np.unique(idx.ravel())
+    return t[idx], y[idx]
+
+
 def _moving_mean(y: np.ndarray, n: int) -> np.ndarray:
     c = np.cumsum(np.r_[0.0, y])
     out = np.empty_like(y)
@@ -106,9 +135,9 @@ def overlay_figure(time: np.ndarray, measured: Mapping[str, np.ndarray], simulat
         m, s = f * np.asarray(measured[ch]), f * np.asarray(simulated[ch])
         r = (2 * i) if wins else i
         ax = fig.add_subplot(gs[r, :])
-        ax.plot(t, s - m, lw=0.5, color=DIFFERENCE, label="difference", alpha=0.6, zorder=1)
-        ax.plot(t, m, lw=0.6, color=MEASURED, label=labels[0], zorder=2)
-        ax.plot(t, s, lw=0.6, color=SIMULATED, label=labels[1], zorder=3)
+        ax.plot(*envelope(t, s - m), lw=0.5, color=DIFFERENCE, label="difference", alpha=0.6, zorder=1)
+        ax.plot(*envelope(t, m), lw=0.6, color=MEASURED, label=labels[0], zorder=2)
+        ax.plot(*envelope(t, s), lw=0.6, color=SIMULATED, label=labels[1], zorder=3)
         for j, (a, b) in enumerate(wins):
             ax.axvspan(t[a], t[b - 1], color=SHADE, alpha=0.12, lw=0)
             ax.text(0.5 * (t[a] + t[b - 1]), 1.0, letters[j], transform=ax.get_xaxis_transform(), ha="center",
