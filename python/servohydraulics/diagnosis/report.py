@@ -54,7 +54,8 @@ def _plots(d, out: Path, files: FileSet) -> dict:
              "overlay": "overlay.png"}
     for kind, fig in figs.items():
         if fig is not None:
-            fig.tight_layout()
+            if kind != "overlay":  # the overlay is laid out by identification.figures
+                fig.tight_layout()
             fig.savefig(files.path(out / names[kind]), dpi=110)
     return {kind: names[kind] for kind, fig in figs.items() if fig is not None}
 
