@@ -2,7 +2,7 @@
 issue 25 item 2, the May runs).
 
     python studies/utfsm_area_displacement.py [--run may_0A_to_1A] [--out build/utfsm25] [--ratios 1,3.33,33.3]
-                                              [--fit-loop-area 30,5]
+                                              [--fit-loop-area 30,5] [--area-max 1000] [--with-supply]
 
 Reads the diagnosed rig of an ``evaluation/utfsm_diagnose.py --run LABEL --out OUT`` run (OUT/LABEL/
 rig_updated.toml), re-sizes its actuator by each ratio with the diagnosis' own load term
@@ -15,7 +15,9 @@ itself; large ratios take the load coupling away (an ideal displacement source w
 ``--fit-loop-area STARTS``: then the loop (K_v, f_v, zeta_v) and A fitted together on the displacement channel
 alone, the diagnosed damper held, from each start of A (multiples of the nominal rig's A, the loop at the
 diagnosed rig's values), by the diagnosis' own fit (``engine.fit``, the force channel weighted 0): whether any
-setting of the loop and the load term gives the nominal model's displacement back.
+setting of the loop and the load term gives the nominal model's displacement back.  ``--area-max R``: A's
+upper bound in that fit, R times the nominal rig's A, instead of the diagnosis' own (``effects`` load term A).
+``--with-supply``: the supply pressure p_s fitted too (the other load term, over its own span).
 """
 
 from __future__ import annotations
@@ -45,7 +47,12 @@ def main() -> None:
     p.add_argument("--ratios", default="1,3.33,33.3", help="comma-separated multiples of the diagnosed area")
     p.add_argument("--fit-loop-area", metavar="STARTS", default="",
                    help="comma-separated starts of A (multiples of the nominal's) for a fit of the loop with A")
+    p.add_argument("--area-max", type=float, default=None, metavar="R",
+                   help="A's upper bound in --fit-loop-area, R times the nominal's (default: the diagnosis' own)")
+    p.add_argument("--with-supply", action="store_true", help="fit the supply pressure p_s with the loop and A")
     a = p.parse_args()
+    if a.area_max is not None and not a.area_max > 0:
+        p.error(f"--area-max {a.area_max!r}: must be > 0")
 
     def numbers(flag: str, text: str) -> list[float]:
         try:
@@ -84,10 +91,11 @@ def main() -> None:
         print(f"| diagnosed, A x{q:g} | {r.A / nominal.A:.3g} | {100 * g['displacement']:.2f} | "
               f"{100 * g['force']:.1f} |", flush=True)
     if starts:
-        fit_loop_area(rig, nominal, cases, starts)
+        fit_loop_area(rig, nominal, cases, starts, a.area_max, a.with_supply)
 
 
-def fit_loop_area(rig, nominal, cases: list, starts: list[float]) -> None:
+def fit_loop_area(rig, nominal, cases: list, starts: list[float], area_max: float | None = None,
+                  with_supply: bool = False) -> None:
     """The loop and A fitted on the displacement alone from each start of A (see the module docstring)."""
     from servohydraulics.diagnosis import engine, workflow
     from servohydraulics.diagnosis.joint import LOOP
@@ -96,10 +104,13 @@ def fit_loop_area(rig, nominal, cases: list, starts: list[float]) -> None:
     sims = engine.simulate_all(rig, cases, 0.0, x0)
     setup = workflow._Setup(nominal, "displacement", cases, [], workflow.KEEP, True, True)
     ctx = workflow._context(setup, workflow._State(rig=rig, tau=0.0, x0=tuple(x0), sims=sims))
-    space = engine.Space(LOOP, ctx, (("A", "m^2"),))
+    space = engine.Space(LOOP, ctx, ((("p_s", "Pa"),) if with_supply else ()) + (("A", "m^2"),))
+    if area_max is not None:  # A is fitted as 1 / A: its upper bound is the reciprocal's lower one
+        space.lo[-1] = 1.0 / (area_max * nominal.A)
     weights = {(c.name, ch): 0.0 for c in cases for ch in c.meas if ch != "displacement"}
-    print("\n| start A / nominal A | fitted A / nominal A (bound) | K_v | f_v [Hz] | zeta_v | displacement | force "
-          "| fit |\n|---|---|---|---|---|---|---|---|")
+    print(f"\nthe loop and A fitted on the displacement, p_s {'fitted too' if with_supply else 'held'}:\n"
+          "| start A / nominal A | fitted A / nominal A (bound) | p_s [MPa] | K_v | f_v [Hz] | zeta_v | displacement "
+          "| force | fit |\n|---|---|---|---|---|---|---|---|---|")
     for start in starts:
         t0 = time.time()
         z0 = space.absent.copy()
@@ -107,7 +118,8 @@ def fit_loop_area(rig, nominal, cases: list, starts: list[float]) -> None:
         res = engine.fit(space, cases, z0, 0.0, "all", x0, max_nfev=30, weights=weights)
         rig1, tau1 = space.rig_and_tau(res.z, 0.0)
         g = engine.gap(engine.simulate_all(rig1, cases, tau1, res.x0), cases)
-        print(f"| {start:g} | {rig1.A / nominal.A:.3g} ({1.0 / (space.lo[-1] * nominal.A):.3g}) | {rig1.K_v:.4g} | "
+        bound = 1.0 / (space.lo[-1] * nominal.A)
+        print(f"| {start:g} | {rig1.A / nominal.A:.3g} ({bound:.3g}) | {1e-6 * rig1.p_s:.4g} | {rig1.K_v:.4g} | "
               f"{rig1.f_v:.4g} | {rig1.zeta_v:.3g} | {100 * g['displacement']:.3f} | {100 * g['force']:.2f} | "
               f"{time.time() - t0:.0f} s, {res.nfev} evaluations |", flush=True)
 
