@@ -183,7 +183,9 @@ def test_a_significant_but_immaterial_third_correction_is_not_named() -> None:
     hidden effects are named with their values (p_s and F_c within 5 %); a third candidate then passes the
     statistical tests at this noise level (moving_mass, a mass 0.07 % off: BIC better by 1,408) but closes
     under ``MATERIAL_MIN`` of the nominal model's gap above the noise floor (0.28 %), and is reported, not
-    named.  Without the materiality test it was named third (the evaluation of stop 35)."""
+    named.  Without the materiality test it was named third (the evaluation of stop 35).  Another candidate the
+    BIC alone would take third (viscous damping, in numpy 2.4 / scipy 1.17's rounding) may be stopped by the
+    held-out test instead: only what the statistics passed is left to materiality."""
     from servohydraulics.diagnosis.engine import MATERIAL_MIN
     from servohydraulics.diagnosis.workflow import DELTA_BIC_MIN
 
@@ -196,10 +198,14 @@ def test_a_significant_but_immaterial_third_correction_is_not_named() -> None:
     assert _names(d) == ["load_pressure", "coulomb_friction"], d.summary
     assert abs(_param(d, "load_pressure", "p_s")["value"] - 12e6) < 0.05 * 12e6
     assert abs(_param(d, "coulomb_friction", "F_c")["value"] - 250.0) < 0.05 * 250.0
-    immaterial = [c for c in d.candidates if c.round == 3 and c.delta_bic is not None and c.delta_bic >= DELTA_BIC_MIN]
-    assert immaterial, [(c.name, c.delta_bic) for c in d.candidates if c.round == 3]
-    for c in immaterial:  # passed every statistical test; only materiality stopped it
-        assert c.share_closed < MATERIAL_MIN and c.rejection.startswith("closes "), c
+    third = {c.name: c for c in d.candidates if c.round == 3 and c.delta_bic is not None}
+    mass = third["moving_mass"]  # passed every statistical test; only materiality stopped it
+    assert mass.delta_bic >= DELTA_BIC_MIN and mass.rejection.startswith("closes "), mass
+    assert mass.share_closed < MATERIAL_MIN, mass
+    for c in third.values():  # any other candidate the BIC alone would take is stopped by a test too
+        assert not c.accepted and c.rejection, c
+        if c.rejection.startswith("closes "):
+            assert c.share_closed < MATERIAL_MIN, c
     # the second effect, ten and more times the force noise, is well above the threshold
     second = next(c for c in d.candidates if c.name == "coulomb_friction" and c.accepted)
     assert second.share_closed > 3 * MATERIAL_MIN, second
