@@ -3,6 +3,7 @@ issue 25 item 2, the May runs).
 
     python studies/utfsm_area_displacement.py [--run may_0A_to_1A] [--out build/utfsm25] [--ratios 1,3.33,33.3]
                                               [--fit-loop-area 30,5] [--area-max 1000] [--with-supply]
+                                              [--refit-damper 0.01,0.001]
 
 Reads the diagnosed rig of an ``evaluation/utfsm_diagnose.py --run LABEL --out OUT`` run (OUT/LABEL/
 rig_updated.toml), re-sizes its actuator by each ratio with the diagnosis' own load term
@@ -18,6 +19,11 @@ diagnosed rig's values), by the diagnosis' own fit (``engine.fit``, the force ch
 setting of the loop and the load term gives the nominal model's displacement back.  ``--area-max R``: A's
 upper bound in that fit, R times the nominal rig's A, instead of the diagnosis' own (``effects`` load term A).
 ``--with-supply``: the supply pressure p_s fitted too (the other load term, over its own span).
+
+``--refit-damper LAMBDAS``: then the loop (K_v, f_v, zeta_v), the load terms (p_s, A) and the damper's force
+law (its alpha, c0, c1 and gamma) fitted together from the diagnosed rig, each key in log coordinates within a
+factor e^3 of its start, to the displacement residual with the force residual weighted by sqrt(lambda)
+(``scipy.optimize.least_squares``, forward differences): the trade between the two channels, for each lambda.
 """
 
 from __future__ import annotations
@@ -50,6 +56,8 @@ def main() -> None:
     p.add_argument("--area-max", type=float, default=None, metavar="R",
                    help="A's upper bound in --fit-loop-area, R times the nominal's (default: the diagnosis' own)")
     p.add_argument("--with-supply", action="store_true", help="fit the supply pressure p_s with the loop and A")
+    p.add_argument("--refit-damper", metavar="LAMBDAS", default="",
+                   help="comma-separated weights of the force channel for a re-fit of the loop, load terms and damper")
     a = p.parse_args()
     if a.area_max is not None and not a.area_max > 0:
         p.error(f"--area-max {a.area_max!r}: must be > 0")
@@ -64,6 +72,7 @@ def main() -> None:
         return out
 
     ratios, starts = numbers("--ratios", a.ratios), numbers("--fit-loop-area", a.fit_loop_area)
+    lambdas = numbers("--refit-damper", a.refit_damper)
     if not ratios:
         p.error("--ratios '': give at least one ratio")
     label, rig_from, record = next(r for r in RUNS if r[0] == a.run)
@@ -92,6 +101,8 @@ def main() -> None:
               f"{100 * g['force']:.1f} |", flush=True)
     if starts:
         fit_loop_area(rig, nominal, cases, starts, a.area_max, a.with_supply)
+    for lam in lambdas:
+        refit_damper(rig, cases, lam)
 
 
 def fit_loop_area(rig, nominal, cases: list, starts: list[float], area_max: float | None = None,
@@ -122,6 +133,51 @@ def fit_loop_area(rig, nominal, cases: list, starts: list[float], area_max: floa
         print(f"| {start:g} | {rig1.A / nominal.A:.3g} ({bound:.3g}) | {1e-6 * rig1.p_s:.4g} | {rig1.K_v:.4g} | "
               f"{rig1.f_v:.4g} | {rig1.zeta_v:.3g} | {100 * g['displacement']:.3f} | {100 * g['force']:.2f} | "
               f"{time.time() - t0:.0f} s, {res.nfev} evaluations |", flush=True)
+
+
+#: the keys --refit-damper moves: the loop, the load terms and the damper's force law
+REFIT_KEYS = ("K_v", "f_v", "zeta_v", "p_s", "A", "mr_alpha_a", "mr_c0_a", "mr_c1_a", "mr_gamma")
+
+
+def refit_damper(rig, cases: list, lam: float) -> None:
+    """``REFIT_KEYS`` fitted to the displacement with the force weighted by sqrt(lam) (see the module docstring)."""
+    import copy
+
+    import numpy as np
+    from scipy.optimize import least_squares
+
+    from servohydraulics.diagnosis import engine
+    from servohydraulics.response import SimulationError
+
+    x0 = engine.refine_x0(rig, cases, 0.0)
+    base = np.array([getattr(rig, k) for k in REFIT_KEYS], dtype=float)
+    meas = {ch: np.concatenate([np.asarray(c.meas[ch], dtype=float) for c in cases])
+            for ch in ("displacement", "force")}
+    scale = {ch: float(np.sqrt(np.mean(v ** 2)) * np.sqrt(v.size)) for ch, v in meas.items()}
+
+    def rig_at(z: np.ndarray):
+        r = copy.deepcopy(rig)
+        for k, b, zz in zip(REFIT_KEYS, base, z):
+            setattr(r, k, float(b * np.exp(zz)))
+        return r
+
+    def residual(z: np.ndarray) -> np.ndarray:
+        try:
+            sims = engine.simulate_all(rig_at(z), cases, 0.0, x0)
+        except (ValueError, SimulationError):  # a key combination the model refuses or cannot run
+            return np.full(2 * meas["displacement"].size, 1.0)
+        sim = {ch: np.concatenate([np.asarray(s[ch], dtype=float) for s in sims]) for ch in meas}
+        return np.concatenate([(sim["displacement"] - meas["displacement"]) / scale["displacement"],
+                               np.sqrt(lam) * (sim["force"] - meas["force"]) / scale["force"]])
+
+    t0 = time.time()
+    sol = least_squares(residual, np.zeros(len(REFIT_KEYS)), bounds=(-3.0, 3.0), method="trf", diff_step=1e-3,
+                        ftol=1e-4, xtol=1e-6, max_nfev=40)
+    r1 = rig_at(sol.x)
+    g = engine.gap(engine.simulate_all(r1, cases, 0.0, engine.refine_x0(r1, cases, 0.0)), cases)
+    values = ", ".join(f"{k} {getattr(r1, k):.4g}" for k in REFIT_KEYS)
+    print(f"\nre-fit with the force weighted by sqrt({lam:g}): displacement {100 * g['displacement']:.3f} %, force "
+          f"{100 * g['force']:.2f} % ({time.time() - t0:.0f} s, {sol.nfev} evaluations)\n  {values}", flush=True)
 
 
 if __name__ == "__main__":
