@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import control as ct
 
 from .. import _core
+from ..linear_plant import OUTPUTS as LINEAR_OUTPUTS
 from ..linear_plant import check_arguments, friction_off, plant_matrices
 from ..rig import Rig, copy_rig
 from .closed_form import equivalent_viscous_damping, velocity_feedback_gain
@@ -37,7 +38,7 @@ from .closed_form import equivalent_viscous_damping, velocity_feedback_gain
 ALPHA = _core.RpsdConfig().alpha  #: constant of the paper's phase-lead networks (Table I), the core's default [-]
 #: the plant's output channels (the core's channel table but time) -> SI unit, in the order of LinearModel.C's rows
 OUTPUT_UNITS = {n: u for n, u in _core.PLANT_CHANNELS if n != "time"}
-OUTPUTS = tuple(OUTPUT_UNITS)
+OUTPUTS = LINEAR_OUTPUTS  #: the same order as OUTPUT_UNITS (both the core's channel table but time)
 STATE_UNITS = dict(_core.STATES)  #: the plant's states (the core's StateIndex order) -> SI unit
 STATES = tuple(STATE_UNITS)
 FRICTION_TREATMENTS = ("off", "equivalent", "tangent")
