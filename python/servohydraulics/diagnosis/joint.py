@@ -337,3 +337,119 @@ def loop_refit_displacement(current: Rig, nominal: Rig, tau: float, cases: list[
         reason=f"the loop alone on the displacement channel (A x{current.A / nominal.A:.3g}): {why}",
         seconds=time.time() - t0)
     return info, (JointModel(rig1, tau1, res.x0, sims1, {}, {}, None) if keep else None)
+
+
+#: the model tracks a channel worse than the nominal model when its gap there exceeds the nominal's by more than
+#: this share (2 %, the held-out test's ``workflow.HELDOUT_MIN``: the 208 cases of the evaluation end at most
+#: 0.02 % above the nominal on a channel, at the noise floor, while the May UTFSM sweep's diagnosed displacement
+#: ends 11 % above it)
+RESTORE_MIN = 0.02
+#: the weights (of the squared residual) of the channels the model tracks no worse than the nominal, in turn, in
+#: the restoring re-fit: from the first that weighs them a tenth of the worse channels down, each started where
+#: the one before ended
+RESTORE_LAMBDAS = (0.1, 0.01, 0.001)
+#: the restoring re-fit may give back at most this share of what the effects closed on a channel they improved
+RESTORE_GIVE_BACK = 0.5
+
+
+def worse_than_nominal(gap_now: dict, nominal_gap: dict) -> list[str]:
+    """The channels whose gap exceeds the nominal model's by more than ``RESTORE_MIN`` of it."""
+    return [c for c in gap_now if gap_now[c] > nominal_gap[c] * (1.0 + RESTORE_MIN)]
+
+
+def _restored(g1: dict, g0: dict, nominal_gap: dict) -> tuple[bool, bool]:
+    """Whether a restoring fit's gaps ``g1`` (from the model's ``g0``) bring every channel to no worse than the
+    nominal's, and whether they keep on each channel the effects improved at least ``1 - RESTORE_GIVE_BACK`` of what
+    the effects closed there."""
+    back = all(g1[c] <= nominal_gap[c] for c in g1)
+    kept = all(g1[c] <= g0[c] + RESTORE_GIVE_BACK * (nominal_gap[c] - g0[c]) for c in g1 if g0[c] < nominal_gap[c])
+    return back, kept
+
+
+def restore_refit(accepted: list[Accepted], parameters: dict, current: Rig, nominal_gap: dict, tau: float,
+                  cases: list[Case], x0s, sims: list, rnd: int, ctx: Context
+                  ) -> tuple[JointRefit | None, JointModel | None]:
+    """The diagnosed model handed to the lab tracks no channel worse than the nominal model did, where a re-fit
+    can give it back (issue 25 item 2: a damper's 1 A force fitted on a rig identified at 0 A worsened the May
+    sweep's displacement 1.68 -> 1.87 %).  After the last round, displacement control: when the model's gap on
+    some channel exceeds the nominal's (``nominal_gap``) by more than ``RESTORE_MIN``, the accepted effects' own
+    parameters, the nominal terms their re-fits moved (the load terms p_s and A among them) and the loop (``LOOP``:
+    K_v, f_v, zeta_v) fitted together, the channels the model tracks no worse weighted by each of
+    ``RESTORE_LAMBDAS`` in turn (the worse channels by 1): the joint and loop re-fits weigh the channels by their
+    likelihoods, where a force channel far from its floor outvotes the displacement.  The first weight whose fit
+    brings every channel back to no worse than the nominal's while keeping, on each channel the effects improved,
+    at least half of what they closed there, is kept, whatever the BIC (which that same weighting decides); a
+    weight that gives more back ends the search (a smaller one gives back more).  (None, None) when not tried."""
+    if ctx.mode not in LOOP.modes or not accepted:
+        return None, None
+    g0 = engine.gap(sims, cases)
+    worse = worse_than_nominal(g0, nominal_gap)
+    if not worse:
+        return None, None
+    t0 = time.time()
+    k = int(sum(a.z.size for a in accepted))
+    acc, held, shared = _partition(accepted)
+    info = JointRefit(round=rnd, effects=tuple(a.name for a in acc) + ("loop",), superseded=tuple(held) or None)
+    head = (f"restoring re-fit (the {' and '.join(worse)} gap above the nominal model's: "
+            + ", ".join(f"{100 * g0[c]:.3g} % > {100 * nominal_gap[c]:.3g} %" for c in worse) + ")")
+    if shared:
+        return dataclasses.replace(info, reason=f"{head}: not tried: effects share the parameter(s) {shared}"), None
+    loop_space = engine.Space(LOOP, ctx, ())
+    loop0 = Accepted("loop", loop_space, loop_space.absent.copy(), loop_space.absent.copy(),
+                     loop_space.absent.copy(), None)
+    js = engine.JointSpace([a.space for a in acc] + [loop_space], current)
+    z, base_tau = _start(acc + [loop0], js, current, tau)
+    rig0, tau0 = js.rig_and_tau(z, base_tau)
+    if rig0 != current or not math.isclose(tau0, tau, rel_tol=1e-9, abs_tol=1e-12):
+        return dataclasses.replace(info, reason=f"{head}: not tried: the model cannot be rebuilt from the effects' "
+                                                "parameters"), None
+    stats0 = engine.channel_stats(sims, cases)
+    neff = engine.n_eff(stats0)
+    info = dataclasses.replace(info, parameters_fitted=tuple([prm.key for prm in js.params]
+                                                             + [kk for kk, _ in js.interacting]))
+    x0, nfev, tried, found = np.asarray(x0s, float), 0, [], None
+    for lam in RESTORE_LAMBDAS:
+        weights = {(c.name, ch): (1.0 if ch in worse else math.sqrt(lam)) for c in cases for ch in c.meas}
+        res = engine.fit(js, cases, z, base_tau, "all", x0, max_nfev=JOINT_MAX_NFEV, weights=weights)
+        nfev += res.nfev
+        rig1, tau1 = js.rig_and_tau(res.z, base_tau)
+        sims1 = engine.simulate_all(rig1, cases, tau1, res.x0)
+        if any(s is None for s in sims1):
+            tried.append(f"weight {lam:g}: the simulation fails")
+            break
+        g1 = engine.gap(sims1, cases)
+        back, kept = _restored(g1, g0, nominal_gap)
+        tried.append(f"weight {lam:g}: " + ", ".join(f"{c} {100 * g1[c]:.3g} %" for c in g1))
+        if back and kept:
+            found = (lam, res, rig1, tau1, sims1, g1)
+            break
+        if not kept:
+            break
+        z, x0 = res.z, res.x0
+    info = dataclasses.replace(info, nfev=nfev, gap_greedy=g0, seconds=None)
+    if found is None:
+        return dataclasses.replace(info, reason=f"{head}: no weight gives every channel back without giving back "
+                                                f"more than {RESTORE_GIVE_BACK:g} of what the effects closed ("
+                                   + "; ".join(tried) + "): kept the model", seconds=time.time() - t0), None
+    lam, res, rig1, tau1, sims1, g1 = found
+    refit, excl, corr = _refitted(acc + [loop0], js, res, engine.series_lengths(cases))
+    loop_fit = refit.pop("loop")
+    excl.pop("loop", None)
+    reports = {n: param_report(a.space, a.z, a.lo, a.hi) for n, a in refit.items()}
+    b0 = engine.bic(stats0, k, neff)
+    b1 = engine.bic(engine.channel_stats(sims1, cases), k + loop_space.n_main, neff)
+    greedy = {a.name: _values(parameters[a.name]) for a in acc}
+    greedy["loop"] = _loop_start(loop_space)
+    info = dataclasses.replace(
+        info, kept=True, bic_greedy=b0, bic_joint=b1, delta_bic=b0 - b1, gap_joint=g1, parameters_greedy=greedy,
+        parameters_joint={**{n: _values(r) for n, r in reports.items()},
+                          "loop": _values(param_report(loop_space, loop_fit.z, loop_fit.lo, loop_fit.hi))},
+        excludes_absent_joint=excl,
+        reason=(f"{head}: the other channels weighted by {lam:g} brings every channel back to no worse than the "
+                "nominal's (" + ", ".join(f"{c} {100 * g1[c]:.3g} % <= {100 * nominal_gap[c]:.3g} %" for c in g1)
+                + f") and keeps at least {1 - RESTORE_GIVE_BACK:g} of what the effects closed"
+                + (f"; BIC better by {b0 - b1:.1f}" if b0 >= b1 else f"; BIC worse by {b1 - b0:.1f}") + ": kept"
+                + (f" (tried: {'; '.join(tried[:-1])})" if len(tried) > 1 else "")),
+        seconds=time.time() - t0)
+    return info, JointModel(rig1, tau1, res.x0, sims1, refit, reports,
+                            joint_groups(acc + [loop_fit], js, corr))

@@ -27,7 +27,7 @@ from ..workers import single_blas_thread
 from . import engine
 from .confirm import confirm, param_groups, param_report
 from .effects import LIBRARY, Context, check_names, interacting, nested, separating_experiment
-from .joint import joint_refit, loop_refit, loop_refit_displacement
+from .joint import joint_refit, loop_refit, loop_refit_displacement, restore_refit
 from .types import Accepted, CandidateLog, Case, Fit, JointRefit, Round, Screening, Sim
 
 #: acceptance thresholds (documented in docs/diagnose.md)
@@ -255,6 +255,8 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
             last = outcome
             break
         _accept(setup, state, outcome)
+    if setup.joint_refit and state.accepted:
+        _restore(setup, state, max(e["round"] for e in state.effects))
     setup.bar.close()
     d = _result(setup, state, sims0, last, time.time() - t_start)
     d.checks, d.dt = checks, dt
@@ -564,6 +566,16 @@ def _polish_loop(setup: _Setup, state: _State, rnd: int) -> None:
         _adopt(setup, state, info, new, "loop re-fit (displacement)")
 
 
+def _restore(setup: _Setup, state: _State, rnd: int) -> None:
+    """After the last round: the restoring re-fit (``joint.restore_refit``) where the model tracks a channel
+    worse than the nominal model; its model replaces the current one if kept."""
+    setup.bar.set_description_str("restoring re-fit")
+    parameters = {e["name"]: e["parameters"] for e in state.effects}
+    info, new = restore_refit(state.accepted, parameters, state.rig, state.history[0][1], state.tau, setup.cases,
+                              state.x0, state.sims, rnd, _context(setup, state))
+    _adopt(setup, state, info, new, "restoring re-fit")
+
+
 def _adopt(setup: _Setup, state: _State, info, new, label: str) -> None:
     """Logs a re-fit (``info``; None: not tried) and, if it was kept (``new``), makes its model the current one."""
     if info is None:
@@ -612,6 +624,8 @@ def _summary(verdict: str, effects: list, last: Round | None, joint_log: list[Jo
         j = joint_log[-1]
         if j.effects == ("loop (displacement)",):  # its reason names it and says why kept or not
             summary += f"; re-fit of {j.reason}"
+        elif j.reason and j.reason.startswith("restoring re-fit"):
+            summary += f"; {j.reason}"
         else:
             summary += (f"; joint re-fit of {' + '.join(j.effects)}: "
                         + (f"kept (BIC better by {j.delta_bic:.1f})" if j.kept else j.reason))
