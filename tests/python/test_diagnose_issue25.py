@@ -19,6 +19,8 @@ workflow now passes, the hidden truth as the oracle.
 
 from __future__ import annotations
 
+import dataclasses
+
 from independent_records import gen, independent_record
 
 import servohydraulics as sh
@@ -356,3 +358,34 @@ def test_the_restoring_re_fit_weighs_the_other_channels_down_until_the_worse_one
     assert _restored({"displacement": 0.02, "force": 0.44}, model, nominal) == (True, True)
     assert _restored({"displacement": 0.02, "force": 0.46}, model, nominal) == (True, False)
     assert _restored({"displacement": 0.021, "force": 0.2}, model, nominal) == (False, True)
+
+
+def test_the_restoring_re_fit_keeps_an_actuator_that_carries_the_measured_force() -> None:
+    """``joint._carry_peak_force``: the restoring re-fit weighs the force down, so the actuator's size (the load term
+    A, its capacity F_cap scaled with it by ``apply_area``) is bounded where its capacity equals the records' peak
+    force: the rig at that bound has F_cap = the peak force (the record check ``force_beyond_capacity`` then
+    passes), and a rig whose capacity already falls short is not shrunk at all.  The space passed in is not
+    changed."""
+    import copy
+
+    import numpy as np
+
+    from servohydraulics.diagnosis import engine
+    from servohydraulics.diagnosis.joint import _carry_peak_force
+
+    _, _, model, _, _, _, _, _, ctx, _ = _restore_setting()
+    for capacity in (1.5, 0.5):  # the rig's capacity, in peak forces (the space's own bound is half the size)
+        rig = copy.copy(model)
+        rig.F_cap = capacity * ctx.peak_force
+        space = engine.Space(LIBRARY["coulomb_friction"], dataclasses.replace(ctx, rig=rig), (("A", "m^2"),))
+        lo, hi = space.lo.copy(), space.hi.copy()
+        narrowed = _carry_peak_force(space, rig, ctx.peak_force)
+        assert np.array_equal(space.lo, lo) and np.array_equal(space.hi, hi)
+        j = narrowed.n_main  # A, fitted as 1 / A: its smallest value is the reciprocal's upper bound
+        assert narrowed.rec[j]
+        at_bound, _ = narrowed.rig_and_tau(np.array([narrowed.absent[0], narrowed.hi[j]]), 0.0)
+        if capacity > 1.0:
+            assert abs(at_bound.F_cap - ctx.peak_force) < 1e-9 * ctx.peak_force, (at_bound.F_cap, ctx.peak_force)
+            assert narrowed.hi[j] < hi[j]
+        else:
+            assert at_bound.A == rig.A and at_bound.F_cap == rig.F_cap

@@ -366,6 +366,27 @@ def _restored(g1: dict, g0: dict, nominal_gap: dict) -> tuple[bool, bool]:
     return back, kept
 
 
+def _carry_peak_force(space: engine.Space, rig: Rig, peak_force: float) -> engine.Space:
+    """``space`` (a copy) with the actuator's size (the load term A, where the space re-fits it) narrowed to what
+    carries the records' peak measured force: its capacity F_cap, which ``apply_area`` scales with A, at least
+    ``peak_force`` (the check ``compare`` and ``diagnose`` make of a record, ``force_beyond_capacity``), or no
+    smaller than ``rig``'s where that already falls short.  The restoring re-fit weighs the force down, so nothing
+    else keeps it from shrinking the actuator below the force it measured (the May UTFSM sweep: 0.78 cm^2,
+    1.63 kN for 1.70 kN measured).  A fit that ends there is reported "at bound"."""
+    keys = [k for k, _ in space.interacting]
+    if "A" not in keys or not peak_force > 0.0 or not rig.F_cap > 0.0:
+        return space
+    out = copy.copy(space)
+    out.lo, out.hi = space.lo.copy(), space.hi.copy()
+    j = space.n_main + keys.index("A")
+    a_min = min(rig.A * peak_force / rig.F_cap, rig.A)
+    if out.rec[j]:  # fitted as 1 / A
+        out.hi[j] = min(out.hi[j], 1.0 / a_min)
+    else:
+        out.lo[j] = max(out.lo[j], a_min)
+    return out
+
+
 def restore_refit(accepted: list[Accepted], parameters: dict, current: Rig, nominal_gap: dict, tau: float,
                   cases: list[Case], x0s, sims: list, rnd: int, ctx: Context
                   ) -> tuple[JointRefit | None, JointModel | None]:
@@ -379,7 +400,8 @@ def restore_refit(accepted: list[Accepted], parameters: dict, current: Rig, nomi
     likelihoods, where a force channel far from its floor outvotes the displacement.  The first weight whose fit
     brings every channel back to no worse than the nominal's while keeping, on each channel the effects improved,
     at least half of what they closed there, is kept, whatever the BIC (which that same weighting decides); a
-    weight that gives more back ends the search (a smaller one gives back more).  (None, None) when not tried."""
+    weight that gives more back ends the search (a smaller one gives back more).  The actuator is not shrunk below
+    what carries the records' peak force (``_carry_peak_force``).  (None, None) when not tried."""
     if ctx.mode not in LOOP.modes or not accepted:
         return None, None
     g0 = engine.gap(sims, cases)
@@ -397,6 +419,7 @@ def restore_refit(accepted: list[Accepted], parameters: dict, current: Rig, nomi
     loop_space = engine.Space(LOOP, ctx, ())
     loop0 = Accepted("loop", loop_space, loop_space.absent.copy(), loop_space.absent.copy(),
                      loop_space.absent.copy(), None)
+    acc = [dataclasses.replace(a, space=_carry_peak_force(a.space, current, ctx.peak_force)) for a in acc]
     js = engine.JointSpace([a.space for a in acc] + [loop_space], current)
     z, base_tau = _start(acc + [loop0], js, current, tau)
     rig0, tau0 = js.rig_and_tau(z, base_tau)

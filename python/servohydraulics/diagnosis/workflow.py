@@ -2,7 +2,9 @@
 confirmation by simulation-error fits and a decision (accept by BIC with
 effective sample sizes, held-out error and intervals; ambiguous; stop), greedy
 for a second and third effect, a joint re-fit of the accepted effects after each
-one from the second on, verdict."""
+one from the second on, the loop re-fits once the actuator is re-sized, the
+restoring re-fit where the model tracks a channel worse than the nominal one,
+verdict."""
 
 from __future__ import annotations
 
@@ -218,7 +220,10 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
             improves the BIC.
         joint_refit: after each effect from the second on, re-fit all
             accepted effects' parameters together (``joint.joint_refit``); kept
-            only if its BIC is not worse than the greedy fit's.
+            only if its BIC is not worse than the greedy fit's.  Also switches the
+            loop re-fits and, after the last round, the restoring re-fit
+            (``joint.restore_refit``: where the model tracks a channel worse than
+            ``rig`` did) on or off.
         dt: the controller's sample time [s] (default: each record's own).  A record sampled
             slower than the controller (a 1 kHz record of a 2 kHz rig) simulated at its own
             rate holds the command twice as long and shows a spurious command delay; with
