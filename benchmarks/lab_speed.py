@@ -274,7 +274,12 @@ def main() -> None:
     import servohydraulics as sh
 
     cases = [c.strip() for c in a.cases.split(",") if c.strip()]
-    out = {"label": a.label, "python": platform.python_version(), "cpus": os.cpu_count(),
+    import numpy
+    import scipy
+
+    # the libraries' rounding moves the fits' paths (docs/benchmarks.md, "This venv's rounding"): recorded with the row
+    out = {"label": a.label, "python": platform.python_version(), "numpy": numpy.__version__,
+           "scipy": scipy.__version__, "cpus": os.cpu_count(),
            "command": "python benchmarks/lab_speed.py " + " ".join(sys.argv[1:]), "cases": {}}
     counter = Counters()
     for case in cases:
