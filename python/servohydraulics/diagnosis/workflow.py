@@ -29,7 +29,7 @@ from ..workers import single_blas_thread
 from . import engine
 from .confirm import confirm, param_groups, param_report
 from .effects import LIBRARY, Context, check_names, interacting, nested, separating_experiment
-from .joint import joint_refit, loop_refit, loop_refit_displacement, restore_refit
+from .joint import joint_refit, loop_refit, loop_refit_displacement, restore_refit, worse_than_nominal
 from .types import Accepted, CandidateLog, Case, Fit, JointRefit, Round, Screening, Sim
 
 #: acceptance thresholds (documented in docs/diagnose.md)
@@ -574,7 +574,8 @@ def _polish_loop(setup: _Setup, state: _State, rnd: int) -> None:
 def _restore(setup: _Setup, state: _State, rnd: int) -> None:
     """After the last round: the restoring re-fit (``joint.restore_refit``) where the model tracks a channel
     worse than the nominal model; its model replaces the current one if kept."""
-    setup.bar.set_description_str("restoring re-fit")
+    if worse_than_nominal(engine.gap(state.sims, setup.cases), state.history[0][1]):  # else not tried
+        setup.bar.set_description_str("restoring re-fit")
     parameters = {e["name"]: e["parameters"] for e in state.effects}
     info, new = restore_refit(state.accepted, parameters, state.rig, state.history[0][1], state.tau, setup.cases,
                               state.x0, state.sims, rnd, _context(setup, state))
