@@ -351,13 +351,18 @@ def test_the_restoring_re_fit_gives_back_the_tracking_the_model_lost() -> None:
 def test_the_restoring_re_fit_weighs_the_other_channels_down_until_the_worse_one_is_back() -> None:
     """``joint._restored``, the rule that ends the restoring re-fit's weights: a fit is kept when every channel is
     back to no worse than the nominal's and each channel the effects improved keeps at least half of what they
-    closed there (the nominal's 80 % force gap, the model's 10 %: up to 45 % kept, 46 % not)."""
-    from servohydraulics.diagnosis.joint import _restored
+    closed there (the nominal's 80 % force gap, the model's 10 %: up to 45 % kept, 46 % not); and the channels it
+    is tried for."""
+    from servohydraulics.diagnosis.joint import _restored, worse_than_nominal
 
     nominal, model = {"displacement": 0.02, "force": 0.8}, {"displacement": 0.025, "force": 0.1}
     assert _restored({"displacement": 0.02, "force": 0.44}, model, nominal) == (True, True)
     assert _restored({"displacement": 0.02, "force": 0.46}, model, nominal) == (True, False)
     assert _restored({"displacement": 0.021, "force": 0.2}, model, nominal) == (False, True)
+    # tried for a channel more than RESTORE_MIN (2 %) above the nominal's, in displacement control only
+    assert worse_than_nominal({"displacement": 0.0205, "force": 0.1}, nominal, "displacement") == ["displacement"]
+    assert worse_than_nominal({"displacement": 0.0203, "force": 0.1}, nominal, "displacement") == []
+    assert worse_than_nominal({"displacement": 0.0205, "force": 0.1}, nominal, "force") == []
 
 
 def test_the_restoring_re_fit_keeps_an_actuator_that_carries_the_measured_force() -> None:

@@ -340,9 +340,9 @@ def loop_refit_displacement(current: Rig, nominal: Rig, tau: float, cases: list[
 
 
 #: the model tracks a channel worse than the nominal model when its gap there exceeds the nominal's by more than
-#: this share (2 %, the held-out test's ``workflow.HELDOUT_MIN``: the 208 cases of the evaluation end at most
-#: 0.02 % above the nominal on a channel, at the noise floor, while the May UTFSM sweep's diagnosed displacement
-#: ends 11 % above it)
+#: this share (2 %, as the held-out test's ``workflow.HELDOUT_MIN``: the 208 cases of the evaluation end at most
+#: 0.02 % above the nominal on a channel, at the noise floor, ``studies/restore_trigger.py``; the May UTFSM sweep's
+#: diagnosed displacement ends 11 % above it)
 RESTORE_MIN = 0.02
 #: the weights (of the squared residual) of the channels the model tracks no worse than the nominal, in turn, in
 #: the restoring re-fit: from the first that weighs them a tenth of the worse channels down, each started where
@@ -352,8 +352,15 @@ RESTORE_LAMBDAS = (0.1, 0.01, 0.001)
 RESTORE_GIVE_BACK = 0.5
 
 
-def worse_than_nominal(gap_now: dict, nominal_gap: dict) -> list[str]:
-    """The channels whose gap exceeds the nominal model's by more than ``RESTORE_MIN`` of it."""
+#: how the restoring re-fit's row of ``joint_refit`` (its ``reason``) begins
+RESTORE_HEAD = "restoring re-fit"
+
+
+def worse_than_nominal(gap_now: dict, nominal_gap: dict, mode: str) -> list[str]:
+    """The channels the restoring re-fit is tried for: in a mode it acts in (``LOOP.modes``), those whose gap
+    exceeds the nominal model's by more than ``RESTORE_MIN`` of it."""
+    if mode not in LOOP.modes:
+        return []
     return [c for c in gap_now if gap_now[c] > nominal_gap[c] * (1.0 + RESTORE_MIN)]
 
 
@@ -402,17 +409,15 @@ def restore_refit(accepted: list[Accepted], parameters: dict, current: Rig, nomi
     at least half of what they closed there, is kept, whatever the BIC (which that same weighting decides); a
     weight that gives more back ends the search (a smaller one gives back more).  The actuator is not shrunk below
     what carries the records' peak force (``_carry_peak_force``).  (None, None) when not tried."""
-    if ctx.mode not in LOOP.modes or not accepted:
-        return None, None
     g0 = engine.gap(sims, cases)
-    worse = worse_than_nominal(g0, nominal_gap)
-    if not worse:
+    worse = worse_than_nominal(g0, nominal_gap, ctx.mode)
+    if not worse or not accepted:
         return None, None
     t0 = time.time()
     k = int(sum(a.z.size for a in accepted))
     acc, held, shared = _partition(accepted)
     info = JointRefit(round=rnd, effects=tuple(a.name for a in acc) + ("loop",), superseded=tuple(held) or None)
-    head = (f"restoring re-fit (the {' and '.join(worse)} gap above the nominal model's: "
+    head = (f"{RESTORE_HEAD} (the {' and '.join(worse)} gap above the nominal model's: "
             + ", ".join(f"{100 * g0[c]:.3g} % > {100 * nominal_gap[c]:.3g} %" for c in worse) + ")")
     if shared:
         return dataclasses.replace(info, reason=f"{head}: not tried: effects share the parameter(s) {shared}"), None
@@ -449,7 +454,7 @@ def restore_refit(accepted: list[Accepted], parameters: dict, current: Rig, nomi
         if not kept:
             break
         z, x0 = res.z, res.x0
-    info = dataclasses.replace(info, nfev=nfev, gap_greedy=g0, seconds=None)
+    info = dataclasses.replace(info, nfev=nfev, gap_greedy=g0)
     if found is None:
         return dataclasses.replace(info, reason=f"{head}: no weight gives every channel back without giving back "
                                                 f"more than {RESTORE_GIVE_BACK:g} of what the effects closed ("

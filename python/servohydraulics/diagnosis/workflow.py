@@ -29,7 +29,7 @@ from ..workers import single_blas_thread
 from . import engine
 from .confirm import confirm, param_groups, param_report
 from .effects import LIBRARY, Context, check_names, interacting, nested, separating_experiment
-from .joint import joint_refit, loop_refit, loop_refit_displacement, restore_refit, worse_than_nominal
+from .joint import RESTORE_HEAD, joint_refit, loop_refit, loop_refit_displacement, restore_refit, worse_than_nominal
 from .types import Accepted, CandidateLog, Case, Fit, JointRefit, Round, Screening, Sim
 
 #: acceptance thresholds (documented in docs/diagnose.md)
@@ -574,12 +574,12 @@ def _polish_loop(setup: _Setup, state: _State, rnd: int) -> None:
 def _restore(setup: _Setup, state: _State, rnd: int) -> None:
     """After the last round: the restoring re-fit (``joint.restore_refit``) where the model tracks a channel
     worse than the nominal model; its model replaces the current one if kept."""
-    if worse_than_nominal(engine.gap(state.sims, setup.cases), state.history[0][1]):  # else not tried
-        setup.bar.set_description_str("restoring re-fit")
+    if worse_than_nominal(engine.gap(state.sims, setup.cases), state.history[0][1], setup.mode):  # else not tried
+        setup.bar.set_description_str(RESTORE_HEAD)
     parameters = {e["name"]: e["parameters"] for e in state.effects}
     info, new = restore_refit(state.accepted, parameters, state.rig, state.history[0][1], state.tau, setup.cases,
                               state.x0, state.sims, rnd, _context(setup, state))
-    _adopt(setup, state, info, new, "restoring re-fit")
+    _adopt(setup, state, info, new, RESTORE_HEAD)
 
 
 def _adopt(setup: _Setup, state: _State, info, new, label: str) -> None:
@@ -630,7 +630,7 @@ def _summary(verdict: str, effects: list, last: Round | None, joint_log: list[Jo
         j = joint_log[-1]
         if j.effects == ("loop (displacement)",):  # its reason names it and says why kept or not
             summary += f"; re-fit of {j.reason}"
-        elif j.reason and j.reason.startswith("restoring re-fit"):
+        elif j.reason and j.reason.startswith(RESTORE_HEAD):
             summary += f"; {j.reason}"
         else:
             summary += (f"; joint re-fit of {' + '.join(j.effects)}: "
