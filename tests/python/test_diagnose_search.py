@@ -173,3 +173,50 @@ def test_the_fit_on_rk4_lands_where_the_fit_on_the_pair_does(monkeypatch):
     assert np.all(np.abs(rk4.z - pair.z) <= 0.1 * sd)
     c0 = space.to_external(rk4.z)[1]
     assert abs(c0 / c0_true - 1.0) < 0.05
+
+
+def test_a_repeated_run_is_served_from_the_cache_and_equals_a_fresh_run():
+    """``engine.RUNS``: a run made again (the same rig, command, delay, initial displacement and
+    options) is the first run's arrays, read-only, and bit for bit what the core gives when asked
+    again; a different rig, delay, start or integrator is a run of its own."""
+    rig = _rig()
+    case = _case(_record(rig))
+    engine.RUNS.clear()
+    h0, m0 = engine.RUNS.hits, engine.RUNS.misses
+    a = engine.simulate_case(rig, case, 0.0, 0.0, search=True)
+    b = engine.simulate_case(copy.copy(rig), case, 0.0, 0.0, search=True)  # an equal rig, another object
+    assert (engine.RUNS.hits - h0, engine.RUNS.misses - m0) == (1, 1)
+    assert b is a
+    fresh = engine.run_case(rig, case, 0.0, 0.0, search=True)
+    for c in engine.SIM_CHANNELS:
+        assert np.array_equal(a[c], fresh[c])
+        assert not a[c].flags.writeable
+        with pytest.raises(ValueError):
+            a[c][0] = 1.0
+    other = copy.copy(rig)
+    other.K_v *= 1.01
+    runs = [engine.simulate_case(other, case, 0.0, 0.0, search=True),
+            engine.simulate_case(rig, case, 1e-3, 0.0, search=True),
+            engine.simulate_case(rig, case, 0.0, 1e-4, search=True),
+            engine.simulate_case(rig, case, 0.0, 0.0, search=False),
+            engine.simulate_case(rig, case, 0.0, 0.0, options=rk4_options(4))]
+    assert engine.RUNS.hits - h0 == 1 and engine.RUNS.misses - m0 == 6
+    for r in runs:
+        assert not np.array_equal(r["force"], a["force"])
+    engine.RUNS.clear()
+
+
+def test_the_run_cache_keeps_its_byte_bound_and_diagnose_leaves_it_empty():
+    rig = _rig()
+    case = _case(_record(rig))
+    one = sum(a.nbytes for a in engine.run_case(rig, case, 0.0, 0.0, search=True).values())
+    small = engine.RunCache(max_bytes=2 * one)
+    for x0 in (0.0, 1e-5, 2e-5):
+        key = small.key(rig, case, 0.0, x0, engine.run_options(True))
+        small.put(key, engine.run_case(rig, case, 0.0, x0, search=True))
+    assert small._bytes <= 2 * one and len(small._runs) == 2
+    assert small.get(small.key(rig, case, 0.0, 0.0, engine.run_options(True)))[0] is False  # the oldest went
+    assert small.get(small.key(rig, case, 0.0, 2e-5, engine.run_options(True)))[0] is True
+    sh.diagnose([_record(rig)], rig, candidates=["viscous_damping"], max_effects=1, progress=False)
+    assert len(engine.RUNS._runs) == 0 and engine.RUNS._bytes == 0
+
