@@ -220,3 +220,25 @@ def test_the_run_cache_keeps_its_byte_bound_and_diagnose_leaves_it_empty():
     sh.diagnose([_record(rig)], rig, candidates=["viscous_damping"], max_effects=1, progress=False)
     assert len(engine.RUNS._runs) == 0 and engine.RUNS._bytes == 0
 
+
+def test_the_progress_bar_counts_the_look_alikes_it_fits(monkeypatch):
+    """The bar's total grows by the shortlist's look-alikes (keep 1: viscous damping's two look-alikes are
+    fitted too), so that its count never runs past its total."""
+    import io
+
+    from tqdm import tqdm
+
+    bars = []
+
+    def progress(total, enabled, desc):
+        bars.append(tqdm(total=total, desc=desc, file=io.StringIO(), leave=True))
+        return bars[-1]
+
+    monkeypatch.setattr(workflow, "_progress", progress)
+    rig = _rig()
+    d = sh.diagnose([_record(rig)], rig, candidates=["viscous_damping", "coulomb_friction", "lugre_friction"],
+                    keep=1, max_effects=1, progress=True)
+    fitted = sum(1 for c in d.candidates if c.delta_bic is not None)
+    assert fitted == 3  # the best screened and its two look-alikes
+    bar = bars[0]
+    assert bar.n == 3 + fitted <= bar.total == 3 + fitted

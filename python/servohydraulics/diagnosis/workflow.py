@@ -332,6 +332,9 @@ def _round(setup: _Setup, state: _State, rnd: int) -> Round:
     screened, log = _screen_all(setup, state, ctx, rnd)
     survivors = _shortlist(screened, setup.keep)
     kept = {s.name for s in survivors}
+    if len(survivors) != setup.keep:  # the bar counted keep fits: the look-alikes and the structural one add theirs
+        setup.bar.total += len(survivors) - setup.keep
+        setup.bar.refresh()
     for rank, s in enumerate(screened):
         if s.name not in kept:
             log[s.name] = dataclasses.replace(
