@@ -141,7 +141,7 @@ class RunCache:
     command delay, the initial displacement and the integrator's options (their ``repr``).  A
     diagnosis runs the same model many times over (the current model as each candidate's "absent"
     in its start's and its fits' comparisons, the search's pair in ``search_options`` and
-    ``agrees``: 396 of the 3,031 runs and 13 % of their time on the UTFSM 10 s record); a run is
+    ``agrees``: 383 of the runs of benchmarks/lab_speed.py's diagnose10, docs/benchmarks.md); a run is
     deterministic, so a repeat is served from here, the very arrays of the first (read-only).
     Least recently used runs are dropped beyond ``max_bytes``; ``clear()`` empties it (``diagnose``
     does when it returns)."""
