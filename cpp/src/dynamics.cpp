@@ -346,6 +346,19 @@ void Dynamics::rhs(const double* y, const Input& in, double* ydot) const noexcep
   actuator_rates(y, g, ydot);
 }
 
+void Dynamics::rhs_jacobian(const double* y, const Input& in, double* ydot, Jacobian& J) const noexcept {
+  Algebra g;
+  evaluate_any(y, in, g);  // the values as evaluate<0> computes them, and the gradients
+  ydot[kX] = y[kV];
+  ydot[kV] = g.a;
+  actuator_rates(y, g, ydot);
+  const int n = layout_.num_states;
+  for (int i = 0; i < n; ++i) std::fill(J[i].begin(), J[i].begin() + n, 0.0);
+  J[kX][kV] = 1.0;
+  for (int j = 0; j < n; ++j) J[kV][j] = g.da[j];
+  actuator_jacobian(g, J, nullptr);
+}
+
 void Dynamics::actuator_rates(const double* y, const Algebra& g, double* ydot) const noexcept {
   const bool actuator = mode_ != ControlMode::Free;
   ydot[kP] = actuator ? g.pdot : 0.0;
@@ -389,7 +402,10 @@ void Dynamics::jacobian_appended(const Algebra& g, Jacobian& J, State* B) const 
 
 void Dynamics::outputs(const double* y, const Input& in, Output& out, OutputGradients* grad) const noexcept {
   Algebra g;
-  evaluate_any(y, in, g);
+  if (grad)
+    evaluate_any(y, in, g);
+  else
+    evaluate<0>(y, in, g);  // the values alone (every width computes the same values)
   if (grad) {
     const bool act = mode_ != ControlMode::Free;
     auto& G = *grad;

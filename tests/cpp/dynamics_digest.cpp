@@ -4,7 +4,7 @@
 // names and scales and the kinematic driver, for every combination of the thirteen Effects
 // switches x the three control modes at fixed-seed random states and inputs, on three rigs
 // (Stribeck peak and LuGre micro-damping; the plain paper rig; no Coulomb force), plus full
-// simulations (dopri5, rk4, cvode) of the paper's rig with friction, LuGre, spring softening,
+// simulations (dopri5, rk4, cvode, ros2) of the paper's rig with friction, LuGre, spring softening,
 // specimens and the loop delay.  Not a ctest: the digest depends on the compiler and libm
 // (tanh, exp, pow); compare it before and after a change on one machine and build.
 //
@@ -265,7 +265,8 @@ int main(int argc, char** argv) {
       {"friction+mr+fluid", paper | 1024u | 4096u},
   };
   for (const Case& c : cases)
-    for (auto method : {SolverOptions::Method::Dopri5, SolverOptions::Method::Rk4, SolverOptions::Method::CvodeBdf}) {
+    for (auto method : {SolverOptions::Method::Dopri5, SolverOptions::Method::Rk4, SolverOptions::Method::CvodeBdf,
+                        SolverOptions::Method::Ros2}) {
       Rig rig = zhao2003();
       rig.stribeck_ratio = 1.4;
       rig.sigma_1 = 200.0;
@@ -274,7 +275,9 @@ int main(int argc, char** argv) {
       Hash one;
       const std::string summary = simulate(one, outputs, rig, ControlMode::Displacement, method, steps);
       std::printf("sim %-22s %-6s %016llx  %s\n", c.name, method == SolverOptions::Method::Dopri5 ? "dopri5"
-                                                       : method == SolverOptions::Method::Rk4 ? "rk4" : "cvode",
+                                                       : method == SolverOptions::Method::Rk4  ? "rk4"
+                                                       : method == SolverOptions::Method::Ros2 ? "ros2"
+                                                                                               : "cvode",
                   static_cast<unsigned long long>(one.h), summary.c_str());
       sims.i(static_cast<long long>(one.h));
     }

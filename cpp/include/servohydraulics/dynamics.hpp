@@ -43,6 +43,10 @@ class Dynamics {
   void rhs(const double* y, const Input& in, double* ydot) const noexcept;
   //! J = df/dy; if B is given, also B = df/du.
   void jacobian(const double* y, const Input& in, Jacobian& J, State* B = nullptr) const noexcept;
+  //! rhs() and jacobian() at one state from one evaluation (an implicit step needs both there):
+  //! ydot as rhs() writes it, J's first num_states() rows and columns as jacobian() writes them
+  //! (the rest of J untouched).
+  void rhs_jacobian(const double* y, const Input& in, double* ydot, Jacobian& J) const noexcept;
   void outputs(const double* y, const Input& in, Output& out, OutputGradients* grad = nullptr) const noexcept;
 
   // The actuator alone, for a rig that moves its piston by other equations (the coupled

@@ -11,6 +11,7 @@
 //   changed(a, b)                  the held input changed (a restart point for CVODE, FSAL)
 //   rhs(s, y, in, ydot)            the right-hand side
 //   jacobian(s, y, in, J)          df/dy into a dense column-major n x n array (SUNDIALS' layout)
+//   jacobian_rhs(s, y, in, J, f)   both at one state (one evaluation where the system can)
 //   tolerances(s, options, atol)   the absolute tolerances (the rig-scaled ones)
 //   checked(s), checked_values(s, y, in, v), checked_scales(s, f)
 //                                  what the checks compare (output_gap.hpp: dopri5's shadow,
@@ -52,6 +53,14 @@ struct OdeSystem<Dynamics> {
     for (int i = 0; i < n; ++i)
       for (int j = 0; j < n; ++j) J[j * n + i] = Jl[i][j];
   }
+  //! jacobian() and rhs() at one state, from one evaluation of the plant.
+  static void jacobian_rhs(const Dynamics& d, const double* y, const Input& in, double* J, double* ydot) noexcept {
+    Jacobian Jl;
+    d.rhs_jacobian(y, in, ydot, Jl);
+    const int n = d.num_states();
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) J[j * n + i] = Jl[i][j];
+  }
   static void tolerances(const Dynamics& d, const SolverOptions& o, double* atol) noexcept {
     absolute_tolerances(d, o, atol);
   }
@@ -87,6 +96,10 @@ struct OdeSystem<MultiRig> {
   static void rhs(const MultiRig& r, const double* y, const Input& in, double* ydot) noexcept { r.rhs(y, in, ydot); }
   static void jacobian(const MultiRig& r, const double* y, const Input& in, double* J) noexcept {
     r.jacobian(y, in, J, 1, r.num_states());
+  }
+  static void jacobian_rhs(const MultiRig& r, const double* y, const Input& in, double* J, double* ydot) noexcept {
+    jacobian(r, y, in, J);
+    rhs(r, y, in, ydot);
   }
   static void tolerances(const MultiRig& r, const SolverOptions& o, double* atol) noexcept {
     for (int k = 0; k < r.num_states(); ++k) atol[k] = o.rtol * o.atol_fraction * r.state_scale(k);
