@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -216,6 +217,32 @@ Stats check_dynamics(const Dynamics& dyn, sh_test::Randomizer& rnd, int wanted, 
     dyn.jacobian(d.y.data(), d.in, J, &B);
     State f;
     dyn.rhs(d.y.data(), d.in, f.data());
+    {
+      // rhs_jacobian (an implicit step's one evaluation) is rhs and jacobian to the bit, and
+      // outputs without gradients (one evaluation without them) gives the values it gives with them.
+      State f2;
+      f2.fill(7.0);
+      Jacobian J2;
+      for (auto& row : J2) row.fill(7.0);
+      dyn.rhs_jacobian(d.y.data(), d.in, f2.data(), J2);
+      bool same = std::memcmp(f.data(), f2.data(), sizeof(double) * n) == 0;
+      for (int i = 0; i < n; ++i) same = same && std::memcmp(J[i].data(), J2[i].data(), sizeof(double) * n) == 0;
+      bool untouched = true;  // the rest of J2 as it was
+      for (int i = 0; i < kMaxStates; ++i)
+        for (int j = 0; j < kMaxStates; ++j) untouched = untouched && (i < n && j < n ? true : J2[i][j] == 7.0);
+      Output with, without;
+      Dynamics::OutputGradients G;
+      dyn.outputs(d.y.data(), d.in, with, &G);
+      dyn.outputs(d.y.data(), d.in, without);
+      const double a[] = {with.displacement, with.velocity, with.acceleration, with.force, with.pressure,
+                          with.spool, with.drive, with.flow, with.specimen_force};
+      const double b[] = {without.displacement, without.velocity, without.acceleration, without.force,
+                          without.pressure, without.spool, without.drive, without.flow, without.specimen_force};
+      const bool outputs_same = std::memcmp(a, b, sizeof a) == 0 && with.flags == without.flags;
+      if (!CHECK(same && untouched && outputs_same))
+        std::printf("  %s: rhs_jacobian %s, rest of J %s, outputs %s\n", where.c_str(), same ? "same" : "DIFFERS",
+                    untouched ? "untouched" : "WRITTEN", outputs_same ? "same" : "DIFFER");
+    }
     double T[kMaxStates];
     for (int i = 0; i < n; ++i) {
       T[i] = std::fabs(f[i]) + std::fabs(B[i]) * (std::fabs(d.in.u) + su);
