@@ -293,20 +293,9 @@ void Dynamics::evaluate(const double* y, const Input& in, Algebra& g) const noex
 // Dispatch on the gradient width num_states() + 1, a compile-time constant in each case.
 template <class F>
 decltype(auto) Dynamics::at_width(F&& f) const noexcept {
-  static_assert(kCap == 17, "one case per width from kNumStates + 1 to kMaxStates + 1");
-  switch (ng_) {
-    case 7: return f(std::integral_constant<int, 7>{});
-    case 8: return f(std::integral_constant<int, 8>{});
-    case 9: return f(std::integral_constant<int, 9>{});
-    case 10: return f(std::integral_constant<int, 10>{});
-    case 11: return f(std::integral_constant<int, 11>{});
-    case 12: return f(std::integral_constant<int, 12>{});
-    case 13: return f(std::integral_constant<int, 13>{});
-    case 14: return f(std::integral_constant<int, 14>{});
-    case 15: return f(std::integral_constant<int, 15>{});
-    case 16: return f(std::integral_constant<int, 16>{});
-    default: return f(std::integral_constant<int, kCap>{});
-  }
+  static_assert(kCap == kMaxStates + 1, "the widths kNumStates + 1 .. kMaxStates + 1");
+  return detail::with_constant<kNumStates + 1, kCap - 1>(
+      ng_, f, [&] { return f(std::integral_constant<int, kCap>{}); });
 }
 
 void Dynamics::evaluate_any(const double* y, const Input& in, Algebra& g) const noexcept {
@@ -341,22 +330,22 @@ LawForce Dynamics::actuator(const double* y, const Input& in, Algebra& g) const 
 void Dynamics::rhs(const double* y, const Input& in, double* ydot) const noexcept {
   Algebra g;
   evaluate<0>(y, in, g);  // the values alone: no gradient (the same values as every width computes)
-  ydot[kX] = y[kV];
-  ydot[kV] = g.a;
-  actuator_rates(y, g, ydot);
+  rates(y, g, ydot);
 }
 
 void Dynamics::rhs_jacobian(const double* y, const Input& in, double* ydot, Jacobian& J) const noexcept {
   Algebra g;
   evaluate_any(y, in, g);  // the values as evaluate<0> computes them, and the gradients
+  rates(y, g, ydot);
+  const int n = layout_.num_states;
+  for (int i = 0; i < n; ++i) std::fill(J[i].begin(), J[i].begin() + n, 0.0);
+  jacobian_rows(g, J, nullptr);
+}
+
+void Dynamics::rates(const double* y, const Algebra& g, double* ydot) const noexcept {
   ydot[kX] = y[kV];
   ydot[kV] = g.a;
   actuator_rates(y, g, ydot);
-  const int n = layout_.num_states;
-  for (int i = 0; i < n; ++i) std::fill(J[i].begin(), J[i].begin() + n, 0.0);
-  J[kX][kV] = 1.0;
-  for (int j = 0; j < n; ++j) J[kV][j] = g.da[j];
-  actuator_jacobian(g, J, nullptr);
 }
 
 void Dynamics::actuator_rates(const double* y, const Algebra& g, double* ydot) const noexcept {
@@ -372,9 +361,14 @@ void Dynamics::actuator_rates(const double* y, const Algebra& g, double* ydot) c
 void Dynamics::jacobian(const double* y, const Input& in, Jacobian& J, State* B) const noexcept {
   Algebra g;
   evaluate_any(y, in, g);
-  const int n = layout_.num_states;
   for (auto& row : J) row.fill(0.0);
   if (B) B->fill(0.0);
+  jacobian_rows(g, J, B);
+}
+
+// Every row of J (and B) from an evaluation g; the entries they do not write are 0 on entry.
+void Dynamics::jacobian_rows(const Algebra& g, Jacobian& J, State* B) const noexcept {
+  const int n = layout_.num_states;
   J[kX][kV] = 1.0;
   for (int j = 0; j < n; ++j) J[kV][j] = g.da[j];
   if (B) (*B)[kV] = g.da[ku_];

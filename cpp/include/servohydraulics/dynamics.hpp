@@ -165,6 +165,9 @@ class Dynamics {
   template <int W>
   bool delay_drive(const double* y, Algebra& a) const noexcept;
   void jacobian_appended(const Algebra& g, Jacobian& J, State* B) const noexcept;
+  // The rates (rhs) and every row of J and B (jacobian) from an evaluation g at y.
+  void rates(const double* y, const Algebra& g, double* ydot) const noexcept;
+  void jacobian_rows(const Algebra& g, Jacobian& J, State* B) const noexcept;
   // f(law) for each law of the structure that is on, in the order of StructureLaws.
   template <class F>
   void each_law(F&& f) const {

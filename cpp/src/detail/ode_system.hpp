@@ -49,14 +49,16 @@ struct OdeSystem<Dynamics> {
   static void jacobian(const Dynamics& d, const double* y, const Input& in, double* J) noexcept {
     Jacobian Jl;
     d.jacobian(y, in, Jl);
-    const int n = d.num_states();
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; j < n; ++j) J[j * n + i] = Jl[i][j];
+    column_major(d, Jl, J);
   }
   //! jacobian() and rhs() at one state, from one evaluation of the plant.
   static void jacobian_rhs(const Dynamics& d, const double* y, const Input& in, double* J, double* ydot) noexcept {
     Jacobian Jl;
     d.rhs_jacobian(y, in, ydot, Jl);
+    column_major(d, Jl, J);
+  }
+  //! The active n x n of Jl into J, column-major.
+  static void column_major(const Dynamics& d, const Jacobian& Jl, double* J) noexcept {
     const int n = d.num_states();
     for (int i = 0; i < n; ++i)
       for (int j = 0; j < n; ++j) J[j * n + i] = Jl[i][j];

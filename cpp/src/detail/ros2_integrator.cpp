@@ -1,18 +1,18 @@
 #include "detail/ros2_integrator.hpp"
 
 #include <cmath>
-#include <type_traits>
 #include <utility>
 
+#include "detail/math.hpp"
 #include "servohydraulics/multi_rig.hpp"
 
 namespace servohydraulics::detail {
 
 namespace {
-// The matrix size m: an int, or std::integral_constant<int, M> for the sizes the plants have
-// (ros2's every substep factors W: with m known at compile time the loops unroll, about half the
-// instructions of a run on the UTFSM rig).  The same operations on each element in the same order
-// either way: the results are the same to the bit.
+// The matrix size m: an int, or std::integral_constant<int, M> for the single actuator's sizes
+// (every ROS2 substep factors W, and the LU and its two solves are about half of a ROS2 run's
+// instructions on the UTFSM rig: with m known at compile time their loops unroll).  The same
+// operations on each element in the same order either way: the results are the same to the bit.
 //
 // In-place LU with partial pivoting of the m x m column-major a (leading dimension m): P a = L U,
 // the unit lower L below the diagonal, U on and above it; piv[k] is the row swapped with row k at
@@ -65,21 +65,7 @@ void lu_solve(const double* a, Size size, const int* piv, double* b) noexcept {
 // f(m) otherwise (a multi-actuator rig).
 template <class F>
 void at_size(int m, F&& f) {
-  static_assert(kNumStates == 6 && kMaxStates == 16, "one case per size");
-  switch (m) {
-    case 6: return f(std::integral_constant<int, 6>{});
-    case 7: return f(std::integral_constant<int, 7>{});
-    case 8: return f(std::integral_constant<int, 8>{});
-    case 9: return f(std::integral_constant<int, 9>{});
-    case 10: return f(std::integral_constant<int, 10>{});
-    case 11: return f(std::integral_constant<int, 11>{});
-    case 12: return f(std::integral_constant<int, 12>{});
-    case 13: return f(std::integral_constant<int, 13>{});
-    case 14: return f(std::integral_constant<int, 14>{});
-    case 15: return f(std::integral_constant<int, 15>{});
-    case 16: return f(std::integral_constant<int, 16>{});
-    default: return f(m);
-  }
+  with_constant<kNumStates, kMaxStates>(m, f, [&] { f(m); });
 }
 }  // namespace
 
