@@ -58,6 +58,19 @@ def test_decide_nested_candidates_are_never_ambiguous() -> None:
     assert "passed, but BIC improvement" in rows["lugre_friction"].rejection
 
 
+def test_decide_says_why_a_larger_bic_improvement_lost_on_common_sample_sizes() -> None:
+    # a (smooth residual: n_eff 100) gains more on its own sample sizes than b (white: 1000), but b's misfit is
+    # lower: on the common (smaller) sizes b wins, and a's reason must say so, not claim 60 < 40
+    a, b = _passing("mr_damper", 100.0, 60.0), _passing("lugre_friction", 90.0, 40.0)
+    a.fit.neff[KEY] = 100.0
+    rnd = workflow._decide(1, [b, a], _log("mr_damper", "lugre_friction"), {})
+    assert rnd.outcome == "accept" and rnd.best_name == "lugre_friction"
+    reason = {row.name: row for row in rnd.log}["mr_damper"].rejection
+    lower = 100.0 * math.log(100.0 / 90.0)  # the same k: the penalties cancel
+    assert "common to both" in reason and f"lower by {lower:.1f}" in reason and "60.0" in reason
+    assert "< lugre_friction" not in reason
+
+
 def test_decide_clear_winner_and_nothing_passing() -> None:
     a, b = _passing("viscous_damping", 100.0, 40.0), _passing("leakage", 110.0, 20.0)
     rnd = workflow._decide(2, [b, a], _log("viscous_damping", "leakage"), {})

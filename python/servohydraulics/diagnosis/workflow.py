@@ -496,10 +496,22 @@ def _decide(rnd: int, passing: list[_Passing], log: dict, stats: dict) -> Round:
         return _ambiguous(rnd, passing, log, fit_gap)
     log[best.name] = dataclasses.replace(log[best.name], accepted=True)
     for p in passing[1:]:
-        log[p.name] = dataclasses.replace(log[p.name], rejection=(
-            f"passed, but BIC improvement {p.fit.dbic:.1f} < {best.name}'s {best.fit.dbic:.1f}"))
+        log[p.name] = dataclasses.replace(log[p.name], rejection=_behind(p, best))
     return Round(rnd, "accept", tuple(log.values()), best=best.fit, best_name=best.name,
                  signature=best.screening.signature)
+
+
+def _behind(p: _Passing, best: _Passing) -> str:
+    """Why a passing candidate is not the one accepted.  Each BIC improvement is counted on the candidate's own
+    effective sample sizes; where ``p``'s is the larger, ``best`` won the comparison on the sizes common to both
+    (``_runner_up``), and the reason says that rather than claim an order the two numbers do not have."""
+    if p.fit.dbic < best.fit.dbic:
+        return f"passed, but BIC improvement {p.fit.dbic:.1f} < {best.name}'s {best.fit.dbic:.1f}"
+    ne = {k: min(p.fit.neff[k], best.fit.neff[k]) for k in p.fit.neff}
+    lower = engine.bic(p.fit.stats, p.fit.z.size, ne) - engine.bic(best.fit.stats, best.fit.z.size, ne)
+    return (f"passed (BIC improvement {p.fit.dbic:.1f} on its own effective sample sizes, {best.name}'s "
+            f"{best.fit.dbic:.1f} on its own), but on the effective sample sizes common to both {best.name}'s BIC "
+            f"is lower by {lower:.1f}")
 
 
 def _runner_up(passing: list[_Passing]) -> tuple[list[_Passing], float]:
