@@ -221,6 +221,34 @@ def test_the_run_cache_keeps_its_byte_bound_and_diagnose_leaves_it_empty():
     assert len(engine.RUNS._runs) == 0 and engine.RUNS._bytes == 0
 
 
+def test_a_diagnosis_that_returns_leaves_the_runs_of_one_still_running():
+    """Two diagnoses on two threads: the one that returns first must not empty the cache under the other (its
+    runs would be made again: time, not results); the last one to return empties it."""
+    import threading
+
+    rig = _rig()
+    case = _case(_record(rig))
+    key = engine.RUNS.key(rig, case, 0.0, 0.0, engine.run_options(True))
+    inside, leave = threading.Event(), threading.Event()
+
+    def long_running():
+        with engine.RUNS.session():
+            engine.RUNS.put(key, engine.run_case(rig, case, 0.0, 0.0, search=True))
+            inside.set()
+            leave.wait(60)
+
+    t = threading.Thread(target=long_running)
+    t.start()
+    try:
+        assert inside.wait(60)
+        sh.diagnose([_record(rig)], rig, candidates=["viscous_damping"], max_effects=1, progress=False)
+        assert engine.RUNS.get(key)[0] is True  # the other's run is still served
+    finally:
+        leave.set()
+        t.join(60)
+    assert len(engine.RUNS._runs) == 0 and engine.RUNS._bytes == 0  # the last one out emptied it
+
+
 def test_the_progress_bar_counts_the_look_alikes_it_fits(monkeypatch):
     """The bar's total grows by the shortlist's look-alikes (keep 1: viscous damping's two look-alikes are
     fitted too), so that its count never runs past its total."""

@@ -11,6 +11,7 @@ statistics (``stats``: AR(1) effective samples and the one HAC covariance rule).
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
@@ -143,8 +144,9 @@ class RunCache:
     in its start's and its fits' comparisons, the search's pair in ``search_options`` and
     ``agrees``: 383 of the runs of benchmarks/lab_speed.py's diagnose10, docs/benchmarks.md); a run is
     deterministic, so a repeat is served from here, the very arrays of the first (read-only).
-    Least recently used runs are dropped beyond ``max_bytes``; ``clear()`` empties it (``diagnose``
-    does when it returns)."""
+    Least recently used runs are dropped beyond ``max_bytes``; ``clear()`` empties it.  ``diagnose``
+    runs inside ``session()``, which empties it when the last of the diagnoses running at the time
+    (on other threads: a lab's sweep of records) returns, not under one still running."""
 
     def __init__(self, max_bytes: int = 256 * 2 ** 20) -> None:
         import threading
@@ -155,6 +157,7 @@ class RunCache:
         self._bytes = 0
         self._lock = threading.Lock()
         self.hits = self.misses = 0
+        self._sessions = 0
 
     @staticmethod
     def key(rig: Rig, case: Case, tau: float, x0: float, options) -> tuple:
@@ -193,6 +196,21 @@ class RunCache:
         with self._lock:
             self._runs.clear()
             self._bytes = 0
+
+    @contextmanager
+    def session(self):
+        """The runs of one diagnosis: on leaving the last open session the cache is emptied (its runs are those
+        diagnoses'; a later one on other records would not hit them)."""
+        with self._lock:
+            self._sessions += 1
+        try:
+            yield self
+        finally:
+            with self._lock:
+                self._sessions -= 1
+                if self._sessions == 0:
+                    self._runs.clear()
+                    self._bytes = 0
 
 
 #: the runs of the diagnosis (``RunCache``)

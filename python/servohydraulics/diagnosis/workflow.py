@@ -236,17 +236,15 @@ def diagnose(records, rig: Rig, mode: str = "displacement", progress: bool = Tru
     Returns:
         A ``Diagnosis`` (``.write(dir)`` writes diagnosis.json, rig_updated.toml, report.md).
     """
-    try:
+    with engine.RUNS.session():  # emptied when the last diagnosis running at the time returns
         return _diagnose(records, rig, mode, progress, keep, max_effects, candidates, refit_interacting, joint_refit,
                          dt, layout, accept)
-    finally:
-        engine.RUNS.clear()  # its runs are this diagnosis' (a later one on other records would not hit them)
 
 
 def _diagnose(records, rig: Rig, mode: str, progress: bool, keep: int, max_effects: int,
               candidates: Sequence[str] | None, refit_interacting: bool, joint_refit: bool, dt: float | None, layout,
               accept) -> Diagnosis:
-    """``diagnose``'s work (``diagnose`` clears the runs' cache after it)."""
+    """``diagnose``'s work (inside ``engine.RUNS.session()``, which empties the runs' cache after it)."""
     t_start = time.time()
     recs = as_records(records, layout)
     if mode not in MODES:
