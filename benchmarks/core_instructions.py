@@ -16,6 +16,13 @@ record), ROS2 at 16 substeps (the diagnosis' stiff fits) and the error-controlle
 (the search's reference).  Each case also prints a digest of the run's channels, so that a change
 that should leave the results as they were can be seen to.
 
+``--evaluations`` counts instead what one evaluation of the plant's model costs: instructions per call
+of ``Dynamics::rhs`` (the right-hand side) and ``Dynamics::jacobian`` (its analytic Jacobian by the
+core's forward-mode derivatives, every state at once), each called ``--calls`` times from Python at
+the states and commands of the 0 A rig's RK4 x4 run of the record's first samples (that run made
+before the counted child starts).  These are the unit costs of a cost model of forward sensitivities
+against difference columns (docs/benchmarks.md, lab speed).
+
 Needs valgrind (``apt-get install valgrind``); a case takes 10-60 s.  Which core is counted: the one
 ``import servohydraulics`` finds (``SERVOHYDRAULICS_CORE_DIR`` selects a build folder).
 """
@@ -61,6 +68,61 @@ h = hashlib.blake2b(b"".join(np.ascontiguousarray(channels[c][: s.rows]).tobytes
 print("digest", h, "rows", s.rows)
 """
 
+EVAL_CHILD = r"""
+import sys
+import numpy as np
+import servohydraulics as sh
+from servohydraulics import _core
+rig_file, states_file = sys.argv[1], sys.argv[2]
+data = np.load(states_file)
+dyn = _core.Dynamics(sh.load_rig(rig_file), _core.ControlMode.Displacement)
+for y, v in zip(data["states"].tolist(), data["inputs"].tolist()):
+    dyn.{what}(y, v)
+print("states", data["states"].shape[1])
+"""
+
+
+def run_states(calls: int, path: Path) -> None:
+    """The plant's states and inputs at the first ``calls`` samples of the 0 A rig's RK4 x4 run, saved to ``path``
+    (made here, not in the counted child: the run's own right-hand sides would be counted)."""
+    import numpy as np
+
+    import servohydraulics as sh
+    from servohydraulics.records import read_record
+    from servohydraulics.simulate import make_plant, solver_options
+
+    rec = read_record(DATA / "chirp20Hz_0A.csv")
+    u = np.asarray(rec.channels["command"], float)[:calls]
+    rig = sh.load_rig(ROOT / "evaluation" / "utfsm_rig_0A.toml")
+    plant = make_plant(rig, "displacement", rec.dt, solver_options(method="rk4", rk4_substeps=4, rk4_flag_rtol=0.0))
+    states = []
+    for v in u:
+        plant.step(float(v))
+        states.append(np.asarray(plant.state, float))
+    np.savez(path, states=np.array(states), inputs=u)
+
+
+#: the plant's evaluations --evaluations counts (the Python name; the C++ symbol callgrind toggles on)
+EVALUATIONS = (("rhs", "servohydraulics::Dynamics::rhs(*"), ("jacobian", "servohydraulics::Dynamics::jacobian(*"))
+
+
+def count_evaluation(what: str, symbol: str, calls: int) -> dict:
+    """Instructions per call of one of the plant's evaluations (``EVALUATIONS``)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out, states = Path(tmp) / "callgrind.out", Path(tmp) / "states.npz"
+        run_states(calls, states)
+        cmd = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", "--collect-atstart=no",
+               f"--toggle-collect={symbol}", sys.executable, "-c", EVAL_CHILD.replace("{what}", what),
+               str(ROOT / "evaluation" / "utfsm_rig_0A.toml"), str(states)]
+        proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+        collected = re.search(r"Collected : (\d+)", proc.stderr)
+        states = re.search(r"states (\d+)", proc.stdout)
+        if proc.returncode != 0 or not collected or not states:
+            raise SystemExit(f"{what}: the child failed (exit {proc.returncode}):\n{proc.stderr[-2000:]}")
+    n = int(collected.group(1))
+    return {"evaluation": what, "calls": calls, "instructions": n, "per_call": n / calls,
+            "states": int(states.group(1))}
+
 
 def count(rig: str, method: str, samples: int) -> dict:
     """Instructions inside ``run_record`` and the digest of the run's channels."""
@@ -84,6 +146,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--samples", type=int, default=6000, help="samples of the record to run (default 6000)")
     ap.add_argument("--json", help="append the rows to this JSON file under --label")
     ap.add_argument("--label", default="run", help="the rows' label in --json")
+    ap.add_argument("--evaluations", action="store_true",
+                    help="count instructions per call of the plant's rhs and jacobian instead of record runs")
+    ap.add_argument("--calls", type=int, default=2000, help="calls of each evaluation (--evaluations; default 2000)")
     args = ap.parse_args(argv)
     if shutil.which("valgrind") is None:
         raise SystemExit("valgrind is not installed (apt-get install valgrind)")
@@ -92,8 +157,15 @@ def main(argv: list[str] | None = None) -> int:
                          "real-data/")
     if args.samples < 100:
         raise SystemExit(f"invalid --samples = {args.samples}: at least 100")
+    if args.evaluations and args.calls < 100:
+        raise SystemExit(f"invalid --calls = {args.calls}: at least 100")
     rows = []
-    for rig, method in CASES:
+    for what, symbol in (EVALUATIONS if args.evaluations else ()):
+        row = count_evaluation(what, symbol, args.calls)
+        rows.append(row)
+        print(f"{what:10s} {row['per_call']:>9,.0f} instructions per call ({row['calls']} calls, "
+              f"{row['states']} states)", flush=True)
+    for rig, method in (() if args.evaluations else CASES):
         row = count(rig, method, args.samples)
         rows.append(row)
         print(f"{rig:16s} {method:10s} {row['instructions']:>13,d} instructions ({row['per_sample']:,.0f} per sample)"
