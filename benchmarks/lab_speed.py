@@ -43,8 +43,6 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
-import numpy as np
-
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(os.environ.get("SH_SHARED_DIR", ROOT.parent / "shared")) / "real-data" / "utfsm-mts-mrdamper"
 CASES = ("identify", "diagnose10", "diagnose10sim", "sweep1A")
@@ -133,17 +131,11 @@ def instrumented(counter: Counters):
 
 
 def _record(name: str, end: float | None = None):
-    from servohydraulics.records import Record, read_record
+    """The UTFSM record ``name`` (its first ``end`` seconds, or all of it): evaluation/utfsm_diagnose.py's reader."""
+    sys.path.insert(0, str(ROOT / "evaluation"))
+    from utfsm_diagnose import _record as utfsm_record
 
-    path = DATA / f"{name}.csv"
-    if not path.exists():
-        raise SystemExit(f"record {path} is absent: the UTFSM data live in ../shared/real-data (its README); "
-                         "set SH_SHARED_DIR to the folder that holds real-data/")
-    rec = read_record(path)
-    if end is None:
-        return rec
-    n = int(round(end / rec.dt)) + 1
-    return Record({k: np.asarray(v)[:n] for k, v in rec.channels.items()})
+    return utfsm_record(name, end)
 
 
 def _simulated_record():

@@ -11,9 +11,9 @@ difference columns on the fit's threads), its integrator choice and checks (``>s
 ``>agrees``), the screening, the initial displacements, the loop and joint re-fits, the restoring re-fit.
 For each step: the runs, their summed thread time and share, and the integrators they ran on (the
 search's error-controlled pair, RK4 or ROS2 at n substeps); then the same with each step's integrator
-choice and checks folded into it.  The runs served by the diagnosis' run cache
-(``engine.RUNS``) are not runs of the core and are counted apart.  The thread times add up to more than
-the wall time on two cores.
+choice and checks folded into it; then the runs and thread time by integrator.  The runs served by
+the diagnosis' run cache (``engine.RUNS``) are not runs of the core and are counted apart.  The thread
+times add up to more than the wall time on two cores.
 """
 
 from __future__ import annotations
@@ -43,6 +43,7 @@ class Attribution:
         self.lock = threading.Lock()
         self.rows: dict = collections.defaultdict(lambda: {"runs": 0, "seconds": 0.0,
                                                            "integrators": collections.Counter()})
+        self.by_integrator: dict = collections.defaultdict(lambda: [0, 0.0])  # integrator -> [runs, seconds]
         self.saved: list = []
 
     def label(self) -> str:
@@ -89,6 +90,8 @@ class Attribution:
                     row["runs"] += 1
                     row["seconds"] += dt
                     row["integrators"][how] += 1
+                    self.by_integrator[how][0] += 1
+                    self.by_integrator[how][1] += dt
         self._patch(engine, "simulate_command", run)
         inner_workers = engine.workers
 
@@ -168,10 +171,15 @@ def main(argv=None) -> int:
     print("\n| step (its integrator choice and checks included) | runs | thread time [s] | share |\n|---|---|---|---|")
     for name, (n, sec) in sorted(folded.items(), key=lambda kv: -kv[1][1]):
         print(f"| {name} | {n} | {sec:.1f} | {100 * sec / total:.1f} % |")
+    print("\n| integrator | runs | thread time [s] | share | per run [s] |\n|---|---|---|---|---|")
+    integrators = []
+    for how, (n, sec) in sorted(att.by_integrator.items(), key=lambda kv: -kv[1][1]):
+        print(f"| {how} | {n} | {sec:.1f} | {100 * sec / total:.1f} % | {sec / n:.3f} |")
+        integrators.append({"integrator": how, "runs": n, "seconds": sec})
     if args.json:
         args.json.write_text(json.dumps({"record": args.record, "end_s": args.end, "wall_s": wall, "cpu_s": cpu,
                                          "runs": runs, "run_seconds": total, "cache_hits": hits, "result": s,
-                                         "steps": table}, indent=1, default=str) + "\n")
+                                         "steps": table, "integrators": integrators}, indent=1, default=str) + "\n")
     return 0
 
 
