@@ -106,39 +106,43 @@ def run_states(calls: int, path: Path) -> None:
 EVALUATIONS = (("rhs", "servohydraulics::Dynamics::rhs(*"), ("jacobian", "servohydraulics::Dynamics::jacobian(*"))
 
 
+def callgrind(symbol: str, args: list[str]) -> tuple[int, str]:
+    """Instructions counted inside the C++ functions matching ``symbol`` (and what they call) while
+    ``python args`` runs under callgrind, and the child's standard output."""
+    with tempfile.TemporaryDirectory() as tmp:
+        cmd = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={Path(tmp) / 'callgrind.out'}",
+               "--collect-atstart=no", f"--toggle-collect={symbol}", sys.executable, *args]
+        proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    collected = re.search(r"Collected : (\d+)", proc.stderr)
+    if proc.returncode != 0 or not collected:
+        raise SystemExit(f"{' '.join(args[2:])}: the child failed (exit {proc.returncode}):\n{proc.stderr[-2000:]}")
+    return int(collected.group(1)), proc.stdout
+
+
 def count_evaluation(what: str, symbol: str, calls: int) -> dict:
     """Instructions per call of one of the plant's evaluations (``EVALUATIONS``)."""
     with tempfile.TemporaryDirectory() as tmp:
-        out, states = Path(tmp) / "callgrind.out", Path(tmp) / "states.npz"
-        run_states(calls, states)
-        cmd = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", "--collect-atstart=no",
-               f"--toggle-collect={symbol}", sys.executable, "-c", EVAL_CHILD.replace("{what}", what),
-               str(ROOT / "evaluation" / "utfsm_rig_0A.toml"), str(states)]
-        proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
-        collected = re.search(r"Collected : (\d+)", proc.stderr)
-        states = re.search(r"states (\d+)", proc.stdout)
-        if proc.returncode != 0 or not collected or not states:
-            raise SystemExit(f"{what}: the child failed (exit {proc.returncode}):\n{proc.stderr[-2000:]}")
-    n = int(collected.group(1))
+        states_file = Path(tmp) / "states.npz"
+        run_states(calls, states_file)
+        n, stdout = callgrind(symbol, ["-c", EVAL_CHILD.replace("{what}", what),
+                                       str(ROOT / "evaluation" / "utfsm_rig_0A.toml"), str(states_file)])
+    states = re.search(r"states (\d+)", stdout)
+    if not states:
+        raise SystemExit(f"{what}: the child printed no state count:\n{stdout[-2000:]}")
     return {"evaluation": what, "calls": calls, "instructions": n, "per_call": n / calls,
             "states": int(states.group(1))}
 
 
 def count(rig: str, method: str, samples: int) -> dict:
     """Instructions inside ``run_record`` and the digest of the run's channels."""
-    with tempfile.TemporaryDirectory() as tmp:
-        out = Path(tmp) / "callgrind.out"
-        cmd = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", "--collect-atstart=no",
-               "--toggle-collect=servohydraulics::run_record*", sys.executable, "-c", CHILD,
-               str(DATA / "chirp20Hz_0A.csv"), str(ROOT / "evaluation" / "utfsm_rig_0A.toml"), rig, method,
-               str(samples)]
-        proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
-        collected = re.search(r"Collected : (\d+)", proc.stderr)
-        digest = re.search(r"digest (\w+) rows (\d+)", proc.stdout)
-        if proc.returncode != 0 or not collected or not digest:
-            raise SystemExit(f"{rig} / {method}: the child failed (exit {proc.returncode}):\n{proc.stderr[-2000:]}")
-    return {"rig": rig, "method": method, "samples": samples, "instructions": int(collected.group(1)),
-            "per_sample": int(collected.group(1)) / samples, "digest": digest.group(1), "rows": int(digest.group(2))}
+    n, stdout = callgrind("servohydraulics::run_record*",
+                          ["-c", CHILD, str(DATA / "chirp20Hz_0A.csv"), str(ROOT / "evaluation" / "utfsm_rig_0A.toml"),
+                           rig, method, str(samples)])
+    digest = re.search(r"digest (\w+) rows (\d+)", stdout)
+    if not digest:
+        raise SystemExit(f"{rig} / {method}: the child printed no digest:\n{stdout[-2000:]}")
+    return {"rig": rig, "method": method, "samples": samples, "instructions": n,
+            "per_sample": n / samples, "digest": digest.group(1), "rows": int(digest.group(2))}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -132,7 +132,8 @@ def instrumented(counter: Counters):
 
 def _record(name: str, end: float | None = None):
     """The UTFSM record ``name`` (its first ``end`` seconds, or all of it): evaluation/utfsm_diagnose.py's reader."""
-    sys.path.insert(0, str(ROOT / "evaluation"))
+    if str(ROOT / "evaluation") not in sys.path:
+        sys.path.insert(0, str(ROOT / "evaluation"))
     from utfsm_diagnose import _record as utfsm_record
 
     return utfsm_record(name, end)

@@ -194,8 +194,11 @@ class RunCache:
 
     def clear(self) -> None:
         with self._lock:
-            self._runs.clear()
-            self._bytes = 0
+            self._empty()
+
+    def _empty(self) -> None:  # the caller holds the lock
+        self._runs.clear()
+        self._bytes = 0
 
     @contextmanager
     def session(self):
@@ -209,8 +212,7 @@ class RunCache:
             with self._lock:
                 self._sessions -= 1
                 if self._sessions == 0:
-                    self._runs.clear()
-                    self._bytes = 0
+                    self._empty()
 
 
 #: the runs of the diagnosis (``RunCache``)

@@ -505,8 +505,8 @@ def _behind(p: _Passing, best: _Passing) -> str:
     (``_runner_up``), and the reason says that rather than claim an order the two numbers do not have."""
     if p.fit.dbic < best.fit.dbic:
         return f"passed, but BIC improvement {p.fit.dbic:.1f} < {best.name}'s {best.fit.dbic:.1f}"
-    ne = {k: min(p.fit.neff[k], best.fit.neff[k]) for k in p.fit.neff}
-    lower = engine.bic(p.fit.stats, p.fit.z.size, ne) - engine.bic(best.fit.stats, best.fit.z.size, ne)
+    bic_p, bic_best = _common_bic(p.fit, best.fit)
+    lower = bic_p - bic_best
     return (f"passed (BIC improvement {p.fit.dbic:.1f} on its own effective sample sizes, {best.name}'s "
             f"{best.fit.dbic:.1f} on its own), but on the effective sample sizes common to both {best.name}'s BIC "
             f"is lower by {lower:.1f}")
@@ -517,11 +517,18 @@ def _runner_up(passing: list[_Passing]) -> tuple[list[_Passing], float]:
     to both (per channel the smaller of the two): the runner-up goes first if it
     wins there; and their misfits' (-2 log L, no parameter penalty) difference."""
     a, b = passing[0].fit, passing[1].fit
-    ne = {k: min(a.neff[k], b.neff[k]) for k in a.neff}
-    fa, fb = engine.bic(a.stats, 0, ne), engine.bic(b.stats, 0, ne)
-    if engine.bic(b.stats, b.z.size, ne) < engine.bic(a.stats, a.z.size, ne):
+    fa, fb = _common_bic(a, b, penalty=False)
+    bic_a, bic_b = _common_bic(a, b)
+    if bic_b < bic_a:
         passing = [passing[1], passing[0]] + passing[2:]
     return passing, abs(fb - fa)
+
+
+def _common_bic(a: Fit, b: Fit, penalty: bool = True) -> tuple[float, float]:
+    """The BICs of two fits on the effective sample sizes common to both (per channel the smaller), with each
+    fit's parameter penalty or (``penalty`` False) its misfit alone."""
+    ne = {k: min(a.neff[k], b.neff[k]) for k in a.neff}
+    return (engine.bic(a.stats, a.z.size if penalty else 0, ne), engine.bic(b.stats, b.z.size if penalty else 0, ne))
 
 
 def _ambiguous(rnd: int, passing: list[_Passing], log: dict, fit_gap: float) -> Round:
