@@ -137,7 +137,8 @@ void expose_plant(py::module_& m) {
       .value("TooMuchWork", Status::TooMuchWork)
       .value("NonFinite", Status::NonFinite)
       .value("NotReady", Status::NotReady)
-      .value("Stiff", Status::Stiff);
+      .value("Stiff", Status::Stiff)
+      .value("Chatter", Status::Chatter);
   st.def_readonly("code", &Status::code)
       .def_readonly("cvode_flag", &Status::cvode_flag)
       .def_readonly("t", &Status::t)

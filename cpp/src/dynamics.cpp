@@ -25,6 +25,7 @@ Dynamics::Dynamics(const Rig& rig, ControlMode mode) : rig_(rig), mode_(mode) {
   wv_ = 2.0 * kPi * rig_.f_v;
   std::apply([&](auto&... law) { ((law = std::decay_t<decltype(law)>::value_type::from(rig_, mode_)), ...); },
              laws_);
+  coulomb_ = ExactCoulomb::from(rig_, mode_);
   // The elements' states are appended in the order of Elements, each only when it is on.
   int n = kNumStates;
   std::size_t idx = 0;
@@ -106,9 +107,11 @@ double Dynamics::spring_stiffness(double x) const noexcept { return law<Spring>(
 double Dynamics::friction_level(double v) const noexcept { return StribeckLevel::of(rig_).at(v).level; }
 double Dynamics::friction_level_slope(double v) const noexcept { return StribeckLevel::of(rig_).at(v).slope; }
 double Dynamics::friction_force(double v) const noexcept {
+  if (coulomb_) return v == 0.0 ? 0.0 : coulomb_->at(v, v > 0.0 ? Sliding::Up : Sliding::Down, 0.0).F;
   return TanhFriction::acts(rig_) ? TanhFriction::of(rig_).at(v).F : 0.0;
 }
 double Dynamics::friction_slope(double v) const noexcept {
+  if (coulomb_) return v == 0.0 ? 0.0 : coulomb_->at(v, v > 0.0 ? Sliding::Up : Sliding::Down, 0.0).dF_dv;
   return TanhFriction::acts(rig_) ? TanhFriction::of(rig_).at(v).dF_dv : 0.0;
 }
 double Dynamics::flow_gain(double s) const noexcept {
@@ -148,7 +151,20 @@ double Dynamics::structure_force(double x, double v, double z) const noexcept {
   Algebra g;
   double F = kNoStaticForce;
   each_law([&](const auto& law) { F += law.eval(y, g).F; });
+  if (coulomb_ && v != 0.0) F += friction_force(v);  // stuck (v = 0) it holds whatever acts: not a function of x, v
   return F;
+}
+
+double Dynamics::held_force(const double* y, const Input& in) const noexcept {
+  if (!coulomb_) return 0.0;
+  Algebra g;
+  g.zero<0>();
+  structure<0>(y, in, g);
+  return g.held;
+}
+
+Sliding Dynamics::sliding(const double* y, const Input& in) const noexcept {
+  return coulomb_ ? coulomb_->mode(y[kV], held_force(y, in)) : Sliding::Auto;
 }
 
 // The structure elements (specimens in parallel with the structure): their force and state rates.
@@ -188,8 +204,22 @@ void Dynamics::structure(const double* y, const Input& in, Algebra& g) const noe
     laws.dF_dz += f.dF_dz;
   });
   if (specimen_on_) specimen<W>(y, g);
+  // The exact Coulomb law last: stuck, it holds the sum of the others (the acceleration is 0).
+  Sliding sliding = Sliding::Auto;
+  if (coulomb_) {
+    g.held = specimen_on_ ? net - g.Fsp : net;
+    sliding = in.sliding == Sliding::Auto ? coulomb_->mode(y[kV], g.held) : in.sliding;
+    const LawForce f = coulomb_->at(y[kV], sliding, g.held);
+    net -= f.F;
+    laws.dF_dv += f.dF_dv;
+  }
   g.a = specimen_on_ ? (net - g.Fsp) / M_ : net / M_;
+  if (sliding == Sliding::Stuck) g.a = 0.0;  // not held - held's rounding
   if constexpr (W == 0) return;  // the values alone (rhs)
+  if (sliding == Sliding::Stuck) {  // v stays 0 whatever the other states do
+    for (int j = 0; j < W; ++j) g.da[j] = 0.0;
+    return;
+  }
   if (!specimen_on_) {
     g.da[kX] = -laws.dF_dx / M_;
     g.da[kV] = -laws.dF_dv / M_;

@@ -117,7 +117,29 @@ struct Plant::Impl {
   }
 
   // Integrate from t to t_end with input `in`; RK4 and ROS2 take `substeps` (0: their own count).
+  // With the exact Coulomb law, stretch by stretch in one sliding mode (advance_sliding).
   Status advance(const Dynamics::Input& in, double t_end, int substeps) noexcept {
+    return dyn.exact_coulomb() ? advance_sliding(in, t_end, substeps) : integrate(in, t_end, substeps);
+  }
+  Status advance_sliding(Dynamics::Input in, double t_end, int substeps) noexcept;
+  // How far the stretch in mode in.sliding is from its end (>= 0 inside, < 0 past it): the velocity
+  // sliding up, minus it sliding down, the static level less the held force stuck.
+  double switch_margin(const Dynamics::Input& in) const noexcept {
+    switch (in.sliding) {
+      case Sliding::Up: return y[kV];
+      case Sliding::Down: return -y[kV];
+      default: return dyn.exact_coulomb()->static_level() - std::fabs(dyn.held_force(y.data(), in));
+    }
+  }
+  // A stuck stretch's state has v = 0 exactly (the law's; an implicit solve leaves rounding there).
+  void hold_stuck(const Dynamics::Input& in) noexcept {
+    if (in.sliding == Sliding::Stuck) y[kV] = 0.0;
+  }
+  // The integrator goes on from y at t (set from outside), its counters running on.
+  void restart() noexcept {
+    std::visit([&](auto& integ) { integ.restart(y, t); }, integ);
+  }
+  Status integrate(const Dynamics::Input& in, double t_end, int substeps) noexcept {
     return std::visit(
         [&](auto& integ) {
           using T = std::decay_t<decltype(integ)>;
@@ -181,6 +203,100 @@ void Plant::reset_state(const State& y0, double t0) {
   m.record_measurements();
 }
 
+namespace {
+// The work and the flags of `part`, a piece of the same sample, added to `st` (a failure's code kept).
+void merge(Status& st, const Status& part) noexcept {
+  st.internal_steps += part.internal_steps;
+  st.rhs_evals += part.rhs_evals;
+  st.restarted = st.restarted || part.restarted;
+  st.stiff = st.stiff || part.stiff;
+  st.inaccurate = st.inaccurate || part.inaccurate;
+  st.error_estimate = std::max(st.error_estimate, part.error_estimate);
+  st.run_error_estimate = std::max(st.run_error_estimate, part.run_error_estimate);
+  if (!part.ok() && st.ok()) {
+    st.code = part.code;
+    st.cvode_flag = part.cvode_flag;
+  }
+  st.t = part.t;
+}
+}  // namespace
+
+// The exact Coulomb law (ExactCoulomb): from t to t_end in stretches, each integrated in one mode,
+// Sliding::Auto's rule at its start (so the right-hand side is smooth over it: no stiff slope, no
+// jump for an error-controlled integrator to chase).  Where a stretch overshoots its end (the margin
+// turns negative: the velocity crosses 0 sliding, the held force passes g(0) stuck), the switch is
+// located by the Illinois variant of regula falsi on the fraction of the stretch, each trial
+// re-integrated from the stretch's start (the error-controlled integrators to their tolerance, the
+// fixed-step ones at their share of the substeps); the run goes on from the first trial past the
+// switch, the velocity set to 0 there where it crossed.  A stuck stretch ends with v = 0 exactly
+// (hold_stuck).  Status::Chatter past
+// Status::kMaxSwitches switches in one call.
+Status Plant::Impl::advance_sliding(Dynamics::Input in, double t_end, int substeps) noexcept {
+  constexpr int kLocateTrials = 30;      // Illinois converges in a few; bisection's worst case is 30
+  constexpr double kLocateMargin = 1e-6;  // of the overshoot's scale: where the switch counts as found
+  const int n_all = substeps > 0 ? substeps : fixed_substeps(integ);  // 0: error-controlled
+  const double t_begin = t;
+  auto share = [&](double from, double to) {
+    return n_all > 0 ? std::max(1, static_cast<int>(std::lround(n_all * (to - from) / (t_end - t_begin)))) : 0;
+  };
+  // The time the switches are located to, and a switch within it of t_end ends the call (a stretch
+  // that short changes nothing the integrators resolve; CVODE refuses an output time at its start).
+  const double t_min = 1e-9 * (t_end - t_begin);
+  Status st;
+  for (int switches = 0;; ++switches) {
+    in.sliding = dyn.sliding(y.data(), in);
+    const State y0 = y;
+    const double t0s = t, e0 = std::max(0.0, switch_margin(in));
+    merge(st, integrate(in, t_end, share(t0s, t_end)));
+    if (!st.ok()) return st;
+    hold_stuck(in);
+    double e1 = switch_margin(in);
+    if (!(e1 < 0.0)) return st;
+    if (switches >= Status::kMaxSwitches) {
+      st.code = Status::Chatter;
+      st.t = t0s;
+      return st;
+    }
+    // Illinois on the fraction th of [t0s, t_end]: the margin is e0 >= 0 at 0 and e1 < 0 at 1.
+    double lo = 0.0, hi = 1.0, elo = e0, ehi = e1;
+    State y_hi = y;
+    double t_hi = t;
+    const double scale = std::max(e0, -e1);
+    int side = 0;
+    for (int k = 0; k < kLocateTrials; ++k) {
+      double th = (lo * ehi - hi * elo) / (ehi - elo);
+      const double gap = t_min / (t_end - t0s);  // no trial closer than t_min to a bracket's end
+      if (!(th > lo + gap && th < hi - gap)) th = 0.5 * (lo + hi);
+      y = y0;
+      t = t0s;
+      restart();
+      const double t_try = t0s + th * (t_end - t0s);
+      merge(st, integrate(in, t_try, share(t0s, t_try)));
+      if (!st.ok()) return st;
+      hold_stuck(in);
+      const double e = switch_margin(in);
+      if (e < 0.0) {
+        hi = th, ehi = e, y_hi = y, t_hi = t;
+        if (side == -1) elo *= 0.5;
+        side = -1;
+      } else {
+        lo = th, elo = e;
+        if (side == 1) ehi *= 0.5;
+        side = 1;
+      }
+      if (std::fabs(e) <= kLocateMargin * scale || (hi - lo) * (t_end - t0s) <= t_min) break;
+    }
+    y = y_hi;
+    t = t_hi;
+    if (in.sliding != Sliding::Stuck) y[kV] = 0.0;  // the velocity crossed 0: stuck or reversing from here
+    restart();
+    if (t_end - t <= t_min) {
+      t = t_end;
+      return st;
+    }
+  }
+}
+
 // With a command delay of (D + f) samples, command j holds over [t_j + (D + f) dt, t_(j+1) + (D + f) dt):
 // over sample k the held value is command k-D-1 until t_k + f dt, then command k-D.  Both parts are
 // integrated exactly as any sample (CVODE stops at the switch; RK4 and ROS2 share their substeps between them).
@@ -197,16 +313,10 @@ Status Plant::Impl::advance_delayed(double t_next) noexcept {
     n2 = std::max(1, n - n1);
   }
   input = held(j - 1);
-  Status first = advance(input, t_switch, n1);
-  if (!first.ok()) return first;
+  Status st = advance(input, t_switch, n1);
+  if (!st.ok()) return st;
   input = held(j);
-  Status st = advance(input, t_next, n2);
-  st.internal_steps += first.internal_steps;
-  st.rhs_evals += first.rhs_evals;
-  st.restarted = st.restarted || first.restarted;
-  st.stiff = st.stiff || first.stiff;
-  st.inaccurate = st.inaccurate || first.inaccurate;
-  st.error_estimate = std::max(st.error_estimate, first.error_estimate);
+  merge(st, advance(input, t_next, n2));
   return st;
 }
 
@@ -235,7 +345,7 @@ Status Plant::step(double command, Output& out) noexcept {
     m.input.u_rate = m.have_prev_u ? (command - m.prev_u) / m.dt : 0.0;
     m.prev_u = command;
     m.have_prev_u = true;
-    st = std::visit([&](auto& integ) { return integ.advance(m.dyn, m.input, m.y, m.t, t_next); }, m.integ);
+    st = m.advance(m.input, t_next, 0);
   } else {
     m.commands.put(m.k, command);
     st = m.advance_delayed(t_next);

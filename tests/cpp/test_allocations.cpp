@@ -173,6 +173,13 @@ int main() {
   light.v_stick = 1e-6;
   check_plant(ControlMode::Displacement, dopri5, light);
   check_plant(ControlMode::Displacement, ros2, light);  // the LU of the stiff matrix: fixed capacity
+  // The exact Coulomb law: stretches, located switches and re-integrations, every method.
+  Rig exact = zhao2003();
+  exact.effects.coulomb_friction = true;
+  exact.F_c = 3000.0;
+  exact.v_stick = 0.0;
+  for (ControlMode mode : {ControlMode::Displacement, ControlMode::Free})
+    for (const SolverOptions* o : {&dopri5, &cvode, &rk4, &erk, &dirk, &ros2}) check_plant(mode, *o, exact);
   for (auto m : {SolverOptions::Method::CvodeBdf, SolverOptions::Method::Dopri5, SolverOptions::Method::ArkodeErk})
     check_overrun(m);
   return sh_test::report("test_allocations");

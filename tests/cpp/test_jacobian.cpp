@@ -83,6 +83,7 @@ bool away_from_kinks(const Dynamics& dyn, const Draw& d) {
   const double margin_x = 1e-5, margin_v = 1e-3, margin_s = 1e-4;
   if (r.effects.spring_softening && std::fabs(std::fabs(y[kX]) - r.x_contact) < margin_x) return false;
   if (dyn.lugre() && std::fabs(y[kV]) < 1e-6) return false;  // |v| in the bristle equation
+  if (dyn.exact_coulomb() && std::fabs(y[kV]) < margin_v) return false;  // the exact law's switch at v = 0
   // Bouc-Wen laws: |w| (w the deformation rate) and, with n = 1, |z|.
   const StateLayout& L = dyn.layout();
   if (const int iz = L.offset_of<BoucWen>(); iz >= 0) {
@@ -365,6 +366,9 @@ int main() {
     Rig stribeck = lugre;
     stribeck.effects.lugre_friction = false;
     run(stribeck, mode, 100, "static friction law with a Stribeck peak");
+    Rig exact = stribeck;  // the exact Coulomb law sliding (the draws' v != 0: Sliding::Auto picks the side)
+    exact.v_stick = 0.0;
+    run(exact, mode, 100, "exact Coulomb law with a Stribeck peak, sliding");
   }
   Rig derivative = zhao2003();
   derivative.G_d = 0.02;  // derivative term of Eq (1), displacement control only

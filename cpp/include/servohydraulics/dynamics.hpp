@@ -27,6 +27,9 @@ class Dynamics {
   struct Input {
     double u = 0.0;
     double u_rate = 0.0;
+    //! The exact Coulomb law's mode over the stretch (ExactCoulomb; the plant sets it, Auto reads
+    //! it from the state); no effect with any other friction law.
+    Sliding sliding = Sliding::Auto;
   };
 
   //! A held command and the state it holds at rest (see operating_point).
@@ -133,11 +136,18 @@ class Dynamics {
   double structure_force(double x, double v, double z = 0.0) const noexcept;
   double spring_force(double x) const noexcept;         //!< f_s(x) [N]
   double spring_stiffness(double x) const noexcept;     //!< df_s/dx [N/m]
-  double friction_force(double v) const noexcept;       //!< static friction law g(v) tanh(v / v_stick) [N] (either law on)
+  double friction_force(double v) const noexcept;       //!< static friction law g(v) tanh(v / v_stick) [N] (either law on; the exact law: g(v) sgn(v), 0 at v = 0)
   double friction_slope(double v) const noexcept;       //!< its derivative [N s/m]
   double friction_level(double v) const noexcept;       //!< sliding level g(v) with the Stribeck peak [N]
   double friction_level_slope(double v) const noexcept; //!< g'(v) [N s/m]
   bool lugre() const noexcept { return law<LuGreFriction>() != nullptr; }  //!< friction is LuGre (state kZ active)
+  //! The exact Coulomb law (v_stick = 0), or nullptr when friction is off or another law.
+  const ExactCoulomb* exact_coulomb() const noexcept { return coulomb_ ? &*coulomb_ : nullptr; }
+  //! The force the exact Coulomb law holds when stuck at y: every other force on the structure
+  //! (pA, or the ideal force in free mode, less damping, spring and specimens) [N].
+  double held_force(const double* y, const Input& in) const noexcept;
+  //! The exact law's mode at y (Sliding::Auto's rule; Auto when the law is off).
+  Sliding sliding(const double* y, const Input& in) const noexcept;
   double flow_gain(double s) const noexcept;            //!< g(s) with the effect switches applied
   double flow_gain_slope(double s) const noexcept;      //!< g'(s)
   double pressure_factor(double s, double p) const noexcept;        //!< the square-root term of Eq (3)
@@ -195,6 +205,7 @@ class Dynamics {
   int ng_ = kNumStates + 1;  // gradient width
   bool specimen_on_ = false;  // a structure element is on
   detail::Optionals<StructureLaws>::type laws_;
+  std::optional<ExactCoulomb> coulomb_;  // the exact Coulomb law, applied after the other forces
   detail::Optionals<Elements>::type elements_;
 };
 

@@ -113,7 +113,9 @@ struct Rig {
   double k_2 = 350.4e3;     //!< stiffness beyond +-x_contact [N/m] (p. 1777: one pair loses contact)
   double x_contact = 0.025; //!< displacement where one spring pair loses contact [m] (2.5 cm precompression)
   double F_c = 31.6;        //!< Coulomb friction [N] (Table I, actuator attached)
-  double v_stick = 1e-4;    //!< friction regularisation velocity: F = g(v) tanh(v / v_stick) [m/s]
+  //! friction regularisation velocity: F = g(v) tanh(v / v_stick) [m/s]; 0 chooses the exact law
+  //! (stick at v = 0 while the other forces stay within g(0), the switches located in time: ExactCoulomb)
+  double v_stick = 1e-4;
   double stribeck_ratio = 1.0;  //!< static to sliding friction F_s / F_c >= 1; g(v) = F_c (1 + (ratio - 1) exp(-(v/v_s)^2)) [-]
   double v_s = 0.01;        //!< Stribeck velocity [m/s]
   double sigma_0 = 1e6;     //!< LuGre bristle (presliding) stiffness [N/m]

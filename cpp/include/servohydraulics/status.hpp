@@ -11,7 +11,10 @@ struct Status {
     NonFinite = 3,      //!< the state became NaN or infinite (diverged)
     NotReady = 4,       //!< step() after a failure without reset()
     Stiff = 5,          //!< Dopri5 without stiff_fallback: the sample is stiff for the explicit pair
+    Chatter = 6,        //!< the exact Coulomb law switched more than Status::kMaxSwitches times in one sample
   };
+  //! Most switches of the exact Coulomb law (stick, slip, reversal) in one sample.
+  static constexpr int kMaxSwitches = 64;
   Code code = Ok;
   int cvode_flag = 0;      //!< CVODE/ARKODE return flag when code != Ok
   double t = 0.0;          //!< time reached [s] (where the failure happened)

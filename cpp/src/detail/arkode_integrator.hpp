@@ -30,6 +30,9 @@ class ArkodeIntegrator {
   ArkodeIntegrator& operator=(const ArkodeIntegrator&) = delete;
 
   void reset(const State& y, double t) noexcept;
+  //! Goes on from y at t as from a new start (the state was set from outside: the plant's
+  //! re-integration to a located friction switch), its counters running on.
+  void restart(const State&, double) noexcept { need_reset_ = true; }
   //! Integrates from t to the stop time t_next with the input held; restarts the one-step method
   //! (ARKStepReset, with the last step size as the first) where the input changed.
   Status advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t, double t_next) noexcept;

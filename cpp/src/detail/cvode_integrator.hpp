@@ -52,6 +52,9 @@ class BasicCvodeIntegrator {
 
   //! Restart at (y, t) with the held input zero; zeroes the counters.
   void reset(const State& y, double t) noexcept;
+  //! Goes on from y at t as from a new start (the state was set from outside: the plant's
+  //! re-integration to a located friction switch), its counters running on.
+  void restart(const State&, double) noexcept { need_reinit_ = true; }
   //! Integrates from t to the stop time t_next with the input held, updating
   //! y and t (to where a failure happened).  Restarts (CVodeReInit) first if
   //! the input changed and the policy says so, or after a failure.

@@ -36,6 +36,13 @@ class BasicDopri5Integrator {
                         bool checked = true);
 
   void reset(const State& y, double t) noexcept;
+  //! Goes on from y at t as from a new start (the state was set from outside: the plant's
+  //! re-integration to a located friction switch), its counters running on.
+  //! (The shadow, if any, starts again from the result at its next check.)
+  void restart(const State&, double) noexcept {
+    fsal_ = false;
+    shadow_live_ = false;
+  }
   //! Integrates from t to t_next with the input held.  Stiffness (more than stiff_steps steps in the
   //! sample, a step below 1e-12 of the sample, or a non-finite stage) redoes the sample from its start
   //! with CVODE (Status::stiff) and stays on CVODE for kImplicitHold samples; without the fallback it

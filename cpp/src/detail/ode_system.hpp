@@ -44,7 +44,10 @@ struct OdeSystem<Dynamics> {
   static constexpr const char* kPrimeState = "the equilibrium at x = 0, command 0";
 
   static int size(const Dynamics& d) noexcept { return d.num_states(); }
-  static bool changed(const Input& a, const Input& b) noexcept { return a.u != b.u || a.u_rate != b.u_rate; }
+  //! (The exact Coulomb law's mode as well: a switch of the friction is a jump of the right-hand side.)
+  static bool changed(const Input& a, const Input& b) noexcept {
+    return a.u != b.u || a.u_rate != b.u_rate || a.sliding != b.sliding;
+  }
   static void rhs(const Dynamics& d, const double* y, const Input& in, double* ydot) noexcept { d.rhs(y, in, ydot); }
   static void jacobian(const Dynamics& d, const double* y, const Input& in, double* J) noexcept {
     Jacobian Jl;

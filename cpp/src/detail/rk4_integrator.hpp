@@ -26,6 +26,9 @@ class BasicRk4Integrator {
   BasicRk4Integrator(const System& sys, double dt, const SolverOptions& options);
 
   void reset(const State& y0, double) noexcept;
+  //! Goes on from y at t as from a new start (the state was set from outside: the plant's
+  //! re-integration to a located friction switch), its counters running on.
+  void restart(const State& y, double) noexcept { companion_ = y; }
   //! The classical RK4 over substeps() equal substeps (`substeps` > 0 replaces the configured
   //! count: the plant passes a share of it for each part of a sample split by a command delay),
   //! twice as many after each refinement.

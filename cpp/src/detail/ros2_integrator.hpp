@@ -37,6 +37,9 @@ class BasicRos2Integrator {
   BasicRos2Integrator(const System& sys, double dt, const SolverOptions& options);
 
   void reset(const State& y0, double) noexcept;
+  //! Goes on from y at t as from a new start (the state was set from outside: the plant's
+  //! re-integration to a located friction switch), its counters running on.
+  void restart(const State&, double) noexcept {}
   //! substeps() equal substeps from t to t_next (`substeps` > 0 replaces the configured count: the
   //! plant passes a share of it for each part of a sample split by a command delay).
   Status advance(const System& sys, const Input& in, State& y, double& t, double t_next,

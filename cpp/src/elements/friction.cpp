@@ -16,8 +16,33 @@ StribeckLevel::Value StribeckLevel::at(double v) const noexcept {
 }
 
 std::optional<TanhFriction> TanhFriction::from(const Rig& r, ControlMode) {
-  if (!acts(r) || LuGreFriction::acts(r)) return std::nullopt;
+  if (!acts(r) || LuGreFriction::acts(r) || r.v_stick == 0.0) return std::nullopt;
   return of(r);
+}
+
+std::optional<ExactCoulomb> ExactCoulomb::from(const Rig& r, ControlMode) {
+  if (!TanhFriction::acts(r) || LuGreFriction::acts(r) || r.v_stick != 0.0) return std::nullopt;
+  return ExactCoulomb{StribeckLevel::of(r)};
+}
+
+Sliding ExactCoulomb::mode(double v, double held) const noexcept {
+  if (v > 0.0) return Sliding::Up;
+  if (v < 0.0) return Sliding::Down;
+  if (std::fabs(held) <= static_level()) return Sliding::Stuck;
+  return held > 0.0 ? Sliding::Up : Sliding::Down;
+}
+
+LawForce ExactCoulomb::at(double v, Sliding s, double held) const noexcept {
+  LawForce f;
+  if (s == Sliding::Stuck) {
+    f.F = held;  // the acceleration is 0: the dynamics zero its gradient (Dynamics::structure)
+    return f;
+  }
+  const double sign = s == Sliding::Up ? 1.0 : -1.0;
+  const StribeckLevel::Value gv = g.at(v);
+  f.F = sign * gv.level;
+  f.dF_dv = sign * gv.slope;
+  return f;
 }
 
 LawForce TanhFriction::at(double v) const noexcept {

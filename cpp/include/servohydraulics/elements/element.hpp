@@ -29,6 +29,7 @@ struct Algebra {
   double zdot = 0, dzdot[kCap];    // rate of the bristle state kZ (a friction law's, LuGre; else 0)
   double Fsp = 0, dFsp[kCap];      // specimen force (the structure elements')
   double vdrive = 0, dvdrive[kCap];  // the drive as the valve sees it (after a drive element)
+  double held = 0;                 // the forces on the structure but the exact Coulomb law's [N]
   double rate[kMaxStates];              // rates of the elements' states (by state index)
   double drate[kMaxStates][kCap];       // and their gradients
   bool drive_sat = false, spool_sat = false;

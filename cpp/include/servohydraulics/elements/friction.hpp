@@ -1,7 +1,8 @@
-// The structure's friction laws, Eq (5): the static law g(v) tanh(v / v_stick), or LuGre
-// (Canudas de Wit et al. 1995) with the bristle deflection z, the base state kZ.  Both slide at
-// the level g(v) with the Stribeck peak.  At most one is on (effects.coulomb_friction, and
-// effects.lugre_friction chooses LuGre).
+// The structure's friction laws, Eq (5): the static law g(v) tanh(v / v_stick), LuGre
+// (Canudas de Wit et al. 1995) with the bristle deflection z, the base state kZ, or the exact
+// Coulomb law (v_stick = 0: stick and slip, ExactCoulomb).  All slide at the level g(v) with the
+// Stribeck peak.  At most one is on (effects.coulomb_friction; effects.lugre_friction chooses
+// LuGre, v_stick = 0 the exact law).
 #pragma once
 
 #include <optional>
@@ -27,7 +28,7 @@ struct TanhFriction {
   StribeckLevel g;
   double v_stick = 1.0;
 
-  static std::optional<TanhFriction> from(const Rig& r, ControlMode);
+  static std::optional<TanhFriction> from(const Rig& r, ControlMode);  //!< on with v_stick > 0
   static TanhFriction of(const Rig& r) noexcept { return {StribeckLevel::of(r), r.v_stick}; }  //!< whichever is on
   //! The Coulomb switch is on with a force (either law acts).
   static bool acts(const Rig& r) noexcept { return r.effects.coulomb_friction && r.F_c != 0.0; }
@@ -36,6 +37,31 @@ struct TanhFriction {
   double static_force(double) const noexcept { return kNoStaticForce; }
   double rate_bound(double) const noexcept { return 0.0; }
   LawForce eval(const double* y, Algebra&) const noexcept { return at(y[kV]); }
+};
+
+//! The sliding state of the exact Coulomb law over a stretch of integration, which the plant holds
+//! (Plant: a mode, not an ODE state).  Auto reads it from the state: v > 0 Up, v < 0 Down, and at
+//! v = 0 Stuck while the other forces stay within the static level g(0), else the way they push.
+enum class Sliding : signed char { Auto = 0, Up = 1, Down = -1, Stuck = 2 };
+
+//! The exact Coulomb law, the limit v_stick -> 0 of TanhFriction (effects.coulomb_friction with
+//! v_stick = 0, without lugre_friction; Karnopp 1985, with the switch located in time).  Sliding
+//! (Up, Down) it is the level g(v) against the motion, a smooth function of v with no stiff
+//! slope; stuck it holds v = 0 with whatever force the others leave (|F| <= g(0)).  The plant
+//! integrates each stretch in one mode and locates where it ends (Plant::Impl::advance): v
+//! crossing 0 while sliding, or the held force reaching g(0) while stuck.  Dynamics applies it
+//! after the other forces (Dynamics::structure), since stuck it is their sum.
+struct ExactCoulomb {
+  static constexpr const char* kName = "coulomb_friction";
+  StribeckLevel g;
+
+  static std::optional<ExactCoulomb> from(const Rig& r, ControlMode);
+  //! The static level g(0) = F_s [N]: the most the stuck law holds.
+  double static_level() const noexcept { return g.at(0.0).level; }
+  //! The mode at velocity v with the other forces' sum `held` [N] (Sliding::Auto's rule).
+  Sliding mode(double v, double held) const noexcept;
+  //! The force [N] and dF/dv in mode s (not Auto) at v with the other forces' sum `held`.
+  LawForce at(double v, Sliding s, double held) const noexcept;
 };
 
 //! LuGre: z' = v - sigma_0 |v| z / g(v), F = sigma_0 z + sigma_1 z' (its sigma_2 v is the
