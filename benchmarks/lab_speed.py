@@ -1,7 +1,7 @@
 """How long identification and diagnosis of lab records take (issue 25, item 6), and where the time goes.
 
     python benchmarks/lab_speed.py [--cases identify,diagnose10,diagnose10sim,sweep1A] [--json FILE]
-                                   [--profile] [--label NAME]
+                                   [--profile] [--label NAME] [--v-stick V]
     python benchmarks/lab_speed.py --table benchmarks/lab_speed.json
 
 The cases (records from ../shared/real-data/utfsm-mts-mrdamper, or $SH_SHARED_DIR/real-data/...):
@@ -172,7 +172,7 @@ class _Clock:
         self.wall, self.cpu = time.perf_counter() - self.t0, _cpu_seconds() - self.c0
 
 
-def run_case(case: str) -> dict:
+def run_case(case: str, v_stick: float | None = None) -> dict:
     """One case; ``wall_s`` and ``cpu_s`` time the identification or the diagnosis alone (not the
     reading or the making of its record)."""
     import servohydraulics as sh
@@ -198,6 +198,8 @@ def run_case(case: str) -> dict:
         else:
             rec = _record("chirp20Hz_1A", 10.0) if case == "diagnose10" else _record("sweep15Hz_1A")
             rig, mode = sh.load_rig(ROOT / "evaluation" / "utfsm_rig_0A.toml"), "displacement"
+        if v_stick is not None:  # the nominal rig's friction law (0: the exact Coulomb law)
+            rig.v_stick = v_stick
         from servohydraulics.diagnosis import engine
 
         hits = getattr(getattr(engine, "RUNS", None), "hits", None)  # None: a package before the run cache
@@ -265,6 +267,9 @@ def main() -> None:
     p.add_argument("--label", default="run", help="name of this run in the JSON (e.g. before, after)")
     p.add_argument("--profile", action="store_true", help="cProfile's top functions per case (main thread)")
     p.add_argument("--table", metavar="FILE", help="print the runs saved in FILE (--json) as a markdown table")
+    p.add_argument("--v-stick", type=float, default=None, metavar="V",
+                   help="the diagnosis cases' nominal rig with v_stick = V [m/s] (0: the exact Coulomb law, "
+                        "docs/model.md); default: the rig's own")
     a = p.parse_args()
     if a.table:
         print(table(Path(a.table)))
@@ -278,7 +283,7 @@ def main() -> None:
     # the libraries' rounding moves the fits' paths (docs/benchmarks.md, "This venv's rounding"): recorded with the row
     out = {"label": a.label, "python": platform.python_version(), "numpy": numpy.__version__,
            "scipy": scipy.__version__, "cpus": os.cpu_count(),
-           "command": "python benchmarks/lab_speed.py " + " ".join(sys.argv[1:]), "cases": {}}
+           "command": "python benchmarks/lab_speed.py " + " ".join(sys.argv[1:]), "v_stick": a.v_stick, "cases": {}}
     counter = Counters()
     for case in cases:
         counter.reset()
@@ -287,7 +292,7 @@ def main() -> None:
         with instrumented(counter):
             if prof:
                 prof.enable()
-            res = run_case(case)
+            res = run_case(case, a.v_stick)
             if prof:
                 prof.disable()
         load1 = os.getloadavg()

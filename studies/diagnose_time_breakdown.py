@@ -1,6 +1,6 @@
 """Where a diagnosis spends its simulation time, by step of the workflow (docs/benchmarks.md, lab-speed).
 
-    python studies/diagnose_time_breakdown.py [--record chirp20Hz_1A] [--end 10] [--json FILE]
+    python studies/diagnose_time_breakdown.py [--record chirp20Hz_1A] [--end 10] [--json FILE] [--v-stick V]
 
 ``sh.diagnose`` of a UTFSM record (default: the first 10 s of ``chirp20Hz_1A``, benchmarks/lab_speed.py's
 ``diagnose10``) against the rig identified at 0 A (evaluation/utfsm_rig_0A.toml), displacement control,
@@ -128,6 +128,8 @@ def main(argv=None) -> int:
     ap.add_argument("--record", default="chirp20Hz_1A", help="a UTFSM record's name (default chirp20Hz_1A)")
     ap.add_argument("--end", type=float, default=10.0, help="its first END seconds (0: the whole record)")
     ap.add_argument("--json", type=Path, help="also write the table to this JSON file")
+    ap.add_argument("--v-stick", type=float, default=None, metavar="V",
+                    help="the nominal rig with v_stick = V [m/s] (0: the exact Coulomb law); default: the rig's own")
     args = ap.parse_args(argv)
     import lab_speed
 
@@ -136,6 +138,8 @@ def main(argv=None) -> int:
 
     rec = lab_speed._record(args.record, args.end if args.end > 0 else None)
     rig = sh.load_rig(ROOT / "evaluation" / "utfsm_rig_0A.toml")
+    if args.v_stick is not None:
+        rig.v_stick = args.v_stick
     att = Attribution()
     att.install()
     h0, m0 = engine.RUNS.hits, engine.RUNS.misses
