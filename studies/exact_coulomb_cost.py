@@ -10,7 +10,8 @@ there), the friction regularised at v_stick = 1e-4 (the rig's), 1e-5 and 1e-6 m/
 pair (dopri5 at rtol 1e-6, ``engine.run_options(True)``), the decisions' pair (rtol 1e-8), RK4 at 4
 and 8 substeps and ROS2 at 8 (``engine.ros2_options``), the run's internal steps, and its rms and
 largest difference from the exact law's rtol-1e-8 run on displacement and force, as fractions of the
-measured channel's standard deviation.  RK4 is not run on the regularised law: it diverges there
+measured channel's standard deviation; then the substeps per sample of RK4 at 4 on the exact law (a
+switch re-integrates its stretch: a real-time step's cost).  RK4 is not run on the regularised law: it diverges there
 (studies/diagnose_run_costs.py).
 """
 
@@ -81,6 +82,13 @@ def main() -> None:
             label = "0 (exact)" if vs == 0 else f"{vs:g}"
             print(f"| {label} | {name} | {cpu:.3f} | {out.work.internal_steps:,} | {cells[0]} | {cells[1]} |",
                   flush=True)
+    # what a real-time step costs: a switch re-integrates its stretch, so RK4's cost per sample is no longer fixed
+    out, _ = run(rig_with(0.0), rk4_options(4))
+    steps = np.asarray(out.channels["internal_steps"])
+    plain = int(np.median(steps))
+    print(f"\nRK4 x4 on the exact law, per sample: {plain} substeps in a sample without a switch; "
+          f"{int(np.sum(steps > plain))} of {steps.size:,} samples switched, the most substeps in one "
+          f"{int(steps.max())}")
 
 
 if __name__ == "__main__":

@@ -135,3 +135,12 @@ def test_the_exact_law_is_refused_where_it_is_not_modelled() -> None:
     r.v_stick = -1e-4
     with pytest.raises(ValueError, match="v_stick"):
         sh.simulate(r, "free", command=np.zeros(10), dt=1e-3)
+
+
+def test_a_stick_slip_chatter_is_an_error_with_its_time() -> None:
+    # a 1 g mass on a 1e9 N/m spring from 1 mm: k x0 / (2 F_c) = 500 half-cycles of 3 us before it sticks,
+    # all in the first 1 ms sample: more switches than Status::kMaxSwitches (64) in one sample
+    r = _rig()
+    r.m, r.k, r.F_c = 1e-3, 1e9, 1e3
+    with pytest.raises(sh.SimulationError, match=r"at t = 0\.000\d+ s: the exact Coulomb law .* more than 64 times"):
+        sh.simulate(r, "free", command=np.zeros(5), dt=1e-3, x0=1e-3, options=sh.solver_options(method="rk4"))
