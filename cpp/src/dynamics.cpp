@@ -107,11 +107,11 @@ double Dynamics::spring_stiffness(double x) const noexcept { return law<Spring>(
 double Dynamics::friction_level(double v) const noexcept { return StribeckLevel::of(rig_).at(v).level; }
 double Dynamics::friction_level_slope(double v) const noexcept { return StribeckLevel::of(rig_).at(v).slope; }
 double Dynamics::friction_force(double v) const noexcept {
-  if (coulomb_) return v == 0.0 ? 0.0 : coulomb_->at(v, v > 0.0 ? Sliding::Up : Sliding::Down, 0.0).F;
+  if (coulomb_) return coulomb_->sliding_at(v).F;
   return TanhFriction::acts(rig_) ? TanhFriction::of(rig_).at(v).F : 0.0;
 }
 double Dynamics::friction_slope(double v) const noexcept {
-  if (coulomb_) return v == 0.0 ? 0.0 : coulomb_->at(v, v > 0.0 ? Sliding::Up : Sliding::Down, 0.0).dF_dv;
+  if (coulomb_) return coulomb_->sliding_at(v).dF_dv;
   return TanhFriction::acts(rig_) ? TanhFriction::of(rig_).at(v).dF_dv : 0.0;
 }
 double Dynamics::flow_gain(double s) const noexcept {

@@ -107,7 +107,7 @@ MultiRig::MultiRig(const std::vector<Rig>& rigs, const Coupler& coupler, const N
             specimen_why);
     require(!r.effects.mr_damper, actuator_field(i, "effects.mr_damper").c_str(), 1.0, specimen_why);
     require(!r.effects.fluid_damper, actuator_field(i, "effects.fluid_damper").c_str(), 1.0, specimen_why);
-    require(!(r.effects.coulomb_friction && !r.effects.lugre_friction && r.F_c != 0.0 && r.v_stick == 0.0),
+    require(!ExactCoulomb::from(r, ControlMode::Displacement),
             actuator_field(i, "v_stick").c_str(), r.v_stick,
             "the exact Coulomb law (v_stick = 0: stick and slip located in time) is not modelled in the coupled "
             "rig; give v_stick > 0 (the regularised law) or LuGre");

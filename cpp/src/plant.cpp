@@ -229,8 +229,7 @@ void merge(Status& st, const Status& part) noexcept {
 // re-integrated from the stretch's start (the error-controlled integrators to their tolerance, the
 // fixed-step ones at their share of the substeps); the run goes on from the first trial past the
 // switch, the velocity set to 0 there where it crossed.  A stuck stretch ends with v = 0 exactly
-// (hold_stuck).  Status::Chatter past
-// Status::kMaxSwitches switches in one call.
+// (hold_stuck).  Status::Chatter past Status::kMaxSwitches switches in one call.
 Status Plant::Impl::advance_sliding(Dynamics::Input in, double t_end, int substeps) noexcept {
   constexpr int kLocateTrials = 30;      // Illinois converges in a few; bisection's worst case is 30
   constexpr double kLocateMargin = 1e-6;  // of the overshoot's scale: where the switch counts as found

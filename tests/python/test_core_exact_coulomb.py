@@ -130,7 +130,7 @@ def test_the_regularised_law_converges_to_it() -> None:
     assert errors[2] < 2e-6  # [m], 0.02 % of x0
 
 
-def test_the_exact_law_is_refused_where_it_is_not_modelled() -> None:
+def test_a_negative_v_stick_names_the_field() -> None:
     r = _rig()
     r.v_stick = -1e-4
     with pytest.raises(ValueError, match="v_stick"):
@@ -144,3 +144,13 @@ def test_a_stick_slip_chatter_is_an_error_with_its_time() -> None:
     r.m, r.k, r.F_c = 1e-3, 1e9, 1e3
     with pytest.raises(sh.SimulationError, match=r"at t = 0\.000\d+ s: the exact Coulomb law .* more than 64 times"):
         sh.simulate(r, "free", command=np.zeros(5), dt=1e-3, x0=1e-3, options=sh.solver_options(method="rk4"))
+
+
+def test_the_coupled_rig_refuses_it_by_name() -> None:
+    from servohydraulics.multi_rig import MARTHS_ANGLES, MARTHS_ARM, MultiActuatorRig
+
+    exact = sh.zhao2003()
+    exact.effects.coulomb_friction = True
+    exact.v_stick = 0.0
+    with pytest.raises(ValueError, match=r"actuators\[1\]\.v_stick = 0: the exact Coulomb law"):
+        MultiActuatorRig([sh.zhao2003(), exact], [MARTHS_ARM] * 2, MARTHS_ANGLES, sh.marths_frame())

@@ -62,6 +62,10 @@ struct ExactCoulomb {
   Sliding mode(double v, double held) const noexcept;
   //! The force [N] and dF/dv in mode s (not Auto) at v with the other forces' sum `held`.
   LawForce at(double v, Sliding s, double held) const noexcept;
+  //! The force as a function of v alone: sliding g(v) sgn(v), 0 at v = 0 (where it is whatever is held).
+  LawForce sliding_at(double v) const noexcept {
+    return v == 0.0 ? LawForce{} : at(v, v > 0.0 ? Sliding::Up : Sliding::Down, 0.0);
+  }
 };
 
 //! LuGre: z' = v - sigma_0 |v| z / g(v), F = sigma_0 z + sigma_1 z' (its sigma_2 v is the
