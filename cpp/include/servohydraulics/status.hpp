@@ -13,7 +13,8 @@ struct Status {
     Stiff = 5,          //!< Dopri5 without stiff_fallback: the sample is stiff for the explicit pair
     Chatter = 6,        //!< the exact Coulomb law switched more than Status::kMaxSwitches times in one sample
   };
-  //! Most switches of the exact Coulomb law (stick, slip, reversal) in one sample.
+  //! Most switches of the exact Coulomb law (stick, slip, reversal) in one sample (in each part of a
+  //! sample that a command delay splits).
   static constexpr int kMaxSwitches = 64;
   Code code = Ok;
   int cvode_flag = 0;      //!< CVODE/ARKODE return flag when code != Ok

@@ -86,7 +86,7 @@ void ArkodeIntegrator::reset(const State& y, double t) noexcept {
 
 Status ArkodeIntegrator::advance(const Dynamics& dyn, const Dynamics::Input& in, State& y, double& t,
                                  double t_next) noexcept {
-  if (in.u != in_.u || in.u_rate != in_.u_rate || in.sliding != in_.sliding) need_reset_ = true;  // a ZOH jump: restart there
+  if (OdeSystem<Dynamics>::changed(in, in_)) need_reset_ = true;  // a ZOH jump (or a friction switch): restart there
   dyn_ = &dyn;
   in_ = in;
   void* ark = mem_.get();

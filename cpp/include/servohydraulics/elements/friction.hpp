@@ -48,11 +48,10 @@ enum class Sliding : signed char { Auto = 0, Up = 1, Down = -1, Stuck = 2 };
 //! v_stick = 0, without lugre_friction; Karnopp 1985, with the switch located in time).  Sliding
 //! (Up, Down) it is the level g(v) against the motion, a smooth function of v with no stiff
 //! slope; stuck it holds v = 0 with whatever force the others leave (|F| <= g(0)).  The plant
-//! integrates each stretch in one mode and locates where it ends (Plant::Impl::advance): v
+//! integrates each stretch in one mode and locates where it ends (Plant::Impl::advance_sliding): v
 //! crossing 0 while sliding, or the held force reaching g(0) while stuck.  Dynamics applies it
 //! after the other forces (Dynamics::structure), since stuck it is their sum.
 struct ExactCoulomb {
-  static constexpr const char* kName = "coulomb_friction";
   StribeckLevel g;
 
   static std::optional<ExactCoulomb> from(const Rig& r, ControlMode);
