@@ -204,22 +204,37 @@ void Dynamics::structure(const double* y, const Input& in, Algebra& g) const noe
     laws.dF_dz += f.dF_dz;
   });
   if (specimen_on_) specimen<W>(y, g);
-  // The exact Coulomb law last: stuck, it holds the sum of the others (the acceleration is 0).
-  Sliding sliding = Sliding::Auto;
-  if (coulomb_) {
-    g.held = specimen_on_ ? net - g.Fsp : net;
-    sliding = in.sliding == Sliding::Auto ? coulomb_->mode(y[kV], g.held) : in.sliding;
-    const LawForce f = coulomb_->at(y[kV], sliding, g.held);
-    net -= f.F;
-    laws.dF_dv += f.dF_dv;
-  }
-  g.a = specimen_on_ ? (net - g.Fsp) / M_ : net / M_;
-  if (sliding == Sliding::Stuck) g.a = 0.0;  // not held - held's rounding
-  if constexpr (W == 0) return;  // the values alone (rhs)
-  if (sliding == Sliding::Stuck) {  // v stays 0 whatever the other states do
-    for (int j = 0; j < W; ++j) g.da[j] = 0.0;
+  if (coulomb_) {  // out of line: a rig without the exact law keeps this function small enough to inline
+    structure_exact<W>(y, in, net, laws, g);
     return;
   }
+  structure_rates<W>(net, laws, g);
+}
+
+// The exact Coulomb law last: stuck, it holds the sum of the others (the acceleration is 0).
+template <int W>
+void Dynamics::structure_exact(const double* y, const Input& in, double net, LawForce laws,
+                               Algebra& g) const noexcept {
+  g.held = specimen_on_ ? net - g.Fsp : net;
+  const Sliding sliding = in.sliding == Sliding::Auto ? coulomb_->mode(y[kV], g.held) : in.sliding;
+  const LawForce f = coulomb_->at(y[kV], sliding, g.held);
+  net -= f.F;
+  laws.dF_dv += f.dF_dv;
+  if (sliding != Sliding::Stuck) {
+    structure_rates<W>(net, laws, g);
+    return;
+  }
+  g.a = 0.0;  // not held - held's rounding
+  for (int j = 0; j < W; ++j) g.da[j] = 0.0;  // v stays 0 whatever the other states do
+}
+
+// The acceleration from the net force on the structure (and its gradient: laws' summed, the
+// specimens' in g).
+template <int W>
+void Dynamics::structure_rates(double net, const LawForce& laws, Algebra& g) const noexcept {
+  const bool actuator = mode_ != ControlMode::Free;
+  g.a = specimen_on_ ? (net - g.Fsp) / M_ : net / M_;
+  if constexpr (W == 0) return;  // the values alone (rhs)
   if (!specimen_on_) {
     g.da[kX] = -laws.dF_dx / M_;
     g.da[kV] = -laws.dF_dv / M_;

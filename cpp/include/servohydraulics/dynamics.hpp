@@ -165,7 +165,12 @@ class Dynamics {
   template <class F>
   decltype(auto) at_width(F&& f) const noexcept;
   template <int W>
-  void structure(const double* y, const Input& in, Algebra& a) const noexcept;
+  [[gnu::always_inline]] inline void structure(const double* y, const Input& in, Algebra& a) const noexcept;
+  template <int W>
+  [[gnu::cold, gnu::noinline]] void structure_exact(const double* y, const Input& in, double net, LawForce laws,
+                                                    Algebra& a) const noexcept;
+  template <int W>
+  void structure_rates(double net, const LawForce& laws, Algebra& a) const noexcept;
   template <int W>
   bool servo_controller(const double* y, const Input& in, Algebra& a) const noexcept;
   template <int W>
@@ -176,7 +181,7 @@ class Dynamics {
   bool delay_drive(const double* y, Algebra& a) const noexcept;
   void jacobian_appended(const Algebra& g, Jacobian& J, State* B) const noexcept;
   // The rates (rhs) and every row of J and B (jacobian) from an evaluation g at y.
-  void rates(const double* y, const Algebra& g, double* ydot) const noexcept;
+  [[gnu::always_inline]] inline void rates(const double* y, const Algebra& g, double* ydot) const noexcept;
   void jacobian_rows(const Algebra& g, Jacobian& J, State* B) const noexcept;
   // f(law) for each law of the structure that is on, in the order of StructureLaws.
   template <class F>
