@@ -125,9 +125,9 @@ def test_lugre_friction_is_named_with_its_presliding_stiffness() -> None:
     """LuGre friction (bristle stiffness 5e5 N/m: 0.5 mm of presliding travel, and a
     Stribeck peak F_s = 1.3 F_c the library's LuGre does not have) hidden in a
     displacement record: named lugre_friction, sigma_0 and the sliding level F_c
-    within 20 %.  The same record with Coulomb friction is named coulomb_friction:
-    lugre_friction nests it (sigma_0 -> infinity) and the BIC prefers the simpler
-    law, never "ambiguous"."""
+    within 20 %, and Coulomb friction, the same F_c, not screened after it.  The same
+    record with Coulomb friction is named coulomb_friction: lugre_friction nests it
+    (sigma_0 -> infinity) and the BIC prefers the simpler law, never "ambiguous"."""
     rec = Record({k: np.asarray(v) for k, v in _displacement_record(
         friction="lugre", F_c=250.0, F_s=325.0, v_s=0.01, sigma_0=5e5).items()})
     d = sh.diagnose(rec, _linear_rig(), mode="displacement", progress=False)
@@ -137,6 +137,10 @@ def test_lugre_friction_is_named_with_its_presliding_stiffness() -> None:
     assert p["sigma_0"]["unit"] == "N/m" and abs(p["sigma_0"]["value"] - 5e5) / 5e5 < 0.2
     assert abs(p["F_c"]["value"] - 250.0) / 250.0 < 0.2
     assert d.rig.effects.lugre_friction and d.rig.sigma_0 == pytest.approx(p["sigma_0"]["value"])
+    # after it, coulomb_friction (its limit, the same F_c) is not screened again: a re-fit of an added parameter
+    later = [c for c in d.candidates if c.name == "coulomb_friction" and c.round > 1]
+    assert later and all(c.rejection.startswith("already in the model: a limit of lugre_friction")
+                         and c.screening_score is None and c.delta_bic is None for c in later)
 
     rec = Record({k: np.asarray(v) for k, v in _displacement_record(friction="coulomb", F_c=250.0).items()})
     d = sh.diagnose(rec, _linear_rig(), mode="displacement", progress=False)

@@ -121,7 +121,8 @@ class Candidate:
     #: candidates that explain similar residuals: when this one ranks first in screening, they are confirmed too
     look_alikes: tuple[str, ...] = ()
     #: candidates this one contains as a limit (lugre_friction is coulomb_friction as sigma_0 -> inf): between
-    #: nested candidates the information criterion decides (parsimony), they are never "ambiguous"
+    #: nested candidates the information criterion decides (parsimony), they are never "ambiguous"; once this one
+    #: is added they are not screened (their parameters are its own, already fitted: ``workflow._not_screened``)
     nests: tuple[str, ...] = ()
     #: its force is carried by the actuator (a structural or specimen force): the current model's load-dependent
     #: loop terms (``load_terms``) are re-fitted with it over their whole range

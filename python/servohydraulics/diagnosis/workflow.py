@@ -346,6 +346,9 @@ def _not_screened(name: str, added: set[str], mode: str, ctx: Context) -> str | 
     """Why a candidate is not screened this round, or None."""
     if name in added:
         return "already added"
+    within = sorted(a for a in added if name in LIBRARY[a].nests)
+    if within:  # its parameters are the added effect's, already fitted: a re-fit of them, not a new effect
+        return f"already in the model: a limit of {within[0]} (added), whose fit covers it"
     if mode not in LIBRARY[name].modes:
         return f"cannot act in {mode} mode"
     return LIBRARY[name].exercised(ctx) or None
