@@ -127,6 +127,46 @@ def test_a_key_whose_removal_changes_nothing_is_at_bound_not_falsely_precise():
     assert 0.19 < u["intervals"]["a"][0] < 0.2 < u["intervals"]["a"][1] < 0.21
 
 
+def test_removals_on_the_fits_own_runs_compare_with_the_cost_on_the_same_runs():
+    """``removal_statistics`` with ``fast`` (the fit's own, cheaper runs; None where they cannot stand for
+    the whole runs): each removal is compared with the cost at the fit on the runs it was made on.  A
+    fast residual that differs from the whole runs' by an integrator's error (a fixed 2 % of the signal,
+    the same at every point) gives the whole runs' statistics; where ``fast`` gives None (key b, a removal
+    the fit's runs cannot make), the whole runs decide, compared with their own cost."""
+    rng = np.random.default_rng(11)
+    n = 4000
+    g = np.sin(np.linspace(0, 40, n))
+    noise = 0.01 * rng.standard_normal(n)
+    coords = Coordinates(("a", "b"), np.array([0.2, 0.1]), ("log", "log"), np.array([0.2, 0.1]))
+
+    def residual(z):  # both keys act: a on g, b on a second signal
+        v = coords.values(z)
+        return v[0] * g - 0.2 * g + (v[1] - 0.1) * np.cos(np.linspace(0, 25, n)) + noise
+
+    calls = []
+
+    def fast(points):
+        calls.append(len(points))
+        out = []
+        for z in points:
+            v = coords.values(z)
+            out.append(None if v[1] < 0.05 else residual(z) + 0.02 * 0.2 * g)  # b removed: not on these runs
+        return out
+
+    z = np.zeros(2)
+    f = residual(z)
+    J = np.column_stack([0.2 * g, 0.1 * np.cos(np.linspace(0, 25, n))])
+    stage = StageResult(z, 0.5 * float(f @ f), 1, f, J)
+    cov = stats.covariance(J, f)
+    whole = removal_statistics(stage, coords, cov, residual)
+    both = removal_statistics(stage, coords, cov, residual, fast)
+    assert calls == [3]  # the fit's point and the two removals, run together
+    assert both[0] == pytest.approx(whole[0], rel=0.05) and both[0] != whole[0]  # a on the fast runs
+    assert both[1] == whole[1]  # b on the whole runs, to the bit
+    assert both[0] > CHI2_1_95 and both[1] > CHI2_1_95
+    assert removal_statistics(stage, coords, cov, residual, lambda pts: [None] * len(pts)) == whole
+
+
 def _context(rig: sh.Rig) -> Context:
     return Context(rig=rig, nominal=rig, mode="displacement", peak_spool=0.1, peak_pressure=5e6, peak_x=0.03,
                    rms_v=0.05, peak_force=3e4)

@@ -145,6 +145,19 @@ def records_peak_velocity(records: list[Response]) -> float:
 FIT_RTOL = 1e-6
 
 
+def automatic_substeps(rig: Rig, records: list[Response], mode: str) -> int | None:
+    """RK4's automatic substep count per sample for the records' runs of ``rig`` (the core's rule from
+    the plant's rate bound: the stiffer the rig, the more substeps; a hysteretic specimen's rate
+    bounded with ``V_REF_MARGIN`` times the records' peak velocity), None when the core refuses the rig."""
+    dt = min(r.dt for r in records)
+    v_ref = V_REF_MARGIN * max(records_peak_velocity(records), 1e-4)
+    try:
+        return make_plant(rig, mode, dt, solver_options(method="rk4", rk4_v_ref=v_ref),
+                          initial_displacement(records[0])).rk4_substeps
+    except Error:
+        return None
+
+
 def fit_options(rig: Rig, records: list[Response], mode: str, method: str = "dopri5", margin: float = 1.5):
     """The time stage's integrator.  ``"dopri5"``: Dormand-Prince 5(4) (the core's default,
     CVODE for a stiff sample) at rtol ``FIT_RTOL``.  ``"rk4"``: RK4 with the substep count
@@ -158,13 +171,8 @@ def fit_options(rig: Rig, records: list[Response], mode: str, method: str = "dop
         return solver_options(method="dopri5", rtol=FIT_RTOL, stiff_check=False)
     if method != "rk4":
         raise ValueError(f"invalid method = {method!r}: expected 'dopri5' or 'rk4'")
-    dt = min(r.dt for r in records)
-    v_ref = V_REF_MARGIN * max(records_peak_velocity(records), 1e-4)
-    try:
-        n = make_plant(rig, mode, dt, solver_options(method="rk4", rk4_v_ref=v_ref),
-                       initial_displacement(records[0])).rk4_substeps
-    except Error:
-        n = MAX_RK4_SUBSTEPS + 1
+    n = automatic_substeps(rig, records, mode)
+    n = MAX_RK4_SUBSTEPS + 1 if n is None else n
     if margin * n > MAX_RK4_SUBSTEPS:
         return solver_options(method="cvode")
     return solver_options(method="rk4", rk4_substeps=max(1, int(np.ceil(margin * n))), rk4_flag_rtol=0.0)

@@ -42,6 +42,7 @@ from .coordinates import FORCE_KEYS, LOOP_KEYS, Coordinates, check_keys, specime
 from .fit import (
     RK4_SUBSTEPS,
     StageResult,
+    automatic_substeps,
     best,
     channel_weights,
     checked_options,
@@ -214,7 +215,7 @@ def key_status(coords: Coordinates, z: np.ndarray, identified: np.ndarray) -> li
 CHI2_1_95 = 3.841458820694124
 
 
-def removal_statistics(stage: StageResult, coords: Coordinates, cov, residual) -> dict[int, float]:
+def removal_statistics(stage: StageResult, coords: Coordinates, cov, residual, fast=None) -> dict[int, float]:
     """For each log key the fit left "identified": the test statistic of "the key is zero", from a
     simulation with the key removed (at the bottom of its log range) rather than from the Jacobian.
 
@@ -226,38 +227,50 @@ def removal_statistics(stage: StageResult, coords: Coordinates, cov, residual) -
     does anything (a damper mass collapsed to 3.6e-11 kg, whose Jacobian column is the integrator's
     noise and whose sandwich interval came out 6e-15 kg wide).  ``residual(z)`` gives the
     weighted residual of ``stage.fun`` at z (whole runs: the cost at ``stage.z`` is recomputed with
-    it, so that an integrator's difference from the fit's runs does not count as a rise)."""
+    it, so that an integrator's difference from the fit's runs does not count as a rise).
+    ``fast(points)`` (optional) gives it at several points at once on cheaper runs (the fit's own),
+    None at a point where those cannot stand for it; each removal is then compared with the cost at
+    ``stage.z`` on the same runs as its own, ``residual``'s only where ``fast`` gave None."""
     from concurrent.futures import ThreadPoolExecutor
 
     lo, _ = coords.bounds()
     sd = cov.sd
-    r0 = residual(np.asarray(stage.z, dtype=float))  # the same runs as the removals' (not the fit's segments)
-    cost0 = 0.5 * float(r0 @ r0)
     cols = {int(i): float(stage.jac[:, i] @ stage.jac[:, i])
             for i in np.flatnonzero(np.asarray(coords.log) & cov.identified)}
     todo = [i for i, c in cols.items() if c > 0.0 and np.isfinite(sd[i]) and sd[i] > 0.0]
+    z0 = np.asarray(stage.z, dtype=float)
+    points = {}
+    for i in todo:
+        points[i] = z0.copy()
+        points[i][i] = lo[i]
 
-    def removed(i: int) -> float:
-        z = np.array(stage.z, dtype=float)
-        z[i] = lo[i]
-        r = residual(z)
+    def statistic(i: int, r: np.ndarray, cost0: float) -> float:
         return float((2.0 * max(0.5 * float(r @ r) - cost0, 0.0) / cols[i]) / sd[i] ** 2)
 
-    with ThreadPoolExecutor(max_workers=default_workers()) as pool:  # the core releases the GIL
-        return dict(zip(todo, pool.map(removed, todo)))
+    out: dict[int, float] = {}
+    if fast is not None and todo:
+        r0, *rs = fast([z0] + [points[i] for i in todo])
+        if r0 is not None:
+            out = {i: statistic(i, r, 0.5 * float(r0 @ r0)) for i, r in zip(todo, rs) if r is not None}
+    rest = [i for i in todo if i not in out]
+    if rest:
+        r0 = residual(z0)  # the same runs as these removals' (not the fit's segments)
+        with ThreadPoolExecutor(max_workers=default_workers()) as pool:  # the core releases the GIL
+            out.update(zip(rest, pool.map(lambda i: statistic(i, residual(points[i]), 0.5 * float(r0 @ r0)), rest)))
+    return {i: out[i] for i in todo}
 
 
-def uncertainty(stage: StageResult, coords: Coordinates, lengths: list[int], cov=None, residual=None
+def uncertainty(stage: StageResult, coords: Coordinates, lengths: list[int], cov=None, residual=None, fast=None
                 ) -> dict[str, Any]:
     """The HAC covariance (``stats.covariance``; ``cov`` when already computed) of the fit in its
     coordinates and, per key, its status, standard error and 95 % interval in the key's unit; plus
     the correlation matrix and the AR(1) summary of the residual (lag-1 rho, effective samples).
     With ``residual`` (z -> the weighted residual of the fit), a log key whose removal the records
     cannot tell from its value (``removal_statistics`` below ``CHI2_1_95``) is "at bound" (collapsed
-    to zero) as well."""
+    to zero) as well (``fast``: ``removal_statistics``' cheaper runs)."""
     cov = covariance(stage.jac, stage.fun, None, lengths) if cov is None else cov
     status = key_status(coords, stage.z, cov.identified)
-    removal = removal_statistics(stage, coords, cov, residual) if residual is not None else {}
+    removal = removal_statistics(stage, coords, cov, residual, fast) if residual is not None else {}
     for i, w in removal.items():
         if status[i] == "identified" and w < CHI2_1_95:
             status[i] = "at bound"
@@ -431,8 +444,8 @@ def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options,
     ``fit.keep_best`` of the start and the stages, on the runs of ``_fit_target`` (checked against
     the pair's whole runs ``before`` of the start, and against those of the result: where they
     disagree the result is polished on the pair's whole runs); returns keep_best's result, the
-    evaluations, the whole runs of the result, how the time stage ran (``Identification.runs``) and the
-    result's ``stats.covariance``."""
+    evaluations, the whole runs of the result, how the time stage ran (``Identification.runs``), the
+    result's ``stats.covariance``, and the options and segments of the runs the result stands on."""
     from tqdm.auto import tqdm
 
     workers = default_workers() if workers is None else max(1, int(workers))
@@ -461,7 +474,7 @@ def _time_stages(recs, start, coords, z1, frequency_stage, mode, chans, options,
                 cov = covariance(kept[3].jac, kept[3].fun, None, target.lengths)
         finally:
             target.close()
-    return (*kept, nfev, after, runs, cov)
+    return (*kept, nfev, after, runs, cov, (target.options, target.segments))
 
 
 #: the time stage's result stands when the pair's whole runs would move it by at most this fraction
@@ -483,6 +496,32 @@ def _shift(target: Target, rig, after: list, weights: dict, final: StageResult, 
     sd = cov.sd
     ok = np.isfinite(sd) & (sd > 0)
     return float(np.max(np.abs(step[ok]) / sd[ok])) if ok.any() else 0.0
+
+
+def _removal_runs(target: Target, start: Rig, coords: Coordinates, z_fit: np.ndarray, recs: list, mode: str,
+                  weights: dict):
+    """``removal_statistics``' cheaper runs: the time stage's own (RK4 on the records' segments, shown to
+    agree with the pair's whole runs at the start and at the result: ``Target.agrees``, ``_shift``), for a
+    removal whose rig is no stiffer than the result (RK4's automatic substep count, from the plant's rate
+    bound, at most the result's: a damper mass removed makes the rig stiff, and goes to the pair) and
+    whose run does not fail; None when the time stage ran on the pair."""
+    if target.options.method.name.lower() != "rk4":
+        return None
+    n_fit = automatic_substeps(coords.apply(start, z_fit), recs, mode)
+
+    def fast(points: list) -> list:
+        rigs = []
+        for z in points:
+            try:
+                rig = coords.apply(start, z)
+            except ValueError:  # not a valid rig: the pair's runs decide
+                rig = None
+            n = None if rig is None or n_fit is None else automatic_substeps(rig, recs, mode)
+            rigs.append(rig if n is not None and n <= n_fit else None)
+        done = iter(target.completed([r for r in rigs if r is not None], weights))
+        return [None if r is None else next(done) for r in rigs]
+
+    return fast
 
 
 def _describe(options) -> str:
@@ -556,12 +595,16 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
     options = fit_options(coords.apply(start, z1), recs, mode)
     t0 = time.perf_counter()
     before_runs = _whole_runs(start, recs, mode, dt, options, default_workers() if workers is None else workers)
-    kept, costs, weights, final, nfev["time"], after_runs, runs, cov = _time_stages(
+    kept, costs, weights, final, nfev["time"], after_runs, runs, cov, (fit_options_, segments_) = _time_stages(
         recs, start, coords, z1, frequency_stage, mode, chans, options, dt, max_nfev, progress, workers, before_runs)
     runtime["time"] = time.perf_counter() - t0
     lengths = [r.time.size for r in recs for _ in chans]
-    u = uncertainty(final, coords, lengths, cov,
-                    residual=lambda z: time_residual(coords.apply(start, z), recs, mode, chans, options, dt, weights))
+    with Target(recs, mode, chans, fit_options_, dt, segments_,
+                default_workers() if workers is None else max(1, int(workers))) as fit_runs:
+        u = uncertainty(final, coords, lengths, cov,
+                        residual=lambda z: time_residual(coords.apply(start, z), recs, mode, chans, options, dt,
+                                                         weights),
+                        fast=_removal_runs(fit_runs, start, coords, final.z, recs, mode, weights))
     values = {k: float(v) for k, v in zip(keys, coords.values(final.z))}
     s1_vals = coords.values(z1)
     out_rig = coords.apply(start, final.z)

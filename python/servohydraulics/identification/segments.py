@@ -226,9 +226,18 @@ class Target:
             if k is None:
                 out.append(np.full(sum(self.lengths_of(chans)), FAILED))
                 continue
-            e = have[k]
-            out.append(np.concatenate([w[ch] * e[ch][i] for i in range(len(self.records)) for ch in chans]))
+            out.append(self._weighted(have[k], w, chans))
         return out
+
+    def completed(self, rigs: list[Rig], weights: dict | None = None) -> list[np.ndarray | None]:
+        """``residuals`` of the rigs over every channel, run together (not cached), None for a rig whose
+        run failed on a segment instead of its ``FAILED`` entries."""
+        w = {ch: 1.0 if weights is None else weights[ch] for ch in self.channels}
+        return [None if any(s is None for s in row) else self._weighted(self._unweighted(row), w, self.channels)
+                for row in self.simulations(rigs)]
+
+    def _weighted(self, e: dict, w: dict, chans: tuple[str, ...]) -> np.ndarray:
+        return np.concatenate([w[ch] * e[ch][i] for i in range(len(self.records)) for ch in chans])
 
     def residual(self, rig: Rig | None, weights: dict | None = None,
                  channels: tuple[str, ...] | None = None) -> np.ndarray:
