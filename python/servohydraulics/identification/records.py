@@ -503,8 +503,8 @@ def _removal_runs(target: Target, start: Rig, coords: Coordinates, z_fit: np.nda
     """``removal_statistics``' cheaper runs: the time stage's own (RK4 on the records' segments, shown to
     agree with the pair's whole runs at the start and at the result: ``Target.agrees``, ``_shift``), for a
     removal whose rig is no stiffer than the result (RK4's automatic substep count, from the plant's rate
-    bound, at most the result's: a damper mass removed makes the rig stiff, and goes to the pair) and
-    whose run does not fail; None when the time stage ran on the pair."""
+    bound, at most the result's: on the UTFSM chirp the damper's c1 removed is stiffer, and goes to the
+    pair) and whose run does not fail; None when the time stage ran on the pair."""
     if target.options.method.name.lower() != "rk4":
         return None
     n_fit = automatic_substeps(coords.apply(start, z_fit), recs, mode)
@@ -595,11 +595,11 @@ def identify(records, rig: Rig | str | Path | None = None, fit: Sequence[str] | 
     options = fit_options(coords.apply(start, z1), recs, mode)
     t0 = time.perf_counter()
     before_runs = _whole_runs(start, recs, mode, dt, options, default_workers() if workers is None else workers)
-    kept, costs, weights, final, nfev["time"], after_runs, runs, cov, (fit_options_, segments_) = _time_stages(
+    kept, costs, weights, final, nfev["time"], after_runs, runs, cov, (stage_options, stage_segments) = _time_stages(
         recs, start, coords, z1, frequency_stage, mode, chans, options, dt, max_nfev, progress, workers, before_runs)
     runtime["time"] = time.perf_counter() - t0
     lengths = [r.time.size for r in recs for _ in chans]
-    with Target(recs, mode, chans, fit_options_, dt, segments_,
+    with Target(recs, mode, chans, stage_options, dt, stage_segments,
                 default_workers() if workers is None else max(1, int(workers))) as fit_runs:
         u = uncertainty(final, coords, lengths, cov,
                         residual=lambda z: time_residual(coords.apply(start, z), recs, mode, chans, options, dt,
