@@ -10,7 +10,8 @@ recall, false-positive rate on no-effect records, confusion matrix, parameter
 error and interval coverage, fraction of the gap closed, runtime.
 
 ``--only SUBSET`` diagnoses and reports the records of one subset (``SUBSETS``,
-chosen by the answer key's labels: e.g. ``issue25``) into its own ``--doc``;
+chosen by the answer key's labels: e.g. ``issue25``) into its own ``--doc``, ``--ids``
+the records named;
 ``--before JSON`` adds the same records diagnosed by earlier code.
 """
 
@@ -456,6 +457,8 @@ def main() -> None:
                                    "comes, and records already in it are not diagnosed again (a long run resumes)")
     p.add_argument("--only", choices=[label for label, _ in SUBSETS],
                    help="diagnose and report only the records of this subset (write the doc elsewhere with --doc)")
+    p.add_argument("--ids", help="diagnose and report only these records (comma-separated ids, e.g. r003,r004; "
+                                 "write the doc elsewhere with --doc)")
     p.add_argument("--cached-only", action="store_true",
                    help="report only the records already in --cache (a run cut short; the doc says how many)")
     a = p.parse_args()
@@ -480,6 +483,13 @@ def main() -> None:
         keep = dict(SUBSETS)[a.only]
         ids = {k["id"] for k in json.loads((data / "answer_key.json").read_text()) if keep(k)}
         manifest = [m for m in manifest if m["id"] in ids]
+    if a.ids:
+        ids = [i.strip() for i in a.ids.split(",") if i.strip()]
+        unknown = sorted(set(ids) - {m["id"] for m in manifest})
+        if unknown or not ids:
+            p.error(f"invalid --ids = {a.ids!r}: {unknown or 'no id'} not in {data / 'manifest.json'}"
+                    + (f" (with --only '{a.only}')" if a.only else ""))
+        manifest = [m for m in manifest if m["id"] in set(ids)]
     done = {}
     if a.cache and Path(a.cache).exists():
         for line in Path(a.cache).read_text().splitlines():
@@ -509,8 +519,8 @@ def main() -> None:
                else f"python evaluation/diagnose_eval/generate.py --out {a.data}")
     cmd = (f"{gen_cmd} --jobs {a.jobs}\n"
            f"python evaluation/diagnose_eval/evaluate.py --data {a.data} --jobs {a.jobs}"
-           + (f" --only '{a.only}'" if a.only else "")
-           + (f" --doc {a.doc}" if a.only or a.doc != "docs/diagnose_eval.md" else "")
+           + (f" --only '{a.only}'" if a.only else "") + (f" --ids {a.ids}" if a.ids else "")
+           + (f" --doc {a.doc}" if a.only or a.ids or a.doc != "docs/diagnose_eval.md" else "")
            + (f" --cache {a.cache} --cached-only: {len(manifest)} records of the set" if a.cached_only else ""))
     write_doc(m, results, key, doc, cmd, wall, a.jobs, before)
     doc.with_suffix(".json").write_text(json.dumps({"metrics": m, "records": results, "command": cmd,
