@@ -174,3 +174,36 @@ def test_a_result_the_pairs_runs_would_move_is_polished_on_them(monkeypatch):
         assert abs(polished.values[k] - ident.values[k]) < 0.1 * ident.std[k]
         lo, hi = ident.intervals[k]
         assert lo <= getattr(rig, k) <= hi  # the truth inside the 95 % interval
+
+
+def test_removal_runs_refuse_a_stiffer_rig_and_an_invalid_one():
+    """``records._removal_runs``: a removal runs on the fit's RK4 segments only when RK4's automatic
+    substep count for its rig (the core's rule from the plant's rate bound) is at most the fitted rig's;
+    the fitted point itself comes back as the target's own residual, to the bit; a stiffer rig (the
+    damper's Bouc-Wen gamma, which bounds this rig's rates, four times higher: more substeps) and a rig the
+    core refuses (gamma infinite) come back None (the
+    pair's whole runs decide), and a Target on the pair gives no fast runs at all."""
+    from servohydraulics.identification.fit import automatic_substeps, rk4_options
+
+    rig = mr_rig()
+    rec = record(rig, duration=6.0)
+    coords = Coordinates.about(rig, ("mr_gamma",))
+    z_fit = np.zeros(1)
+    n_fit = automatic_substeps(rig, [rec], "displacement")
+    assert coords.kind == ("log",)
+    stiff, soft, invalid = np.array([np.log(4.0)]), np.array([np.log(0.25)]), np.array([800.0])
+    assert automatic_substeps(coords.apply(rig, invalid), [rec], "displacement") is None  # the core refuses gamma inf
+    assert automatic_substeps(coords.apply(rig, stiff), [rec], "displacement") > n_fit  # the premise
+    assert automatic_substeps(coords.apply(rig, soft), [rec], "displacement") <= n_fit
+    with segments.Target.build([rec], "displacement", ("displacement", "force"), rk4_options(n_fit), None, rig,
+                               2) as target:
+        fast = records._removal_runs(target, rig, coords, z_fit, [rec], "displacement", None)
+        points = [z_fit, stiff, soft, invalid]
+        out = fast(points)
+        np.testing.assert_array_equal(out[0], target.residual(rig))
+        assert out[1] is None
+        np.testing.assert_array_equal(out[2], target.residual(coords.apply(rig, soft)))
+        assert out[3] is None
+    pair = segments.Target([rec], "displacement", ("displacement",), fit_options(rig, [rec], "displacement"), None,
+                           [segments.whole(rec)])
+    assert records._removal_runs(pair, rig, coords, z_fit, [rec], "displacement", None) is None
