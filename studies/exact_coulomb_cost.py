@@ -8,7 +8,9 @@ The first 10 s of the UTFSM chirp at 1 A (benchmarks/lab_speed.py's ``diagnose10
 there), the friction regularised at v_stick = 1e-4 (the rig's), 1e-5 and 1e-6 m/s, and exact
 (v_stick = 0): for each, the thread CPU seconds of a run (the least of ``--repeats``) by the search's
 pair (dopri5 at rtol 1e-6, ``engine.run_options(True)``), the decisions' pair (rtol 1e-8), RK4 at 4
-and 8 substeps and ROS2 at 8 (``engine.ros2_options``), the run's internal steps, and its rms and
+and 8 substeps and ROS2 at 8 (``engine.ros2_options``), and on the rig's own law (v_stick = 1e-4) CVODE alone
+at rtol 1e-6 restarted at every sample (the core's default: a held command's change is a discontinuity) and
+never restarted (``restart="never"``: its history carried across the samples), the run's internal steps, and its rms and
 largest difference from the exact law's rtol-1e-8 run on displacement and force, as fractions of the
 measured channel's standard deviation; then the substeps per sample of RK4 at 4 on the exact law (a
 switch re-integrates its stretch: a real-time step's cost).  RK4 is not run on the regularised law: it diverges there
@@ -46,6 +48,10 @@ def main() -> None:
     case = engine.make_case(rec, "displacement", "chirp20Hz_1A[0, 10 s]")
     integrators = [("pair 1e-6", engine.run_options(True)), ("pair 1e-8", engine.run_options(False)),
                    ("RK4 x4", rk4_options(4)), ("RK4 x8", rk4_options(8)), ("ROS2 x8", engine.ros2_options(8))]
+    # CVODE alone on the rig's own law: does carrying its history across the samples save the restarts' steps?
+    cvode = {"method": "cvode", "rtol": 1e-6, "stiff_check": False}
+    cvode_rows = [("CVODE 1e-6, restarted each sample", sh.solver_options(**cvode)),
+                  ("CVODE 1e-6, never restarted", sh.solver_options(**cvode, restart="never"))]
 
     def rig_with(v_stick: float):
         r = sh.load_rig(ROOT / "evaluation" / "utfsm_rig_0A.toml")
@@ -71,7 +77,7 @@ def main() -> None:
     print("|---|---|---|---|---|---|")
     for vs in V_STICKS:
         r = rig_with(vs)
-        for name, opts in integrators:
+        for name, opts in integrators + (cvode_rows if vs == 1e-4 else []):
             if vs > 0 and name.startswith("RK4"):
                 continue
             out, cpu = run(r, opts)
