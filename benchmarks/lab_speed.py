@@ -1,7 +1,7 @@
 """How long identification and diagnosis of lab records take (issue 25, item 6), and where the time goes.
 
     python benchmarks/lab_speed.py [--cases identify,diagnose10,diagnose10sim,sweep1A] [--json FILE]
-                                   [--profile] [--label NAME] [--v-stick V]
+                                   [--profile] [--label NAME] [--v-stick V] [--continuation pair|search]
     python benchmarks/lab_speed.py --table benchmarks/lab_speed.json
 
 The cases (records from ../shared/real-data/utfsm-mts-mrdamper, or $SH_SHARED_DIR/real-data/...):
@@ -270,12 +270,19 @@ def main() -> None:
     p.add_argument("--v-stick", type=float, default=None, metavar="V",
                    help="the diagnosis cases' nominal rig with v_stick = V [m/s] (0: the exact Coulomb law, "
                         "docs/model.md); default: the rig's own")
+    p.add_argument("--continuation", choices=("pair", "search"), default=None,
+                   help="where a diagnosis fit goes on when its fixed step stopped agreeing with the pair "
+                        "(diagnosis.engine.FIT_CONTINUATION; default: the package's, 'pair')")
     a = p.parse_args()
     if a.table:
         print(table(Path(a.table)))
         return
     import servohydraulics as sh
 
+    if a.continuation is not None:
+        from servohydraulics.diagnosis import engine
+
+        engine.FIT_CONTINUATION = a.continuation
     cases = [c.strip() for c in a.cases.split(",") if c.strip()]
     import numpy
     import scipy
@@ -283,7 +290,8 @@ def main() -> None:
     # the libraries' rounding moves the fits' paths (docs/benchmarks.md, "This venv's rounding"): recorded with the row
     out = {"label": a.label, "python": platform.python_version(), "numpy": numpy.__version__,
            "scipy": scipy.__version__, "cpus": os.cpu_count(),
-           "command": "python benchmarks/lab_speed.py " + " ".join(sys.argv[1:]), "v_stick": a.v_stick, "cases": {}}
+           "command": "python benchmarks/lab_speed.py " + " ".join(sys.argv[1:]), "v_stick": a.v_stick,
+           "continuation": a.continuation, "cases": {}}
     counter = Counters()
     for case in cases:
         counter.reset()

@@ -175,6 +175,45 @@ def test_the_fit_on_rk4_lands_where_the_fit_on_the_pair_does(monkeypatch):
     assert abs(c0 / c0_true - 1.0) < 0.05
 
 
+@pytest.mark.parametrize("continuation, checks, expect", [
+    ("pair", [False], ["rk4 3", "pair"]),  # the default: straight on to the pair
+    ("search", [False, True], ["rk4 3", "rk4 8"]),  # chosen again, and it agrees at its result
+    ("search", [False, False], ["rk4 3", "rk4 8", "pair"]),  # chosen again, disagrees again: the pair
+    ("search", [True], ["rk4 3"]),  # the first result agrees: no continuation
+])
+def test_a_fit_whose_fixed_step_stopped_agreeing_goes_on_as_fit_continuation_says(monkeypatch, continuation, checks,
+                                                                                  expect):
+    """``engine.fit``'s continuation (``FIT_CONTINUATION``): the integrators its runs used, in order, where the
+    end checks (``agrees``) answer ``checks`` and the integrator choice (``search_options``) gives RK4 at 3
+    substeps at the start and at 8 where it is asked again; each fit ends on a result the last check accepted
+    or on the pair, and the choice is asked again once at most."""
+    rig = _rig()
+    rec = _record(rig, 1.2 * sh._core.mr_damper_law(rig)["c0"])
+    setup = workflow._prepare([rec], rig, "displacement", ["mr_damper"], 1, False, False)
+    x0 = tuple(c.x0_data for c in setup.cases)
+    ctx = workflow._context(setup, workflow._State(rig=rig, tau=0.0, x0=x0,
+                                                   sims=engine.simulate_all(rig, setup.cases, 0.0, x0)))
+    space = engine.Space(LIBRARY["mr_damper"], ctx, ())
+    used, answers, choices = [], iter(checks), iter([[rk4_options(3)], [rk4_options(8)]])
+    real = engine.simulate_all
+
+    def simulate_all(rig, cases, tau, x0s, search=False, options=None):
+        o = options[0]
+        name = f"rk4 {o.rk4_substeps}" if engine.fixed_step(o) else "pair"
+        if not used or used[-1] != name:
+            used.append(name)
+        return real(rig, cases, tau, x0s, search, options)
+
+    monkeypatch.setattr(engine, "FIT_CONTINUATION", continuation)
+    monkeypatch.setattr(engine, "simulate_all", simulate_all)
+    monkeypatch.setattr(engine, "agrees", lambda *a: next(answers))
+    monkeypatch.setattr(engine, "search_options", lambda *a: next(choices))
+    res = engine.fit(space, setup.cases, space.absent.copy(), 0.0, "all", x0, max_nfev=4)
+    assert used == expect
+    assert next(answers, None) is None  # every check asked for was made
+    assert np.all(np.isfinite(res.z)) and res.nfev >= len(expect)
+
+
 def test_a_repeated_run_is_served_from_the_cache_and_equals_a_fresh_run():
     """``engine.RUNS``: a run made again (the same rig, command, delay, initial displacement and
     options) is the first run's arrays, read-only, and bit for bit what the core gives when asked

@@ -692,7 +692,9 @@ def fit(space: Space, cases: list[Case], z0: np.ndarray, base_tau: float, which:
 
     The runs use ``search_options`` at the start (RK4 at the fewest agreeing substeps, else the
     search's pair); when the RK4 runs of the result no longer agree with the pair's (the fit moved
-    the candidate somewhere stiffer), the fit goes on from there on the pair's runs."""
+    the candidate somewhere stiffer), the fit goes on from there on the pair's runs (``FIT_CONTINUATION``
+    ``"pair"``, the default), or (``"search"``) on ``search_options`` chosen again there, checked again at
+    its result and, where that no longer agrees either, on the pair's."""
     sd = np.array([max(c.x0_sd, 1e-8) for c in cases])
     cen = np.array([c.x0_data for c in cases])
     lo = np.concatenate([space.lo, cen - 4 * sd])
@@ -713,13 +715,26 @@ def fit(space: Space, cases: list[Case], z0: np.ndarray, base_tau: float, which:
     options = search_options(rig0, cases, tau0, zs[p:])
     res = run(zs, options)
     nfev = int(res.nfev)
-    if any(fixed_step(o) for o in options):
+    rechosen = FIT_CONTINUATION == "search"
+    while any(fixed_step(o) for o in options):
         rig1, tau1 = space.rig_and_tau(res.x[:p], base_tau)
-        if not agrees(rig1, cases, tau1, res.x[p:], options):
-            res = run(np.clip(res.x, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo)), [run_options(True)] * len(cases))
-            nfev += int(res.nfev)
+        if agrees(rig1, cases, tau1, res.x[p:], options):
+            break
+        z1 = np.clip(res.x, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
+        if rechosen:  # once: the integrator chosen again where the fixed step stopped agreeing
+            options, rechosen = search_options(rig1, cases, tau1, z1[p:]), False
+        else:
+            options = [run_options(True)] * len(cases)
+        res = run(z1, options)
+        nfev += int(res.nfev)
     return FitResult(z=res.x[:p].copy(), x0=res.x[p:].copy(), jac=res.jac, fun=res.fun, nuisance_scale=sd,
                      nfev=nfev)
+
+
+#: where a fit goes on when its fixed step's result no longer agrees with the search's pair (``fit``): "pair"
+#: (the default) or "search" (``search_options`` chosen again at that point, then the pair): a measurement's
+#: switch (benchmarks/lab_speed.py ``--continuation``; docs/benchmarks.md, "Stop 44"), not a user setting
+FIT_CONTINUATION = "pair"
 
 
 def series_lengths(cases: list[Case], which: str = "all") -> list[int]:
