@@ -255,8 +255,9 @@ def removal_statistics(stage: StageResult, coords: Coordinates, cov, residual, f
     rest = [i for i in todo if i not in out]
     if rest:
         r0 = residual(z0)  # the same runs as these removals' (not the fit's segments)
+        cost0 = 0.5 * float(r0 @ r0)
         with ThreadPoolExecutor(max_workers=default_workers()) as pool:  # the core releases the GIL
-            out.update(zip(rest, pool.map(lambda i: statistic(i, residual(points[i]), 0.5 * float(r0 @ r0)), rest)))
+            out.update(zip(rest, pool.map(lambda i: statistic(i, residual(points[i]), cost0), rest)))
     return {i: out[i] for i in todo}
 
 
