@@ -284,6 +284,11 @@ def main() -> None:
 
         engine.FIT_CONTINUATION = a.continuation
     cases = [c.strip() for c in a.cases.split(",") if c.strip()]
+    if a.json and Path(a.json).exists() and a.label in json.loads(Path(a.json).read_text()):
+        # the JSON is keyed by label: a second run under one label would replace the first's cases
+        print(f"invalid --label = {a.label!r}: {a.json} already has a run of that name; choose another",
+              file=sys.stderr)
+        raise SystemExit(2)
     import numpy
     import scipy
 
