@@ -263,7 +263,7 @@ def table(path: Path, labels: list[str] | None = None) -> str:
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--cases", default=",".join(CASES), help=f"comma-separated, of {', '.join(CASES)}")
-    p.add_argument("--json", help="write the results here (appended under --label)")
+    p.add_argument("--json", help="write the results here (added under --label; a label already there is refused)")
     p.add_argument("--label", default="run", help="name of this run in the JSON (e.g. before, after)")
     p.add_argument("--profile", action="store_true", help="cProfile's top functions per case (main thread)")
     p.add_argument("--table", metavar="FILE", help="print the runs saved in FILE (--json) as a markdown table")
