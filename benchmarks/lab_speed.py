@@ -2,6 +2,7 @@
 
     python benchmarks/lab_speed.py [--cases identify,diagnose10,diagnose10sim,sweep1A] [--json FILE]
                                    [--profile] [--label NAME] [--v-stick V] [--continuation pair|search]
+                                   [--stiff-steps N]
     python benchmarks/lab_speed.py --table benchmarks/lab_speed.json
 
 The cases (records from ../shared/real-data/utfsm-mts-mrdamper, or $SH_SHARED_DIR/real-data/...):
@@ -273,6 +274,9 @@ def main() -> None:
     p.add_argument("--continuation", choices=("pair", "search"), default=None,
                    help="where a diagnosis fit goes on when its fixed step stopped agreeing with the pair "
                         "(diagnosis.engine.FIT_CONTINUATION; default: the package's, 'pair')")
+    p.add_argument("--stiff-steps", type=int, default=None, metavar="N",
+                   help="the diagnosis' error-controlled pair redoes a sample by CVODE past N dopri5 steps "
+                        "(diagnosis.engine.STIFF_STEPS; default: the core's stiff_steps, 24)")
     a = p.parse_args()
     if a.table:
         print(table(Path(a.table)))
@@ -283,6 +287,10 @@ def main() -> None:
         from servohydraulics.diagnosis import engine
 
         engine.FIT_CONTINUATION = a.continuation
+    if a.stiff_steps is not None:
+        from servohydraulics.diagnosis import engine
+
+        engine.STIFF_STEPS = a.stiff_steps
     cases = [c.strip() for c in a.cases.split(",") if c.strip()]
     if a.json and Path(a.json).exists() and a.label in json.loads(Path(a.json).read_text()):
         # the JSON is keyed by label: a second run under one label would replace the first's cases
@@ -296,7 +304,7 @@ def main() -> None:
     out = {"label": a.label, "python": platform.python_version(), "numpy": numpy.__version__,
            "scipy": scipy.__version__, "cpus": os.cpu_count(),
            "command": "python benchmarks/lab_speed.py " + " ".join(sys.argv[1:]), "v_stick": a.v_stick,
-           "continuation": a.continuation, "cases": {}}
+           "continuation": a.continuation, "stiff_steps": a.stiff_steps, "cases": {}}
     counter = Counters()
     for case in cases:
         counter.reset()

@@ -16,6 +16,7 @@ import pytest
 import servohydraulics as sh
 from servohydraulics.diagnosis import engine, workflow
 from servohydraulics.diagnosis.effects import LIBRARY
+from servohydraulics.diagnosis.effects import apply_area as _apply_area
 from servohydraulics.identification.fit import rk4_options
 from servohydraulics.identification.run import simulate_command
 from servohydraulics.identification.segments import AGREEMENT, AGREEMENT_RMS
@@ -345,3 +346,27 @@ def test_the_run_cache_key_tells_every_field_of_the_rig_apart():
             others = [m for m in type(v).__members__.values() if m != v]
             setattr(r, name, others[0])
         assert engine.RUNS.key(r, case, 0.0, 0.0, engine.run_options(True)) != key, name
+
+
+def test_the_pairs_stiff_switch_at_100_steps_keeps_its_runs_and_leaves_cvode_the_stiff_samples(monkeypatch):
+    """``engine.STIFF_STEPS`` (a measurement switch, docs/benchmarks.md, stop 45): dopri5 hands a sample to
+    CVODE past that many steps.  On the 0 A rig re-sized x30 by the load term (the sweep's loop re-fit ends
+    there) the samples that passed 24 steps were accuracy-limited, not stiff: at 100, dopri5 alone takes every
+    sample and agrees with the default pair (CVODE on those samples: an independent integrator) well inside
+    the fits' test, at both tolerances.  On Coulomb friction's rig the samples are stiff and still go to CVODE."""
+    rig = _rig()
+    t = np.arange(int(3.0 / DT) + 1) * DT
+    u = np.minimum(t / 0.3, 1.0) * 0.008 * np.sin(2 * np.pi * (0.5 + 2.5 * t) * t)
+    resized = _apply_area(rig, 30.0 * rig.A)
+    coulomb = LIBRARY["coulomb_friction"].apply(rig, np.array([700.0]))
+    for r, stiff in ((resized, False), (coulomb, True)):
+        for search, tol in ((True, 0.1 * AGREEMENT), (False, 0.01 * AGREEMENT)):
+            monkeypatch.setattr(engine, "STIFF_STEPS", None)
+            ref = simulate_command(r, "displacement", u, DT, 0.0, engine.run_options(search))
+            monkeypatch.setattr(engine, "STIFF_STEPS", 100)
+            run = simulate_command(r, "displacement", u, DT, 0.0, engine.run_options(search))
+            assert ref.work.stiff_samples > 0
+            assert (run.work.stiff_samples > 0) == stiff
+            for c in ("displacement", "force"):
+                y0, y1 = np.asarray(ref.channels[c], float), np.asarray(run.channels[c], float)
+                assert np.max(np.abs(y1 - y0)) <= tol * np.std(y0), (c, search, stiff)

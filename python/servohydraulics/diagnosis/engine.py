@@ -133,7 +133,15 @@ def run_options(search: bool):
     shadow (``stiff_check``: the diagnosis reads no flag; the results are the same to the bit)."""
     from ..identification.fit import FIT_RTOL
 
-    return solver_options(rtol=FIT_RTOL if search else None, stiff_check=False)
+    opts = solver_options(rtol=FIT_RTOL if search else None, stiff_check=False)
+    if STIFF_STEPS is not None:
+        opts.stiff_steps = int(STIFF_STEPS)
+    return opts
+
+
+#: dopri5's steps in one sample beyond which the pair's runs redo the sample by CVODE (``run_options``;
+#: None: the core's ``stiff_steps``, 24): a measurement switch (benchmarks/lab_speed.py --stiff-steps)
+STIFF_STEPS = None
 
 
 class RunCache:
