@@ -1,6 +1,7 @@
 """Where a diagnosis spends its simulation time, by step of the workflow (docs/benchmarks.md, lab-speed).
 
     python studies/diagnose_time_breakdown.py [--record chirp20Hz_1A] [--end 10] [--json FILE] [--v-stick V]
+                                               [--stiff-steps N]
 
 ``sh.diagnose`` of a UTFSM record (default: the first 10 s of ``chirp20Hz_1A``, benchmarks/lab_speed.py's
 ``diagnose10``) against the rig identified at 0 A (evaluation/utfsm_rig_0A.toml), displacement control,
@@ -130,6 +131,9 @@ def main(argv=None) -> int:
     ap.add_argument("--json", type=Path, help="also write the table to this JSON file")
     ap.add_argument("--v-stick", type=float, default=None, metavar="V",
                     help="the nominal rig with v_stick = V [m/s] (0: the exact Coulomb law); default: the rig's own")
+    ap.add_argument("--stiff-steps", type=int, default=None, metavar="N",
+                    help="the pair hands a sample to CVODE past N dopri5 steps (diagnosis.engine.STIFF_STEPS; "
+                         "default: the core's 24)")
     args = ap.parse_args(argv)
     import lab_speed
 
@@ -140,6 +144,8 @@ def main(argv=None) -> int:
     rig = sh.load_rig(ROOT / "evaluation" / "utfsm_rig_0A.toml")
     if args.v_stick is not None:
         rig.v_stick = args.v_stick
+    if args.stiff_steps is not None:
+        engine.STIFF_STEPS = args.stiff_steps
     att = Attribution()
     att.install()
     h0, m0 = engine.RUNS.hits, engine.RUNS.misses
