@@ -130,7 +130,8 @@ def run_options(search: bool):
     gaps) uses the core's default (rtol 1e-8).  A search run costs 1.5 (a friction rig) to 23 (the
     UTFSM MR damper, whose default run turns stiff) times less; a fit's own runs go on RK4 where
     that agrees with this pair (``search_options``).  No run is checked by the pair's
-    shadow (``stiff_check``: the diagnosis reads no flag; the results are the same to the bit)."""
+    shadow (``stiff_check``: the diagnosis reads no flag; the results are the same to the bit).
+    ``STIFF_STEPS`` (None by default) sets the dopri5 steps in a sample past which the pair hands it to CVODE."""
     from ..identification.fit import FIT_RTOL
 
     opts = solver_options(rtol=FIT_RTOL if search else None, stiff_check=False)
