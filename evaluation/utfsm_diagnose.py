@@ -160,7 +160,14 @@ def main() -> None:
                    help="one run of issue 25's table: its rig (evaluation/utfsm_rigs/), record and label; OUT is "
                         "then the folder of the table (OUT/<label>/) and the table is re-written after the run")
     p.add_argument("--summary", action="store_true", help="only re-write the table of the runs found under OUT")
+    p.add_argument("--stiff-steps", type=int, default=None, metavar="N",
+                   help="the diagnosis' error-controlled pair hands a sample to CVODE past N dopri5 steps "
+                        "(diagnosis.engine.STIFF_STEPS, a measurement switch; default: the package's)")
     a = p.parse_args()
+    if a.stiff_steps is not None:
+        from servohydraulics.diagnosis import engine
+
+        engine.STIFF_STEPS = a.stiff_steps
     out = Path(a.out)
     if a.summary:
         write_section(Path(a.doc), SUMMARY, summary_section(out))
@@ -196,7 +203,7 @@ def main() -> None:
         print(f"  gap {c}: {100 * js['gap_before'][c]:.2f} % -> {100 * js['gap_after'][c]:.2f} % "
               f"(noise floor {100 * js['noise_floor'][c]:.2f} %)")
     given = [("run", a.run)] if a.run else [("rig", a.rig), ("record", a.record)]
-    given += [("end", a.end), ("max-effects", a.max_effects), ("out", table or a.out)]
+    given += [("end", a.end), ("max-effects", a.max_effects), ("out", table or a.out), ("stiff-steps", a.stiff_steps)]
     given += [] if a.run else [("label", a.label)]
     args = " ".join(f"--{k} {v:g}" if k == "end" else f"--{k} {v}" for k, v in given if v is not None and v != "")
     args += "".join(f" --effect-off {e}" for e in a.effect_off)

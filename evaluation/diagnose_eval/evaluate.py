@@ -29,9 +29,14 @@ import numpy as np
 TARGETS = {"recall_single": 0.90, "false_positive": 0.05, "param_error": 0.20, "gap_closed": 0.80}
 
 
-def run_one(args: tuple[str, str, str, str]) -> dict:
-    rid, record, rig_path, mode = args
+def run_one(args: tuple) -> dict:
+    """One diagnosis: (id, record, rig, mode[, stiff_steps]): the last sets ``diagnosis.engine.STIFF_STEPS``
+    (None: the package's default) in the worker."""
+    rid, record, rig_path, mode = args[:4]
     import servohydraulics as sh
+    from servohydraulics.diagnosis import engine
+
+    engine.STIFF_STEPS = args[4] if len(args) > 4 else None
 
     t0 = time.time()
     d = sh.diagnose([record], sh.load_rig(rig_path), mode=mode, progress=False)
@@ -459,6 +464,9 @@ def main() -> None:
                    help="diagnose and report only the records of this subset (write the doc elsewhere with --doc)")
     p.add_argument("--ids", help="diagnose and report only these records (comma-separated ids, e.g. r003,r004; "
                                  "write the doc elsewhere with --doc)")
+    p.add_argument("--stiff-steps", type=int, default=None, metavar="N",
+                   help="the diagnosis' error-controlled pair hands a sample to CVODE past N dopri5 steps "
+                        "(diagnosis.engine.STIFF_STEPS, a measurement switch; default: the package's)")
     p.add_argument("--cached-only", action="store_true",
                    help="report only the records already in --cache (a run cut short; the doc says how many)")
     a = p.parse_args()
@@ -498,7 +506,7 @@ def main() -> None:
                 done[r["id"]] = r
     if a.cached_only:
         manifest = [m for m in manifest if m["id"] in done]
-    jobs = [(m["id"], str(data / m["record"]), str(data / m["rig"]), m["mode"]) for m in manifest
+    jobs = [(m["id"], str(data / m["record"]), str(data / m["rig"]), m["mode"], a.stiff_steps) for m in manifest
             if m["id"] not in done]
     t0 = time.time()
     from tqdm import tqdm
@@ -521,6 +529,7 @@ def main() -> None:
            f"python evaluation/diagnose_eval/evaluate.py --data {a.data} --jobs {a.jobs}"
            + (f" --only '{a.only}'" if a.only else "") + (f" --ids {a.ids}" if a.ids else "")
            + (f" --doc {a.doc}" if a.only or a.ids or a.doc != "docs/diagnose_eval.md" else "")
+           + (f" --stiff-steps {a.stiff_steps}" if a.stiff_steps is not None else "")
            + (f" --cache {a.cache} --cached-only: {len(manifest)} records of the set" if a.cached_only else ""))
     write_doc(m, results, key, doc, cmd, wall, a.jobs, before)
     doc.with_suffix(".json").write_text(json.dumps({"metrics": m, "records": results, "command": cmd,
