@@ -24,43 +24,63 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 
-def main() -> None:
+def case_and_rigs(lugre_bound: bool = False):
+    """The record's case (the first 10 s of the UTFSM 1 A chirp, benchmarks/lab_speed.py's ``diagnose10``) and
+    the rigs by name: the 0 A rig (evaluation/utfsm_rig_0A.toml) and it with the candidates the diagnosis fits
+    there; ``lugre_bound`` adds LuGre at its sigma_0 bound (1e10 N/m, F_c 780 N: diagnose10's round 1 ends there).
+    Shared by the studies of run costs (studies/pair_stiff_steps.py, studies/ros2_partial_jacobian.py)."""
     import lab_speed
 
     import servohydraulics as sh
     from servohydraulics.diagnosis import engine
     from servohydraulics.diagnosis.effects import LIBRARY, apply_area
-    from servohydraulics.identification.fit import rk4_options
-    from servohydraulics.identification.run import simulate_command
-    from servohydraulics.simulate import SimulationError
 
     rec = lab_speed._record("chirp20Hz_1A", 10.0)
     rig = sh.load_rig(ROOT / "evaluation" / "utfsm_rig_0A.toml")
     case = engine.make_case(rec, "displacement", "chirp20Hz_1A[0, 10 s]")
     law = sh._core.mr_damper_law(rig)
-    alpha = law["alpha"]
-    rigs = {"0 A rig": rig, "LuGre sigma_0 3e6, F_c 733": LIBRARY["lugre_friction"].apply(rig, np.array([3e6, 733.0])),
-            "Coulomb F_c 700": LIBRARY["coulomb_friction"].apply(rig, np.array([700.0])),
-            "MR damper c0 1e6": LIBRARY["mr_damper"].apply(rig, np.array([alpha, 1e6, law["c1"]])),
-            "actuator A x30": apply_area(rig, 30.0 * rig.A)}
+    rigs = {"0 A rig": rig, "LuGre sigma_0 3e6, F_c 733": LIBRARY["lugre_friction"].apply(rig, np.array([3e6, 733.0]))}
+    if lugre_bound:
+        rigs["LuGre sigma_0 1e10, F_c 780"] = LIBRARY["lugre_friction"].apply(rig, np.array([1e10, 780.0]))
+    rigs.update({"Coulomb F_c 700": LIBRARY["coulomb_friction"].apply(rig, np.array([700.0])),
+                 "MR damper c0 1e6": LIBRARY["mr_damper"].apply(rig, np.array([law["alpha"], 1e6, law["c1"]])),
+                 "actuator A x30": apply_area(rig, 30.0 * rig.A)})
+    return case, rigs
 
-    def run(r, opts):
+
+def timed_run(rig, opts, case, repeats: int = 1):
+    """The run of the case's command through ``rig`` by ``opts``: (its compared channels, the least thread CPU
+    of ``repeats`` runs [s], the Response); (None, the CPU until it failed, None) when the run fails."""
+    from servohydraulics.diagnosis import engine
+    from servohydraulics.identification.run import simulate_command
+    from servohydraulics.simulate import SimulationError
+
+    best, sim = None, None
+    for _ in range(repeats):
         t = time.thread_time()
         try:
-            s = simulate_command(r, "displacement", case.u, case.dt, case.x0_data, opts)
+            sim = simulate_command(rig, "displacement", case.u, case.dt, case.x0_data, opts)
         except SimulationError:
-            return None, time.thread_time() - t
-        return {c: s.channels[c] for c in engine.SIM_CHANNELS}, time.thread_time() - t
+            return None, time.thread_time() - t, None
+        dt = time.thread_time() - t
+        best = dt if best is None else min(best, dt)
+    return {c: sim.channels[c] for c in engine.SIM_CHANNELS}, best, sim
 
+
+def main() -> None:
+    from servohydraulics.diagnosis import engine
+    from servohydraulics.identification.fit import rk4_options
+
+    case, rigs = case_and_rigs()
     columns = [(f"RK4 {n}", rk4_options(n)) for n in (3, 4, 6, 8, 12, 32)] + \
               [(f"ROS2 {n}", engine.ros2_options(n)) for n in (8, 16, 32)]
     print("| rig | pair (rtol 1e-6) [s] | " + " | ".join(f"{c} [s] / gap" for c, _ in columns) + " |")
     print("|---|---|" + "---|" * len(columns))
     for name, r in rigs.items():
-        ref, tp = run(r, engine.run_options(True))
+        ref, tp, _ = timed_run(r, engine.run_options(True), case)
         cells = []
         for _, opts in columns:
-            s, t = run(r, opts)
+            s, t, _ = timed_run(r, opts, case)
             cells.append("diverged" if s is None else f"{t:.3f} / {engine.agreement(s, ref, case)[0]:.1e}")
         print(f"| {name} | {tp:.3f} | " + " | ".join(cells) + " |")
 

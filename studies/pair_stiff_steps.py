@@ -17,33 +17,19 @@ and the largest difference from the run at 24 as a fraction of the measured chan
 from __future__ import annotations
 
 import sys
-import time
 from pathlib import Path
-
-import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
+sys.path.insert(0, str(ROOT / "studies"))
 
 
 def main() -> int:
-    import lab_speed
+    from diagnose_run_costs import case_and_rigs, timed_run
 
-    import servohydraulics as sh
     from servohydraulics.diagnosis import engine
-    from servohydraulics.diagnosis.effects import LIBRARY, apply_area
-    from servohydraulics.identification.run import simulate_command
 
-    rec = lab_speed._record("chirp20Hz_1A", 10.0)
-    rig = sh.load_rig(ROOT / "evaluation" / "utfsm_rig_0A.toml")
-    case = engine.make_case(rec, "displacement", "chirp20Hz_1A[0, 10 s]")
-    law = sh._core.mr_damper_law(rig)
-    rigs = {"0 A rig": rig,
-            "LuGre sigma_0 3e6, F_c 733": LIBRARY["lugre_friction"].apply(rig, np.array([3e6, 733.0])),
-            "LuGre sigma_0 1e10, F_c 780": LIBRARY["lugre_friction"].apply(rig, np.array([1e10, 780.0])),
-            "Coulomb F_c 700": LIBRARY["coulomb_friction"].apply(rig, np.array([700.0])),
-            "MR damper c0 1e6": LIBRARY["mr_damper"].apply(rig, np.array([law["alpha"], 1e6, law["c1"]])),
-            "actuator A x30": apply_area(rig, 30.0 * rig.A)}
+    case, rigs = case_and_rigs(lugre_bound=True)
     counts = (24, 100, 400)
     print("| rtol | rig | " + " | ".join(f"stiff_steps {n}: CPU [s] / CVODE samples / gap" for n in counts) + " |")
     print("|---|---|" + "---|" * len(counts))
@@ -53,14 +39,12 @@ def main() -> int:
             for n in counts:
                 opts = engine.run_options(search)
                 opts.stiff_steps = n
-                best = None
-                for _ in range(2):
-                    t = time.thread_time()
-                    s = simulate_command(r, "displacement", case.u, case.dt, case.x0_data, opts)
-                    best = min(best or np.inf, time.thread_time() - t)
-                sim = {c: s.channels[c] for c in engine.SIM_CHANNELS}
+                sim, best, response = timed_run(r, opts, case, repeats=2)
+                if sim is None:
+                    cells.append("failed")
+                    continue
                 ref = sim if ref is None else ref
-                cells.append(f"{best:.3f} / {s.work.stiff_samples} / {engine.agreement(sim, ref, case)[0]:.1e}")
+                cells.append(f"{best:.3f} / {response.work.stiff_samples} / {engine.agreement(sim, ref, case)[0]:.1e}")
             print(f"| {opts.rtol:g} | {name} | " + " | ".join(cells) + " |", flush=True)
     return 0
 

@@ -24,51 +24,24 @@ test is 1e-3).
 from __future__ import annotations
 
 import sys
-import time
 from pathlib import Path
-
-import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
+sys.path.insert(0, str(ROOT / "studies"))
 
 
 def main() -> int:
-    import lab_speed
+    from diagnose_run_costs import case_and_rigs, timed_run
 
-    import servohydraulics as sh
     from servohydraulics.diagnosis import engine
-    from servohydraulics.diagnosis.effects import LIBRARY, apply_area
     from servohydraulics.identification.fit import rk4_options
-    from servohydraulics.identification.run import simulate_command
-    from servohydraulics.simulate import SimulationError
 
     if not hasattr(engine.ros2_options(8), "ros2_partial_jacobian"):
         print("this core has no SolverOptions.ros2_partial_jacobian: apply studies/ros2_partial_jacobian.patch "
               "and build the core (this file's docstring)", file=sys.stderr)
         return 2
-    rec = lab_speed._record("chirp20Hz_1A", 10.0)
-    rig = sh.load_rig(ROOT / "evaluation" / "utfsm_rig_0A.toml")
-    case = engine.make_case(rec, "displacement", "chirp20Hz_1A[0, 10 s]")
-    law = sh._core.mr_damper_law(rig)
-    rigs = {"0 A rig": rig,
-            "LuGre sigma_0 3e6, F_c 733": LIBRARY["lugre_friction"].apply(rig, np.array([3e6, 733.0])),
-            "LuGre sigma_0 1e10, F_c 780": LIBRARY["lugre_friction"].apply(rig, np.array([1e10, 780.0])),
-            "Coulomb F_c 700": LIBRARY["coulomb_friction"].apply(rig, np.array([700.0])),
-            "MR damper c0 1e6": LIBRARY["mr_damper"].apply(rig, np.array([law["alpha"], 1e6, law["c1"]])),
-            "actuator A x30": apply_area(rig, 30.0 * rig.A)}
-
-    def run(r, opts):
-        best, out = None, None
-        for _ in range(2):
-            t = time.thread_time()
-            try:
-                s = simulate_command(r, "displacement", case.u, case.dt, case.x0_data, opts)
-            except SimulationError:
-                return None, time.thread_time() - t
-            dt = time.thread_time() - t
-            best, out = (dt if best is None else min(best, dt)), s
-        return {c: out.channels[c] for c in engine.SIM_CHANNELS}, best
+    case, rigs = case_and_rigs(lugre_bound=True)
 
     def ros2(n, partial):
         o = engine.ros2_options(n)
@@ -80,10 +53,10 @@ def main() -> int:
     print("| rig | pair (rtol 1e-6) [s] | " + " | ".join(f"{c} [s] / gap" for c, _ in columns) + " |")
     print("|---|---|" + "---|" * len(columns))
     for name, r in rigs.items():
-        ref, tp = run(r, engine.run_options(True))
+        ref, tp, _ = timed_run(r, engine.run_options(True), case, repeats=2)
         cells = []
         for _, opts in columns:
-            s, t = run(r, opts)
+            s, t, _ = timed_run(r, opts, case, repeats=2)
             cells.append("diverged" if s is None else f"{t:.3f} / {engine.agreement(s, ref, case)[0]:.1e}")
         print(f"| {name} | {tp:.3f} | " + " | ".join(cells) + " |", flush=True)
     return 0
