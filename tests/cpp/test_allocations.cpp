@@ -172,6 +172,9 @@ int main() {
   light.m_p = 1.0;
   light.v_stick = 1e-6;
   check_plant(ControlMode::Displacement, dopri5, light);
+  SolverOptions dopri5_rosenbrock;  // the stiff samples by the error-controlled Rosenbrock: fixed-capacity LU
+  dopri5_rosenbrock.stiff_rosenbrock = true;
+  check_plant(ControlMode::Displacement, dopri5_rosenbrock, light);
   check_plant(ControlMode::Displacement, ros2, light);  // the LU of the stiff matrix: fixed capacity
   // The exact Coulomb law: stretches, located switches and re-integrations, every method.
   Rig exact = zhao2003();

@@ -53,6 +53,12 @@ struct SolverOptions {
   //! record run_record's caller may run check_record: record.hpp).  false: no check (the second run
   //! of check_record itself; a caller that pays for neither).
   bool stiff_check = true;
+  //! Dopri5 with stiff_fallback: a stiff sample by an error-controlled Rosenbrock method (the
+  //! second-order L-stable W-formula of Shampine & Reichelt 1997, MATLAB's ode23s, with its third-order
+  //! error estimate; the step carried from sample to sample: a one-step method needs no restart at each
+  //! sample's input jump) instead of CVODE's BDF, which restarts at order 1 with a small first step at
+  //! every such jump.  A sample it cannot finish in 200 steps is CVODE's.  false: CVODE (the reference).
+  bool stiff_rosenbrock = false;
   //! Rk4: substeps per sample; 0 = automatic (rk4_automatic_substeps in plant.hpp): the fewest with
   //! h * rho(J) <= rk4_h_rho, rho the largest spectral radius of the Jacobian over the operating
   //! states the loop can reach (rest, pressure up to 0.9 p_s, spool at its stops, sliding), chosen at
@@ -126,6 +132,8 @@ inline constexpr SolverOptionField kSolverOptionFields[] = {
     {"max_internal_step", &SolverOptions::max_internal_step, "s", "CVODE/ARKODE maximum step (0 = no limit)"},
     {"stiff_steps", &SolverOptions::stiff_steps, "", "dopri5: steps in one sample beyond which it is stiff"},
     {"stiff_fallback", &SolverOptions::stiff_fallback, "", "dopri5: redo a stiff sample with CVODE"},
+    {"stiff_rosenbrock", &SolverOptions::stiff_rosenbrock, "",
+     "dopri5: a stiff sample by an error-controlled Rosenbrock method (one-step) instead of CVODE"},
     {"stiff_check", &SolverOptions::stiff_check, "",
      "dopri5: check a run that turned stiff against a run at rtol / 10 (flags where it may miss 1e-3)"},
     {"rk4_substeps", &SolverOptions::rk4_substeps, "", "RK4 substeps per sample (0 = automatic)"},

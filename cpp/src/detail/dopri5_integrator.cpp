@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "detail/small_lu.hpp"
+
 namespace servohydraulics::detail {
 
 namespace {
@@ -31,7 +33,9 @@ BasicDopri5Integrator<System>::BasicDopri5Integrator(const System& sys, double d
       stiff_steps_(opt.stiff_steps),
       dt_(dt),
       gap_(sys),
-      h_(dt) {
+      h_(dt),
+      rosenbrock_(opt.stiff_rosenbrock),
+      h_rosenbrock_(dt) {
   Sys::tolerances(sys, opt, atol_);
   if (opt.stiff_fallback) {
     // Absolute tolerances 1e-2 of these cut the error on high-gain rigs ~7x but made one of 150
@@ -50,6 +54,8 @@ void BasicDopri5Integrator<System>::reset(const State& y, double t) noexcept {
   steps_done_ = rhs_done_ = restarts_ = stiff_samples_ = 0;
   fsal_ = false;
   h_ = dt_;
+  h_rosenbrock_ = dt_;
+  rosenbrock_failed_ = false;
   hold_ = 0;
   shadow_live_ = false;
   gap_.reset();
@@ -155,11 +161,93 @@ typename BasicDopri5Integrator<System>::Outcome BasicDopri5Integrator<System>::e
   return Outcome::Done;
 }
 
+// The stiff sample by Shampine and Reichelt's (1997, SIAM J. Sci. Comput. 18(1), "The MATLAB ODE
+// suite", section 3) second-order Rosenbrock W-formula, L-stable, with its third-order error estimate,
+// d = 1 / (2 + sqrt 2), W = I - h d J (the autonomous form: the input is held in a sample):
+//   k1 = W^-1 F0,  F1 = f(y + h k1 / 2),  k2 = W^-1 (F1 - k1) + k1,  y+ = y + h k2,
+//   F2 = f(y+),  k3 = W^-1 (F2 - e32 (k2 - F1) - 2 (k1 - F0)),  est = h (k1 - 2 k2 + k3) / 6,
+// e32 = 6 + sqrt 2, weighed as dopri5's (atol_, rtol_); the step follows err^(-1/3).  A one-step
+// method: the step proposed at a sample's end starts the next stiff sample, with no restart from order 1.
+template <class System>
+Status BasicDopri5Integrator<System>::rosenbrock_sample(const System& sys, const Input& in, State& y, double& t,
+                                                  double t_next) noexcept {
+  constexpr double kD = 0.29289321881345248;    // 1 / (2 + sqrt 2)
+  constexpr double kE32 = 7.4142135623730951;   // 6 + sqrt 2
+  Status st;
+  st.stiff = true;
+  ++stiff_samples_;
+  fsal_ = false;
+  h_ = dt_;
+  State f0{}, f1{}, f2{}, k1{}, k2{}, k3{}, yn{};
+  double* W = W_.data();
+  long attempts = 0;
+  at_size(n_, [&](auto size) {
+    const int m = size;
+    while (t < t_next) {
+      const double remaining = t_next - t;
+      const double n_left = std::ceil(remaining / std::min(h_rosenbrock_, remaining) * (1.0 - 1e-12));
+      const double h = remaining / std::max(1.0, n_left);
+      if (++attempts > kRosenbrockAttempts || h < 1e-14 * dt_) {
+        st.code = Status::TooMuchWork;
+        return;
+      }
+      Sys::jacobian_rhs(sys, y.data(), in, W, f0.data());
+      for (int i = 0; i < m * m; ++i) W[i] *= -kD * h;
+      for (int i = 0; i < m; ++i) W[i + i * m] += 1.0;
+      lu_factor(W, size, piv_.data());
+      for (int i = 0; i < m; ++i) k1[i] = f0[i];
+      lu_solve(W, size, piv_.data(), k1.data());
+      for (int i = 0; i < m; ++i) yn[i] = y[i] + 0.5 * h * k1[i];
+      Sys::rhs(sys, yn.data(), in, f1.data());
+      for (int i = 0; i < m; ++i) k2[i] = f1[i] - k1[i];
+      lu_solve(W, size, piv_.data(), k2.data());
+      for (int i = 0; i < m; ++i) {
+        k2[i] += k1[i];
+        yn[i] = y[i] + h * k2[i];
+      }
+      Sys::rhs(sys, yn.data(), in, f2.data());
+      for (int i = 0; i < m; ++i) k3[i] = f2[i] - kE32 * (k2[i] - f1[i]) - 2.0 * (k1[i] - f0[i]);
+      lu_solve(W, size, piv_.data(), k3.data());
+      st.rhs_evals += 3;
+      double sum = 0.0;
+      for (int i = 0; i < m; ++i) {
+        const double e = h / 6.0 * (k1[i] - 2.0 * k2[i] + k3[i]);
+        const double sc = atol_[i] + rtol_ * std::max(std::fabs(y[i]), std::fabs(yn[i]));
+        sum += (e / sc) * (e / sc);
+      }
+      const double err = std::sqrt(sum / m);
+      if (!(err <= 1.0)) {  // rejected (NaN: a stage blew up)
+        h_rosenbrock_ = h * (std::isfinite(err) ? std::max(kShrink, kSafety * std::cbrt(1.0 / err)) : kShrink);
+        continue;
+      }
+      for (int i = 0; i < m; ++i) y[i] = yn[i];
+      t = n_left <= 1.0 ? t_next : t + h;
+      ++st.internal_steps;
+      h_rosenbrock_ = std::min(dt_, h * (err > 0.0 ? std::min(kGrow, std::max(kShrink, kSafety * std::cbrt(1.0 / err)))
+                                            : kGrow));
+    }
+  });
+  return st;
+}
+
 template <class System>
 Status BasicDopri5Integrator<System>::implicit_sample(const System& sys, const Input& in, State& y, double& t,
                                                       double t_next) noexcept {
+  Status tried;
+  if (rosenbrock_ && !rosenbrock_failed_) {
+    const State y0 = y;
+    const double t0 = t;
+    tried = rosenbrock_sample(sys, in, y, t, t_next);
+    if (tried.ok()) return tried;
+    y = y0;  // more than kRosenbrockAttempts steps (an accuracy-bound sample at a tight tolerance): CVODE's BDF
+    t = t0;
+    --stiff_samples_;
+    rosenbrock_failed_ = true;  // the rest of this stretch of stiff samples goes to CVODE directly
+  }
   implicit_->reset(y, t);
   Status st = implicit_->advance(sys, in, y, t, t_next);
+  st.internal_steps += tried.internal_steps;
+  st.rhs_evals += tried.rhs_evals;
   ++restarts_;
   fsal_ = false;
   h_ = dt_;
@@ -178,6 +266,7 @@ Status BasicDopri5Integrator<System>::advance(const System& sys, const Input& in
     --hold_;
     st = implicit_sample(sys, in, y, t, t_next);
   } else {
+    rosenbrock_failed_ = false;
     const Outcome out = explicit_sample(sys, in, y, t, t_next, st);
     if (out != Outcome::Done) {
       y = y0;

@@ -2,11 +2,12 @@
 // Runge-Kutta pair with error control inside each controller sample (the
 // sample is the maximum step; first-same-as-last within a sample and across
 // samples while the held input and the state are unchanged), and an automatic
-// switch to CVODE for a sample where the pair turns stiff; a run that has turned
+// switch to CVODE (or an error-controlled Rosenbrock method) for a sample where the pair turns stiff; a run that has turned
 // stiff is checked to its end by a shadow run at a tighter tolerance that flags
 // the samples it cannot vouch for.
 #pragma once
 
+#include <array>
 #include <memory>
 
 #include "detail/cvode_integrator.hpp"
@@ -75,6 +76,9 @@ class BasicDopri5Integrator {
   //! shadow is off by e/2 at most and the gap is between e/2 and 3e/2: a gap above half the
   //! tolerance says the result may miss it.
   static constexpr double kShadowGap = 0.5;
+  //! stiff_rosenbrock: the Rosenbrock steps (accepted and rejected) in one sample past which the sample is
+  //! CVODE's after all (its BDF goes to order 5 where a second-order method needs many steps).
+  static constexpr long kRosenbrockAttempts = 200;
 
  private:
   enum class Outcome { Done, Stiff, TooMuchWork };
@@ -84,6 +88,9 @@ class BasicDopri5Integrator {
   //! weighted RMS norm of the embedded error estimate (returned).
   double trial_step(const System& sys, const Input& in, const State& y, double h, State& y5) noexcept;
   Status implicit_sample(const System& sys, const Input& in, State& y, double& t, double t_next) noexcept;
+  //! The stiff sample by the error-controlled Rosenbrock method (options.stiff_rosenbrock), its step
+  //! carried across samples.
+  Status rosenbrock_sample(const System& sys, const Input& in, State& y, double& t, double t_next) noexcept;
   //! Advances the shadow over the sample just done, from t_start to t_next (starting it at y_start
   //! if it is not following the run yet), compares it with the result y and flags st.
   void verify(const System& sys, const Input& in, const State& y_start, double t_start, const State& y,
@@ -105,6 +112,12 @@ class BasicDopri5Integrator {
   Input fsal_in_{};
   double h_;           // the step the controller proposes next [s]
   int hold_ = 0;       // samples left on CVODE
+  bool rosenbrock_ = false;  // stiff samples by rosenbrock_sample, not CVODE
+  bool rosenbrock_failed_ = false;  // it gave up in this stretch of stiff samples: CVODE until it ends
+  double h_rosenbrock_;             // the step rosenbrock_sample proposes next [s]
+  // rosenbrock_sample's W = I - d h J (column-major, then its LU) and pivots: no allocation
+  std::array<double, static_cast<std::size_t>(Sys::kCapacity) * Sys::kCapacity> W_{};
+  std::array<int, Sys::kCapacity> piv_{};
   long steps_done_ = 0, rhs_done_ = 0, restarts_ = 0, stiff_samples_ = 0;
 };
 
