@@ -2,7 +2,7 @@
 
     python benchmarks/lab_speed.py [--cases identify,diagnose10,diagnose10sim,sweep1A] [--json FILE]
                                    [--profile] [--label NAME] [--v-stick V] [--continuation pair|search]
-                                   [--stiff-steps N]
+                                   [--stiff-steps N] [--search-stiff rosenbrock|cvode] [--ros2-rungs N,N]
     python benchmarks/lab_speed.py --table benchmarks/lab_speed.json
 
 The cases (records from ../shared/real-data/utfsm-mts-mrdamper, or $SH_SHARED_DIR/real-data/...):
@@ -276,7 +276,14 @@ def main() -> None:
                         "(diagnosis.engine.FIT_CONTINUATION; default: the package's, 'pair')")
     p.add_argument("--stiff-steps", type=int, default=None, metavar="N",
                    help="the diagnosis' error-controlled pair redoes a sample by CVODE past N dopri5 steps "
-                        "(diagnosis.engine.STIFF_STEPS; default: the core's stiff_steps, 24)")
+                        "(diagnosis.engine.STIFF_STEPS; default: the package's, 100 since stop 46; "
+                        "24, the core's, before)")
+    p.add_argument("--search-stiff", choices=("rosenbrock", "cvode"), default=None,
+                   help="the integrator of the diagnosis' search pair's stiff samples "
+                        "(diagnosis.engine.SEARCH_STIFF_ROSENBROCK; default: the package's, rosenbrock since stop 46)")
+    p.add_argument("--ros2-rungs", default=None, metavar="N,N",
+                   help="the fixed ROS2 substep counts of the fits' integrator ladder, '' for none "
+                        "(diagnosis.engine.SEARCH_ROS2_SUBSTEPS; default: the package's, none since stop 46)")
     a = p.parse_args()
     if a.table:
         print(table(Path(a.table)))
@@ -291,6 +298,14 @@ def main() -> None:
         from servohydraulics.diagnosis import engine
 
         engine.STIFF_STEPS = a.stiff_steps
+    if a.search_stiff is not None:
+        from servohydraulics.diagnosis import engine
+
+        engine.SEARCH_STIFF_ROSENBROCK = a.search_stiff == "rosenbrock"
+    if a.ros2_rungs is not None:
+        from servohydraulics.diagnosis import engine
+
+        engine.SEARCH_ROS2_SUBSTEPS = tuple(int(v) for v in a.ros2_rungs.split(",") if v.strip())
     cases = [c.strip() for c in a.cases.split(",") if c.strip()]
     if a.json and Path(a.json).exists() and a.label in json.loads(Path(a.json).read_text()):
         # the JSON is keyed by label: a second run under one label would replace the first's cases
@@ -305,6 +320,12 @@ def main() -> None:
            "scipy": scipy.__version__, "cpus": os.cpu_count(),
            "command": "python benchmarks/lab_speed.py " + " ".join(sys.argv[1:]), "v_stick": a.v_stick,
            "continuation": a.continuation, "stiff_steps": a.stiff_steps, "cases": {}}
+    from servohydraulics.diagnosis import engine as _engine
+
+    out["stiff_steps_in_effect"] = _engine.STIFF_STEPS  # rows before stop 46 lack it: 24 (the core's) by default
+    out["search_stiff"] = "rosenbrock" if _engine.SEARCH_STIFF_ROSENBROCK else "cvode"  # likewise: cvode before stop 46
+    out["ros2_rungs"] = list(_engine.SEARCH_ROS2_SUBSTEPS if _engine.SEARCH_STIFF_ROSENBROCK
+                             else _engine.SEARCH_ROS2_SUBSTEPS or (8, 16))  # likewise: [8, 16] before stop 46
     counter = Counters()
     for case in cases:
         counter.reset()

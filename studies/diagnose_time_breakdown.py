@@ -133,7 +133,7 @@ def main(argv=None) -> int:
                     help="the nominal rig with v_stick = V [m/s] (0: the exact Coulomb law); default: the rig's own")
     ap.add_argument("--stiff-steps", type=int, default=None, metavar="N",
                     help="the pair hands a sample to CVODE past N dopri5 steps (diagnosis.engine.STIFF_STEPS; "
-                         "default: the core's 24)")
+                         "default: the package's, 100)")
     args = ap.parse_args(argv)
     import lab_speed
 

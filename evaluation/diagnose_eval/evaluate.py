@@ -36,7 +36,8 @@ def run_one(args: tuple) -> dict:
     import servohydraulics as sh
     from servohydraulics.diagnosis import engine
 
-    engine.STIFF_STEPS = args[4] if len(args) > 4 else None
+    if len(args) > 4 and args[4] is not None:
+        engine.STIFF_STEPS = args[4]
 
     t0 = time.time()
     d = sh.diagnose([record], sh.load_rig(rig_path), mode=mode, progress=False)
@@ -466,7 +467,7 @@ def main() -> None:
                                  "write the doc elsewhere with --doc)")
     p.add_argument("--stiff-steps", type=int, default=None, metavar="N",
                    help="the diagnosis' error-controlled pair hands a sample to CVODE past N dopri5 steps "
-                        "(diagnosis.engine.STIFF_STEPS, a measurement switch; default: the package's)")
+                        "(diagnosis.engine.STIFF_STEPS; default: the package's, 100)")
     p.add_argument("--cached-only", action="store_true",
                    help="report only the records already in --cache (a run cut short; the doc says how many)")
     a = p.parse_args()

@@ -1,7 +1,8 @@
 """The diagnosis' fits on RK4 (``engine.search_options``, ``engine.fit``): RK4 at the fewest
 substeps whose run agrees with the search's error-controlled pair, chosen per fit start; a diverged
-RK4 run retried at larger counts, then on the pair; where no RK4 count agrees, ROS2 (linearly
-implicit, L-stable) at the fewest of its counts that agrees; the pair where none does.  The oracles:
+RK4 run retried at larger counts, then on the pair, whose stiff samples go to the core's
+error-controlled Rosenbrock (with the pair's stiff samples by CVODE instead, ROS2 at fixed counts
+before the pair, as in stop 45).  The oracles:
 whole runs of the error-controlled pair (at the search's rtol and at the core's default), the
 fixed-step run at the count the ladder lands on, and the same fit run on the pair alone."""
 
@@ -113,24 +114,69 @@ def test_the_pair_where_no_count_agrees():
     assert not _within(engine.simulate_case(coulomb, case, 0.0, case.x0_data,
                                             options=rk4_options(engine.SEARCH_RK4_SUBSTEPS[-1])), ref, case)
     assert not _within(engine.simulate_case(coulomb, case, 0.0, case.x0_data,
-                                            options=engine.ros2_options(engine.SEARCH_ROS2_SUBSTEPS[-1])), ref, case)
+                                            options=engine.ros2_options(16)), ref, case)
     opts = engine.search_options(coulomb, [case], 0.0, [case.x0_data])[0]
     assert not engine.fixed_step(opts) and opts.rtol == engine.run_options(True).rtol
 
 
-def test_ros2_where_no_rk4_count_agrees():
+def _utfsm_10s_case():
+    """The first 10 s of the UTFSM chirp at 1 A (benchmarks/lab_speed.py's diagnose10 record)."""
+    from shared_data import shared_path
+
+    from servohydraulics.records import read_record
+
+    full = read_record(shared_path("real-data/utfsm-mts-mrdamper/chirp20Hz_1A.csv"))
+    n = int(round(10.0 / full.dt)) + 1
+    return _case(Record({k: np.asarray(v)[:n] for k, v in full.channels.items()}))
+
+
+def test_the_search_pairs_stiff_samples_by_the_rosenbrock_agree_with_cvodes():
+    """The search's pair does its stiff samples by the core's error-controlled Rosenbrock
+    (``SEARCH_STIFF_ROSENBROCK``, ``SolverOptions.stiff_rosenbrock``), not CVODE.  On the diagnose10 record through
+    the 0 A rig with 700 N of Coulomb friction (half its samples stiff) and with LuGre at its static
+    limit (sigma_0 1e10 N/m: round 1's answer there), the run agrees with the same pair doing them by
+    CVODE, an independent integrator, and with the decisions' run (CVODE at rtol 1e-8), each to a
+    tenth of the fits' test; it takes the same samples as stiff.  Where no sample is stiff (the 0 A
+    rig) the two pairs are the same run to the bit.  Without fixed ROS2 rungs the ladder now keeps the
+    pair on the Coulomb rig."""
+    case = _utfsm_10s_case()
+    rig = _rig()
+    rigs = {"coulomb": LIBRARY["coulomb_friction"].apply(rig, np.array([700.0])),
+            "lugre at its bound": LIBRARY["lugre_friction"].apply(rig, np.array([1e10, 780.0])), "0 A": rig}
+    assert engine.SEARCH_STIFF_ROSENBROCK and engine.run_options(True).stiff_rosenbrock
+    assert not engine.run_options(False).stiff_rosenbrock
+    for name, r in rigs.items():
+        ros = simulate_command(r, "displacement", case.u, case.dt, case.x0_data, engine.run_options(True))
+        o = engine.run_options(True)
+        o.stiff_rosenbrock = False
+        cv = simulate_command(r, "displacement", case.u, case.dt, case.x0_data, o)
+        tight = simulate_command(r, "displacement", case.u, case.dt, case.x0_data, engine.run_options(False))
+        assert ros.work.stiff_samples == cv.work.stiff_samples, name
+        chans = [{c: s.channels[c] for c in engine.SIM_CHANNELS} for s in (ros, cv, tight)]
+        if name == "0 A":
+            assert ros.work.stiff_samples == 0
+            for c in engine.SIM_CHANNELS:
+                np.testing.assert_array_equal(chans[0][c], chans[1][c])
+            continue
+        assert ros.work.stiff_samples > 1000, name
+        for other in chans[1:]:
+            worst, rms = engine.agreement(chans[0], other, case)
+            assert worst <= 0.1 * AGREEMENT and rms <= 0.1 * AGREEMENT_RMS, (name, worst, rms)
+    opts = engine.search_options(rigs["coulomb"], [case], 0.0, [case.x0_data])[0]
+    assert not engine.fixed_step(opts)
+
+
+def test_ros2_where_no_rk4_count_agrees(monkeypatch):
     """The first 10 s of the UTFSM chirp at 1 A (±2 mm) through the 0 A rig with 700 N of Coulomb
     friction (benchmarks/lab_speed.py's diagnose10 record; studies/diagnose_run_costs.py): no RK4 count
     agrees with the pair (the tanh law's slope F_c / (m v_stick) is outside RK4's stability region),
     ROS2 at the fewest of its counts that does is chosen, the count below it does not agree, and the
-    chosen run stays within the fits' test of the pair's at the core's default tolerance too."""
-    from shared_data import shared_path
-
-    from servohydraulics.records import Record, read_record
-
-    full = read_record(shared_path("real-data/utfsm-mts-mrdamper/chirp20Hz_1A.csv"))
-    n = int(round(10.0 / full.dt)) + 1
-    case = _case(Record({k: np.asarray(v)[:n] for k, v in full.channels.items()}))
+    chosen run stays within the fits' test of the pair's at the core's default tolerance too.  (The
+    ladder of stop 45, the pair's stiff samples by CVODE: ``SEARCH_STIFF_ROSENBROCK`` False brings the ROS2
+    rungs (8, 16) back.)"""
+    monkeypatch.setattr(engine, "SEARCH_STIFF_ROSENBROCK", False)
+    monkeypatch.setattr(engine, "SEARCH_ROS2_SUBSTEPS", (8, 16))
+    case = _utfsm_10s_case()
     coulomb = LIBRARY["coulomb_friction"].apply(_rig(), np.array([700.0]))
     ref = engine.simulate_case(coulomb, case, 0.0, case.x0_data, search=True)
     for k in engine.SEARCH_RK4_SUBSTEPS:
@@ -349,11 +395,12 @@ def test_the_run_cache_key_tells_every_field_of_the_rig_apart():
 
 
 def test_the_pairs_stiff_switch_at_100_steps_keeps_its_runs_and_leaves_cvode_the_stiff_samples(monkeypatch):
-    """``engine.STIFF_STEPS`` (a measurement switch, docs/benchmarks.md, stop 45): dopri5 hands a sample to
-    CVODE past that many steps.  On the 0 A rig re-sized x30 by the load term (the sweep's loop re-fit ends
-    there) the samples that passed 24 steps were accuracy-limited, not stiff: at 100, dopri5 alone takes every
-    sample and agrees with the default pair (CVODE on those samples: an independent integrator) well inside
-    the fits' test, at both tolerances.  On Coulomb friction's rig the samples are stiff and still go to CVODE."""
+    """``engine.STIFF_STEPS`` (the diagnosis' 100 against the core's 24, docs/benchmarks.md, stops 45-46):
+    dopri5 hands a sample to its stiff integrator past that many steps.  On the 0 A rig re-sized x30 by the
+    load term (the sweep's loop re-fit ends there) the samples that passed 24 steps were accuracy-limited,
+    not stiff: at 100, dopri5 alone takes every sample and agrees with the pair at 24 (its stiff integrator
+    on those samples: another method) well inside the fits' test, at both tolerances.  On Coulomb
+    friction's rig the samples are stiff and still go to the stiff integrator."""
     rig = _rig()
     t = np.arange(int(3.0 / DT) + 1) * DT
     u = np.minimum(t / 0.3, 1.0) * 0.008 * np.sin(2 * np.pi * (0.5 + 2.5 * t) * t)
@@ -363,7 +410,9 @@ def test_the_pairs_stiff_switch_at_100_steps_keeps_its_runs_and_leaves_cvode_the
         for search, tol in ((True, 0.1 * AGREEMENT), (False, 0.01 * AGREEMENT)):
             monkeypatch.setattr(engine, "STIFF_STEPS", None)
             ref = simulate_command(r, "displacement", u, DT, 0.0, engine.run_options(search))
-            monkeypatch.setattr(engine, "STIFF_STEPS", 100)
+            assert engine.run_options(search).stiff_steps == 24
+            monkeypatch.undo()
+            assert engine.STIFF_STEPS == 100 and engine.run_options(search).stiff_steps == 100
             run = simulate_command(r, "displacement", u, DT, 0.0, engine.run_options(search))
             assert ref.work.stiff_samples > 0
             assert (run.work.stiff_samples > 0) == stiff

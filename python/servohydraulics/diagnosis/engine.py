@@ -131,18 +131,36 @@ def run_options(search: bool):
     UTFSM MR damper, whose default run turns stiff) times less; a fit's own runs go on RK4 where
     that agrees with this pair (``search_options``).  No run is checked by the pair's
     shadow (``stiff_check``: the diagnosis reads no flag; the results are the same to the bit).
-    ``STIFF_STEPS`` (None by default) sets the dopri5 steps in a sample past which the pair hands it to CVODE."""
+    The pair hands a sample to its stiff integrator past ``STIFF_STEPS`` dopri5 steps in it (100, not
+    the core's 24); a search run's stiff samples go to the core's error-controlled Rosenbrock method
+    (``stiff_rosenbrock``, ``SEARCH_STIFF_ROSENBROCK``) rather than CVODE, a decision's to CVODE (the
+    core's default)."""
     from ..identification.fit import FIT_RTOL
 
     opts = solver_options(rtol=FIT_RTOL if search else None, stiff_check=False)
     if STIFF_STEPS is not None:
         opts.stiff_steps = int(STIFF_STEPS)
+    if search and SEARCH_STIFF_ROSENBROCK:
+        opts.stiff_rosenbrock = True
     return opts
 
 
 #: dopri5's steps in one sample beyond which the pair's runs redo the sample by CVODE (``run_options``;
-#: None: the core's ``stiff_steps``, 24): a measurement switch (benchmarks/lab_speed.py --stiff-steps)
-STIFF_STEPS = None
+#: None: the core's ``stiff_steps``, 24).  100: a sample of a rig re-sized by the load term (the loop
+#: re-fit of a long record) that needs 25-100 steps is accuracy-limited, not stiff, and dopri5 does
+#: it for less than CVODE from a restart; a stiff sample (Coulomb friction's rig) still goes to CVODE,
+#: 76 wasted steps later.  Measured (docs/benchmarks.md, stops 45 and 46): the UTFSM 1 A sweep 2.25 times
+#: faster with the same answer; the diagnosis evaluation's records the same to the last digit; the four
+#: whole-record runs of docs/diagnose.md the same names and gaps (May 1 A -> 0 A at another point of the
+#: load term's flat valley).  benchmarks/lab_speed.py --stiff-steps sets another.
+STIFF_STEPS: int | None = 100
+
+#: the search's pair does its stiff samples by the core's error-controlled Rosenbrock method
+#: (SolverOptions.stiff_rosenbrock: a one-step method that carries its step across the samples, where CVODE's
+#: BDF restarts at each) instead of CVODE: on the stiff friction rigs a run costs 3.5-4.4 times less and is as
+#: close to the decisions' rtol-1e-8 run (docs/benchmarks.md, stop 46).  False: CVODE, and the ladder's fixed
+#: ROS2 rungs back (``SEARCH_ROS2_SUBSTEPS``): the search of stop 45 (benchmarks/lab_speed.py --search-stiff cvode).
+SEARCH_STIFF_ROSENBROCK = True
 
 
 class RunCache:
@@ -273,8 +291,10 @@ SEARCH_RK4_SUBSTEPS = (3, 4, 6, 8)
 SEARCH_RK4_LADDER = (6, 8, 12)
 #: the ROS2 substep counts a fit's runs may use where no RK4 count agrees (``search_options``): a rig made
 #: stiff by a fast state (a regularised Coulomb law's slope F_c / v_stick, a re-sized oil column), where RK4
-#: diverges or needs hundreds of substeps and the search's pair hands most samples to CVODE
-SEARCH_ROS2_SUBSTEPS = (8, 16)
+#: diverges or needs hundreds of substeps.  None since the search's pair does its stiff samples by the
+#: error-controlled Rosenbrock (``SEARCH_STIFF_ROSENBROCK``): on those rigs the pair then costs less than ROS2 at
+#: 8 and 16 fixed substeps (docs/benchmarks.md, stop 46); (8, 16) when the pair's stiff samples are CVODE's
+SEARCH_ROS2_SUBSTEPS: tuple = ()
 
 
 def fixed_step(options) -> bool:
@@ -307,9 +327,10 @@ def search_options(rig: Rig, cases: list[Case], tau: float, x0s) -> list:
     run of ``rig`` (the fit's start: a candidate's parameters change the rig's stiffness, so each fit
     checks its own) agrees with the search's error-controlled pair (``run_options(True)``) to
     ``segments.AGREEMENT`` (largest) and ``AGREEMENT_RMS`` (rms) of each channel's standard
-    deviation; else ROS2 at the fewest of ``SEARCH_ROS2_SUBSTEPS`` that agrees (a rig too stiff for
-    RK4: a regularised Coulomb law, a re-sized oil column); the pair where none does (a Coulomb
-    friction's switch that a fixed step straddles on a large, fast record).
+    deviation; else ROS2 at the fewest of ``SEARCH_ROS2_SUBSTEPS`` that agrees (none by default; (8, 16)
+    where the pair's stiff samples are CVODE's, ``SEARCH_STIFF_ROSENBROCK`` False); the pair where none does
+    (a rig too stiff for RK4: a regularised Coulomb law, a re-sized oil column; a Coulomb friction's
+    switch that a fixed step straddles on a large, fast record).
     A fixed step also keeps the residual a smooth function of the parameters (clean difference
     columns).  ``fit`` checks the result again (``agrees``)."""
     from ..identification.fit import rk4_options
@@ -321,7 +342,8 @@ def search_options(rig: Rig, cases: list[Case], tau: float, x0s) -> list:
         ref = simulate_case(rig, case, tau, x0, options=pair)
         chosen = pair
         if ref is not None:
-            ladder = [rk4_options(n) for n in SEARCH_RK4_SUBSTEPS] + [ros2_options(n) for n in SEARCH_ROS2_SUBSTEPS]
+            ros2 = SEARCH_ROS2_SUBSTEPS if SEARCH_STIFF_ROSENBROCK else SEARCH_ROS2_SUBSTEPS or (8, 16)
+            ladder = [rk4_options(n) for n in SEARCH_RK4_SUBSTEPS] + [ros2_options(n) for n in ros2]
             for opts in ladder:
                 worst, rms = agreement(simulate_case(rig, case, tau, x0, options=opts), ref, case)
                 if worst <= AGREEMENT and rms <= AGREEMENT_RMS:
