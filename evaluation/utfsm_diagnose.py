@@ -161,8 +161,8 @@ def main() -> None:
                         "then the folder of the table (OUT/<label>/) and the table is re-written after the run")
     p.add_argument("--summary", action="store_true", help="only re-write the table of the runs found under OUT")
     p.add_argument("--stiff-steps", type=int, default=None, metavar="N",
-                   help="the diagnosis' error-controlled pair hands a sample to CVODE past N dopri5 steps "
-                        "(diagnosis.engine.STIFF_STEPS; default: the package's, 100)")
+                   help="the diagnosis' error-controlled pair hands a sample to its stiff integrator past N "
+                        "dopri5 steps (diagnosis.engine.STIFF_STEPS; default: the package's, 100)")
     a = p.parse_args()
     if a.stiff_steps is not None:
         from servohydraulics.diagnosis import engine

@@ -4,7 +4,7 @@
 
 The dopri5 pair redoes a sample it finds stiff (past ``stiff_steps`` steps in it) by its stiff integrator:
 CVODE's BDF (the core's default), which restarts at order 1 with a small first step at every sample's
-input jump, or (``SolverOptions.stiff_rosenbrock``) the second-order L-stable Rosenbrock W-formula of Shampine
+input jump, or (``SolverOptions.stiff_rosenbrock``) the second-order L-stable Rosenbrock formula of Shampine
 and Reichelt (1997) with its third-order error estimate, a one-step method that carries its step from
 sample to sample.  For the first 10 s of the UTFSM 1 A chirp (benchmarks/lab_speed.py's diagnose10) through
 the 0 A rig and through it with the candidates the diagnosis fits there (``diagnose_run_costs.case_and_rigs``),

@@ -466,8 +466,8 @@ def main() -> None:
     p.add_argument("--ids", help="diagnose and report only these records (comma-separated ids, e.g. r003,r004; "
                                  "write the doc elsewhere with --doc)")
     p.add_argument("--stiff-steps", type=int, default=None, metavar="N",
-                   help="the diagnosis' error-controlled pair hands a sample to CVODE past N dopri5 steps "
-                        "(diagnosis.engine.STIFF_STEPS; default: the package's, 100)")
+                   help="the diagnosis' error-controlled pair hands a sample to its stiff integrator past N "
+                        "dopri5 steps (diagnosis.engine.STIFF_STEPS; default: the package's, 100)")
     p.add_argument("--cached-only", action="store_true",
                    help="report only the records already in --cache (a run cut short; the doc says how many)")
     a = p.parse_args()

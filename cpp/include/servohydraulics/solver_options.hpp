@@ -54,7 +54,7 @@ struct SolverOptions {
   //! of check_record itself; a caller that pays for neither).
   bool stiff_check = true;
   //! Dopri5 with stiff_fallback: a stiff sample by an error-controlled Rosenbrock method (the
-  //! second-order L-stable W-formula of Shampine & Reichelt 1997, MATLAB's ode23s, with its third-order
+  //! second-order L-stable Rosenbrock formula of Shampine & Reichelt 1997, MATLAB's ode23s, with its third-order
   //! error estimate; the step carried from sample to sample: a one-step method needs no restart at each
   //! sample's input jump) instead of CVODE's BDF, which restarts at order 1 with a small first step at
   //! every such jump.  A sample it cannot finish in 200 steps is CVODE's.  false: CVODE (the reference).

@@ -162,7 +162,7 @@ typename BasicDopri5Integrator<System>::Outcome BasicDopri5Integrator<System>::e
 }
 
 // The stiff sample by Shampine and Reichelt's (1997, SIAM J. Sci. Comput. 18(1), "The MATLAB ODE
-// suite", section 3) second-order Rosenbrock W-formula, L-stable, with its third-order error estimate,
+// suite", section 3) second-order Rosenbrock formula, L-stable, with its third-order error estimate,
 // d = 1 / (2 + sqrt 2), W = I - h d J (the autonomous form: the input is held in a sample):
 //   k1 = W^-1 F0,  F1 = f(y + h k1 / 2),  k2 = W^-1 (F1 - k1) + k1,  y+ = y + h k2,
 //   F2 = f(y+),  k3 = W^-1 (F2 - e32 (k2 - F1) - 2 (k1 - F0)),  est = h (k1 - 2 k2 + k3) / 6,
@@ -170,7 +170,7 @@ typename BasicDopri5Integrator<System>::Outcome BasicDopri5Integrator<System>::e
 // method: the step proposed at a sample's end starts the next stiff sample, with no restart from order 1.
 template <class System>
 Status BasicDopri5Integrator<System>::rosenbrock_sample(const System& sys, const Input& in, State& y, double& t,
-                                                  double t_next) noexcept {
+                                                        double t_next) noexcept {
   constexpr double kD = 0.29289321881345248;    // 1 / (2 + sqrt 2)
   constexpr double kE32 = 7.4142135623730951;   // 6 + sqrt 2
   Status st;
@@ -223,8 +223,8 @@ Status BasicDopri5Integrator<System>::rosenbrock_sample(const System& sys, const
       for (int i = 0; i < m; ++i) y[i] = yn[i];
       t = n_left <= 1.0 ? t_next : t + h;
       ++st.internal_steps;
-      h_rosenbrock_ = std::min(dt_, h * (err > 0.0 ? std::min(kGrow, std::max(kShrink, kSafety * std::cbrt(1.0 / err)))
-                                            : kGrow));
+      const double grow = err > 0.0 ? std::min(kGrow, std::max(kShrink, kSafety * std::cbrt(1.0 / err))) : kGrow;
+      h_rosenbrock_ = std::min(dt_, h * grow);
     }
   });
   return st;

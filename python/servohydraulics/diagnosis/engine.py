@@ -145,19 +145,19 @@ def run_options(search: bool):
     return opts
 
 
-#: dopri5's steps in one sample beyond which the pair's runs redo the sample by CVODE (``run_options``;
-#: None: the core's ``stiff_steps``, 24).  100: a sample of a rig re-sized by the load term (the loop
-#: re-fit of a long record) that needs 25-100 steps is accuracy-limited, not stiff, and dopri5 does
-#: it for less than CVODE from a restart; a stiff sample (Coulomb friction's rig) still goes to CVODE,
-#: 76 wasted steps later.  Measured (docs/benchmarks.md, stops 45 and 46): the UTFSM 1 A sweep 2.25 times
-#: faster with the same answer; the diagnosis evaluation's records the same to the last digit; the four
-#: whole-record runs of docs/diagnose.md the same names and gaps (May 1 A -> 0 A at another point of the
-#: load term's flat valley).  benchmarks/lab_speed.py --stiff-steps sets another.
+#: dopri5's steps in one sample beyond which the pair's runs redo the sample by their stiff integrator
+#: (``run_options``; None: the core's ``stiff_steps``, 24).  100: a sample of a rig re-sized by the load
+#: term (the loop re-fit of a long record) that needs 25-100 steps is accuracy-limited, not stiff, and
+#: dopri5 does it for less than CVODE from a restart; a stiff sample (Coulomb friction's rig) still goes
+#: to the stiff integrator, 76 wasted steps later.  Measured (docs/benchmarks.md, stops 45 and 46): the
+#: UTFSM 1 A sweep 2.25 times faster with the same answer; the diagnosis evaluation's records the same
+#: to the last digit; the four whole-record runs of docs/diagnose.md the same names and gaps (May 1 A ->
+#: 0 A at another point of the load term's flat valley).  benchmarks/lab_speed.py --stiff-steps sets another.
 STIFF_STEPS: int | None = 100
 
 #: the search's pair does its stiff samples by the core's error-controlled Rosenbrock method
 #: (SolverOptions.stiff_rosenbrock: a one-step method that carries its step across the samples, where CVODE's
-#: BDF restarts at each) instead of CVODE: on the stiff friction rigs a run costs 3.5-4.4 times less and is as
+#: BDF restarts at each) instead of CVODE: on the stiff friction rigs a run costs 3.6 times less and is as
 #: close to the decisions' rtol-1e-8 run (docs/benchmarks.md, stop 46).  False: CVODE, and the ladder's fixed
 #: ROS2 rungs back (``SEARCH_ROS2_SUBSTEPS``): the search of stop 45 (benchmarks/lab_speed.py --search-stiff cvode).
 SEARCH_STIFF_ROSENBROCK = True
