@@ -275,12 +275,13 @@ def main() -> None:
                    help="where a diagnosis fit goes on when its fixed step stopped agreeing with the pair "
                         "(diagnosis.engine.FIT_CONTINUATION; default: the package's, 'pair')")
     p.add_argument("--stiff-steps", type=int, default=None, metavar="N",
-                   help="the diagnosis' error-controlled pair redoes a sample by CVODE past N dopri5 steps "
-                        "(diagnosis.engine.STIFF_STEPS; default: the package's, 100 since stop 46; "
+                   help="the diagnosis' error-controlled pair redoes a sample by its stiff integrator past N "
+                        "dopri5 steps (diagnosis.engine.STIFF_STEPS; default: the package's, 100 since stop 46; "
                         "24, the core's, before)")
     p.add_argument("--search-stiff", choices=("rosenbrock", "cvode"), default=None,
                    help="the integrator of the diagnosis' search pair's stiff samples "
-                        "(diagnosis.engine.SEARCH_STIFF_ROSENBROCK; default: the package's, rosenbrock since stop 46)")
+                        "(diagnosis.engine.SEARCH_STIFF_ROSENBROCK; default: the package's, rosenbrock since stop 46); "
+                        "cvode brings back the fits' ROS2 rungs 8,16 as well, unless --ros2-rungs says otherwise")
     p.add_argument("--ros2-rungs", default=None, metavar="N,N",
                    help="the fixed ROS2 substep counts of the fits' integrator ladder, '' for none "
                         "(diagnosis.engine.SEARCH_ROS2_SUBSTEPS; default: the package's, none since stop 46)")
@@ -302,6 +303,8 @@ def main() -> None:
         from servohydraulics.diagnosis import engine
 
         engine.SEARCH_STIFF_ROSENBROCK = a.search_stiff == "rosenbrock"
+        if a.search_stiff == "cvode":
+            engine.SEARCH_ROS2_SUBSTEPS = (8, 16)  # stop 45's search
     if a.ros2_rungs is not None:
         from servohydraulics.diagnosis import engine
 
@@ -324,8 +327,7 @@ def main() -> None:
 
     out["stiff_steps_in_effect"] = _engine.STIFF_STEPS  # rows before stop 46 lack it: 24 (the core's) by default
     out["search_stiff"] = "rosenbrock" if _engine.SEARCH_STIFF_ROSENBROCK else "cvode"  # likewise: cvode before stop 46
-    out["ros2_rungs"] = list(_engine.SEARCH_ROS2_SUBSTEPS if _engine.SEARCH_STIFF_ROSENBROCK
-                             else _engine.SEARCH_ROS2_SUBSTEPS or (8, 16))  # likewise: [8, 16] before stop 46
+    out["ros2_rungs"] = list(_engine.SEARCH_ROS2_SUBSTEPS)  # likewise: [8, 16] before stop 46
     counter = Counters()
     for case in cases:
         counter.reset()

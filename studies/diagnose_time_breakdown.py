@@ -132,8 +132,8 @@ def main(argv=None) -> int:
     ap.add_argument("--v-stick", type=float, default=None, metavar="V",
                     help="the nominal rig with v_stick = V [m/s] (0: the exact Coulomb law); default: the rig's own")
     ap.add_argument("--stiff-steps", type=int, default=None, metavar="N",
-                    help="the pair hands a sample to CVODE past N dopri5 steps (diagnosis.engine.STIFF_STEPS; "
-                         "default: the package's, 100)")
+                    help="the pair hands a sample to its stiff integrator past N dopri5 steps "
+                         "(diagnosis.engine.STIFF_STEPS; default: the package's, 100)")
     args = ap.parse_args(argv)
     import lab_speed
 

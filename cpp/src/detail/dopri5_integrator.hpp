@@ -2,9 +2,9 @@
 // Runge-Kutta pair with error control inside each controller sample (the
 // sample is the maximum step; first-same-as-last within a sample and across
 // samples while the held input and the state are unchanged), and an automatic
-// switch to CVODE (or an error-controlled Rosenbrock method) for a sample where the pair turns stiff; a run that has turned
-// stiff is checked to its end by a shadow run at a tighter tolerance that flags
-// the samples it cannot vouch for.
+// switch to CVODE (or an error-controlled Rosenbrock method) for a sample where
+// the pair turns stiff; a run that has turned stiff is checked to its end by a
+// shadow run at a tighter tolerance that flags the samples it cannot vouch for.
 #pragma once
 
 #include <array>

@@ -158,8 +158,8 @@ STIFF_STEPS: int | None = 100
 #: the search's pair does its stiff samples by the core's error-controlled Rosenbrock method
 #: (SolverOptions.stiff_rosenbrock: a one-step method that carries its step across the samples, where CVODE's
 #: BDF restarts at each) instead of CVODE: on the stiff friction rigs a run costs 3.6 times less and is as
-#: close to the decisions' rtol-1e-8 run (docs/benchmarks.md, stop 46).  False: CVODE, and the ladder's fixed
-#: ROS2 rungs back (``SEARCH_ROS2_SUBSTEPS``): the search of stop 45 (benchmarks/lab_speed.py --search-stiff cvode).
+#: close to the decisions' rtol-1e-8 run (docs/benchmarks.md, stop 46).  False: CVODE; with
+#: ``SEARCH_ROS2_SUBSTEPS = (8, 16)`` the search of stop 45 (benchmarks/lab_speed.py --search-stiff cvode).
 SEARCH_STIFF_ROSENBROCK = True
 
 
@@ -293,7 +293,7 @@ SEARCH_RK4_LADDER = (6, 8, 12)
 #: stiff by a fast state (a regularised Coulomb law's slope F_c / v_stick, a re-sized oil column), where RK4
 #: diverges or needs hundreds of substeps.  None since the search's pair does its stiff samples by the
 #: error-controlled Rosenbrock (``SEARCH_STIFF_ROSENBROCK``): on those rigs the pair then costs less than ROS2 at
-#: 8 and 16 fixed substeps (docs/benchmarks.md, stop 46); (8, 16) when the pair's stiff samples are CVODE's
+#: 8 and 16 fixed substeps (docs/benchmarks.md, stop 46); stop 45's search, on CVODE, had (8, 16)
 SEARCH_ROS2_SUBSTEPS: tuple = ()
 
 
@@ -327,8 +327,8 @@ def search_options(rig: Rig, cases: list[Case], tau: float, x0s) -> list:
     run of ``rig`` (the fit's start: a candidate's parameters change the rig's stiffness, so each fit
     checks its own) agrees with the search's error-controlled pair (``run_options(True)``) to
     ``segments.AGREEMENT`` (largest) and ``AGREEMENT_RMS`` (rms) of each channel's standard
-    deviation; else ROS2 at the fewest of ``SEARCH_ROS2_SUBSTEPS`` that agrees (none by default; (8, 16)
-    where the pair's stiff samples are CVODE's, ``SEARCH_STIFF_ROSENBROCK`` False); the pair where none does
+    deviation; else ROS2 at the fewest of ``SEARCH_ROS2_SUBSTEPS`` that agrees (none by default; stop 45's
+    search, the pair's stiff samples by CVODE, had (8, 16)); the pair where none does
     (a rig too stiff for RK4: a regularised Coulomb law, a re-sized oil column; a Coulomb friction's
     switch that a fixed step straddles on a large, fast record).
     A fixed step also keeps the residual a smooth function of the parameters (clean difference
@@ -342,8 +342,7 @@ def search_options(rig: Rig, cases: list[Case], tau: float, x0s) -> list:
         ref = simulate_case(rig, case, tau, x0, options=pair)
         chosen = pair
         if ref is not None:
-            ros2 = SEARCH_ROS2_SUBSTEPS if SEARCH_STIFF_ROSENBROCK else SEARCH_ROS2_SUBSTEPS or (8, 16)
-            ladder = [rk4_options(n) for n in SEARCH_RK4_SUBSTEPS] + [ros2_options(n) for n in ros2]
+            ladder = [rk4_options(n) for n in SEARCH_RK4_SUBSTEPS] + [ros2_options(n) for n in SEARCH_ROS2_SUBSTEPS]
             for opts in ladder:
                 worst, rms = agreement(simulate_case(rig, case, tau, x0, options=opts), ref, case)
                 if worst <= AGREEMENT and rms <= AGREEMENT_RMS:
