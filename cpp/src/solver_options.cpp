@@ -34,6 +34,8 @@ void SolverOptions::validate() const {
           rk4_flag_rtol, "must be in [0, 1) (a fraction of the run's peaks; 0 = no check)");
   require(rk4_max_refinements >= 0 && rk4_max_refinements <= 16, "rk4_max_refinements", rk4_max_refinements,
           "must be in 0..16 (each doubles the substeps of the rest of the run)");
+  require(rosenbrock_order == 2 || rosenbrock_order == 4, "rosenbrock_order", rosenbrock_order,
+          "must be 2 (Shampine & Reichelt's formula) or 4 (RODAS4)");
   require(ros2_substeps >= 1 && ros2_substeps <= kMaxSubsteps, "ros2_substeps", ros2_substeps,
           "must be in 1..100000");
 }

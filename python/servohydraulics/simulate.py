@@ -33,13 +33,16 @@ def solver_options(method: str = DEFAULT_METHOD, rtol: float | None = None, rest
                    stiff_fallback: bool | None = None, stiff_steps: int | None = None,
                    stiff_check: bool | None = None, rk4_flag_rtol: float | None = None,
                    rk4_max_refinements: int | None = None, stiff_rosenbrock: bool | None = None,
-                   max_internal_step: float | None = None, ros2_substeps: int | None = None) -> _core.SolverOptions:
+                   max_internal_step: float | None = None, ros2_substeps: int | None = None,
+                   stiffness_test: bool | None = None, rosenbrock_order: int | None = None) -> _core.SolverOptions:
     """Builds solver options; see ``SolverOptions`` in solver_options.hpp (one keyword per row of
     its field table, ``_core.SOLVER_OPTION_FIELDS``).
 
     ``method``: ``"dopri5"`` (default: Dormand-Prince 5(4) with error control at ``rtol``, a sample
     where it turns stiff is redone by CVODE (by an error-controlled Rosenbrock method, a one-step method
-    that needs no restart at each sample, if ``stiff_rosenbrock``), or reported as status ``stiff`` if
+    that needs no restart at each sample, if ``stiff_rosenbrock``: of order 2, or RODAS4 if ``rosenbrock_order``
+    is 4; found stiff by Hairer's stiffness test as well
+    as by its step count if ``stiffness_test``), or reported as status ``stiff`` if
     ``stiff_fallback`` is False; a run that turned stiff is checked against one at ``rtol / 10``, ``stiff_check`` False
     drops that check), ``"rk4"`` (the real-time option: fixed cost, ``rk4_substeps`` per sample or automatic,
     checked by a companion run at twice the substeps that flags where the two differ by more than
@@ -63,7 +66,9 @@ def solver_options(method: str = DEFAULT_METHOD, rtol: float | None = None, rest
             stiff_check=None if stiff_check is None else bool(stiff_check), rk4_flag_rtol=rk4_flag_rtol,
             rk4_max_refinements=rk4_max_refinements,
             stiff_rosenbrock=None if stiff_rosenbrock is None else bool(stiff_rosenbrock),
-            max_internal_step=max_internal_step, ros2_substeps=ros2_substeps)
+            max_internal_step=max_internal_step, ros2_substeps=ros2_substeps,
+            stiffness_test=None if stiffness_test is None else bool(stiffness_test),
+            rosenbrock_order=rosenbrock_order)
     o.validate()
     return o
 

@@ -175,6 +175,10 @@ int main() {
   SolverOptions dopri5_rosenbrock;  // the stiff samples by the error-controlled Rosenbrock: fixed-capacity LU
   dopri5_rosenbrock.stiff_rosenbrock = true;
   check_plant(ControlMode::Displacement, dopri5_rosenbrock, light);
+  SolverOptions dopri5_rodas4 = dopri5_rosenbrock;  // RODAS4's six stages, found stiff by Hairer's test as well
+  dopri5_rodas4.rosenbrock_order = 4;
+  dopri5_rodas4.stiffness_test = true;
+  check_plant(ControlMode::Displacement, dopri5_rodas4, light);
   check_plant(ControlMode::Displacement, ros2, light);  // the LU of the stiff matrix: fixed capacity
   // The exact Coulomb law: stretches, located switches and re-integrations, every method.
   Rig exact = zhao2003();

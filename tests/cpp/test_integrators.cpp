@@ -16,8 +16,10 @@
 //    LuGre rig.  The default is accurate (CVODE takes the stiff samples) or
 //    returns a non-ok status, never a wrong answer with status ok; without the
 //    fallback it returns Status::Stiff.
-//    With stiff_rosenbrock the stiff samples go to the error-controlled Rosenbrock instead: within 1e-3
-//    as well, at rtol 1e-8 and 1e-6, at least five times closer at the tighter one.
+//    With stiff_rosenbrock the stiff samples go to the error-controlled Rosenbrock instead, of order 2
+//    or 4 (RODAS4): within 1e-3 as well, at rtol 1e-8 and 1e-6, at least five times closer at the
+//    tighter one; with Hairer's
+//    stiffness test as well (stiffness_test) within 1e-3, and on the stiff rig in fewer right-hand sides.
 // 5. Absolute tolerances scale with the rig: the piston area of
 //    4.47 m^2, where fixed tolerances gave a peak force 11x the converged one.
 // 6. RK4: the substep cap (no hang at 2^31 - 1), the companion at twice the
@@ -264,22 +266,43 @@ void check_stiff_configurations() {
     if (c.expect_stiff) CHECK(def.summary.stiff_samples > 0);
     // The stiff samples by the error-controlled Rosenbrock (stiff_rosenbrock) instead of CVODE: as accurate, at both
     // of the tolerances the diagnosis uses; a run that never turns stiff is the default's to the bit.
-    double ros2_error_at[2] = {0.0, 0.0};
-    for (double rtol : {1e-8, 1e-6}) {
-      SolverOptions ros2 = method(M::Dopri5, rtol), cv = ros2;
-      ros2.stiff_rosenbrock = true;
-      const Trace r = run(c.rig, c.mode, c.u, ros2), d = run(c.rig, c.mode, c.u, cv);
-      CHECK(r.summary.status.ok());
-      CHECK(r.summary.stiff_samples == d.summary.stiff_samples);
-      const double er = rel_error(r, ref), ed = rel_error(d, ref);
-      std::printf("  rtol %.0e, %ld stiff samples: Rosenbrock's error %.2e, CVODE's %.2e\n", rtol,
-                  r.summary.stiff_samples, er, ed);
-      CHECK(er <= 1e-3);
-      if (d.summary.stiff_samples == 0) CHECK(er == ed);
-      ros2_error_at[rtol < 1e-7 ? 0 : 1] = er;
+    // Both orders: 2 (Shampine & Reichelt's formula) and 4 (RODAS4).
+    for (int order : {2, 4}) {
+      double ros2_error_at[2] = {0.0, 0.0};
+      for (double rtol : {1e-8, 1e-6}) {
+        SolverOptions ros2 = method(M::Dopri5, rtol), cv = ros2;
+        ros2.stiff_rosenbrock = true;
+        ros2.rosenbrock_order = order;
+        const Trace r = run(c.rig, c.mode, c.u, ros2), d = run(c.rig, c.mode, c.u, cv);
+        CHECK(r.summary.status.ok());
+        CHECK(r.summary.stiff_samples == d.summary.stiff_samples);
+        const double er = rel_error(r, ref), ed = rel_error(d, ref);
+        std::printf("  rtol %.0e, %ld stiff samples: Rosenbrock's (order %d) error %.2e, CVODE's %.2e\n", rtol,
+                    r.summary.stiff_samples, order, er, ed);
+        CHECK(er <= 1e-3);
+        if (d.summary.stiff_samples == 0) CHECK(er == ed);
+        ros2_error_at[rtol < 1e-7 ? 0 : 1] = er;
+      }
+      // its error control works: a hundredfold tighter rtol, a run at least five times closer
+      if (c.expect_stiff) CHECK(ros2_error_at[0] * 5.0 <= ros2_error_at[1]);
     }
-    // its error control works: a hundredfold tighter rtol, a run at least five times closer
-    if (c.expect_stiff) CHECK(ros2_error_at[0] * 5.0 <= ros2_error_at[1]);
+    // Hairer's stiffness test as well (stiffness_test, with the Rosenbrock: the diagnosis' search): as accurate,
+    // and where the rig is stiff it hands the samples over in fewer right-hand sides than the step count alone
+    // at the diagnosis' stiff_steps of 100
+    {
+      SolverOptions counted = method(M::Dopri5, 1e-6);
+      counted.stiff_rosenbrock = true;
+      counted.stiff_steps = 100;
+      SolverOptions tested = counted;
+      tested.stiffness_test = true;
+      const Trace a = run(c.rig, c.mode, c.u, counted), b = run(c.rig, c.mode, c.u, tested);
+      CHECK(b.summary.status.ok());
+      const double eb = rel_error(b, ref);
+      std::printf("  stiffness test: %ld stiff samples, %ld rhs (step count alone: %ld, %ld rhs), error %.2e\n",
+                  b.summary.stiff_samples, b.summary.rhs_evals, a.summary.stiff_samples, a.summary.rhs_evals, eb);
+      CHECK(eb <= 1e-3);
+      if (c.expect_stiff) CHECK(b.summary.rhs_evals < a.summary.rhs_evals);
+    }
     const Trace rk4 = run(c.rig, c.mode, c.u, method(M::Rk4));
     CHECK(rk4.summary.inaccurate_samples > 0 || !rk4.summary.status.ok() || rel_error(rk4, ref) <= 1e-2);
     within_or_status(rk4, ref, 1e-2, "rk4 (automatic substeps)");

@@ -131,3 +131,12 @@ def test_ros2_is_l_stable_where_one_rk4_substep_is_not():
     assert e8 < 1e-2 < e4
     with pytest.raises(ValueError, match="ros2_substeps"):
         sh.solver_options(method="ros2", ros2_substeps=0)
+
+
+def test_the_rosenbrock_order_is_2_or_4():
+    """``rosenbrock_order`` names one of the two methods the pair has for its stiff samples; another value is an
+    error naming the field and the value."""
+    assert sh.solver_options().rosenbrock_order == 2 and not sh.solver_options().stiffness_test
+    assert sh.solver_options(stiff_rosenbrock=True, rosenbrock_order=4, stiffness_test=True).rosenbrock_order == 4
+    with pytest.raises(ValueError, match="rosenbrock_order.*3"):
+        sh.solver_options(stiff_rosenbrock=True, rosenbrock_order=3)

@@ -59,6 +59,15 @@ struct SolverOptions {
   //! sample's input jump) instead of CVODE's BDF, which restarts at order 1 with a small first step at
   //! every such jump.  A sample it cannot finish in 200 steps is CVODE's.  false: CVODE (the reference).
   bool stiff_rosenbrock = false;
+  //! Dopri5 with stiff_rosenbrock: the Rosenbrock method's order, 2 (Shampine & Reichelt's formula above)
+  //! or 4 (Hairer & Wanner's RODAS4: six stages, L-stable and stiffly accurate, with an embedded third-order
+  //! solution; Solving ODEs II, sec. VI.4): at the tolerances of 1e-6 and below fewer steps a sample.
+  int rosenbrock_order = 2;
+  //! Dopri5: Hairer's stiffness test as well (Hairer & Wanner, Solving ODEs II, sec. IV.2; their DOPRI5): after
+  //! each accepted step h |f(y5) - f(y6)| / |y5 - y6| (y6 the sixth stage's state) estimates h times the
+  //! dominant eigenvalue; 15 accepted steps in one sample with it above 3.25 (the method's stability
+  //! boundary), never 6 in a row below it between them, and the sample is stiff before stiff_steps steps.
+  bool stiffness_test = false;
   //! Rk4: substeps per sample; 0 = automatic (rk4_automatic_substeps in plant.hpp): the fewest with
   //! h * rho(J) <= rk4_h_rho, rho the largest spectral radius of the Jacobian over the operating
   //! states the loop can reach (rest, pressure up to 0.9 p_s, spool at its stops, sliding), chosen at
@@ -134,6 +143,10 @@ inline constexpr SolverOptionField kSolverOptionFields[] = {
     {"stiff_fallback", &SolverOptions::stiff_fallback, "", "dopri5: redo a stiff sample with CVODE"},
     {"stiff_rosenbrock", &SolverOptions::stiff_rosenbrock, "",
      "dopri5: a stiff sample by an error-controlled Rosenbrock method (one-step) instead of CVODE"},
+    {"rosenbrock_order", &SolverOptions::rosenbrock_order, "",
+     "dopri5 with stiff_rosenbrock: the Rosenbrock method's order, 2 (ode23s's formula) or 4 (RODAS4)"},
+    {"stiffness_test", &SolverOptions::stiffness_test, "",
+     "dopri5: Hairer's stiffness test (h lambda above 3.25 in 15 accepted steps of a sample) as well"},
     {"stiff_check", &SolverOptions::stiff_check, "",
      "dopri5: check a run that turned stiff against a run at rtol / 10 (flags where it may miss 1e-3)"},
     {"rk4_substeps", &SolverOptions::rk4_substeps, "", "RK4 substeps per sample (0 = automatic)"},

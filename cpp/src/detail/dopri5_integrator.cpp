@@ -35,6 +35,8 @@ BasicDopri5Integrator<System>::BasicDopri5Integrator(const System& sys, double d
       gap_(sys),
       h_(dt),
       rosenbrock_(opt.stiff_rosenbrock),
+      rosenbrock_order_(opt.rosenbrock_order),
+      stiffness_test_(opt.stiffness_test),
       h_rosenbrock_(dt) {
   Sys::tolerances(sys, opt, atol_);
   if (opt.stiff_fallback) {
@@ -110,6 +112,7 @@ double BasicDopri5Integrator<System>::trial_step(const System& sys, const Input&
   for (int i = 0; i < n; ++i)
     tmp[i] = y[i] + h * (a61 * k1[i] + a62 * k_[1][i] + a63 * k_[2][i] + a64 * k_[3][i] + a65 * k_[4][i]);
   Sys::rhs(sys, tmp.data(), in, k_[5].data());
+  if (stiffness_test_) ysti_ = tmp;
   for (int i = 0; i < n; ++i)
     y5[i] = y[i] + h * (b1 * k1[i] + b3 * k_[2][i] + b4 * k_[3][i] + b5 * k_[4][i] + b6 * k_[5][i]);
   Sys::rhs(sys, y5.data(), in, k_[6].data());
@@ -131,7 +134,7 @@ typename BasicDopri5Integrator<System>::Outcome BasicDopri5Integrator<System>::e
     ++st.rhs_evals;
   }
   fsal_ = false;
-  int attempts = 0;
+  int attempts = 0, stiff_count = 0, nonstiff_count = 0;
   bool rejected = false;
   State y5 = y;  // the entries past n_ (unused states) stay as they are
   while (t < t_next) {
@@ -151,6 +154,23 @@ typename BasicDopri5Integrator<System>::Outcome BasicDopri5Integrator<System>::e
     const double fac = err > 0.0 ? std::min(kGrow, std::max(kShrink, kSafety * std::pow(err, -0.2))) : kGrow;
     h_ = std::min(dt_, h * (rejected ? std::min(1.0, fac) : fac));
     rejected = false;
+    // Hairer's stiffness test (options.stiffness_test; their DOPRI5): h lambda ~ h |f(y5) - f(ysti)| /
+    // |y5 - ysti|; kHairerStiff accepted steps above 3.25 (the stability boundary) in a sample, never 6 in a
+    // row below it between them: stiff
+    if (stiffness_test_) {
+      double num = 0.0, den = 0.0;
+      for (int i = 0; i < n_; ++i) {
+        const double a = k_[6][i] - k_[5][i], b = y5[i] - ysti_[i];
+        num += a * a;
+        den += b * b;
+      }
+      if (den > 0.0 && h * std::sqrt(num / den) > 3.25) {
+        nonstiff_count = 0;
+        if (++stiff_count >= kHairerStiff) return Outcome::Stiff;
+      } else if (++nonstiff_count >= 6) {
+        stiff_count = 0;
+      }
+    }
     y = y5;
     k_[0] = k_[6];
     t = n_left <= 1.0 ? t_next : t + h;
@@ -230,6 +250,94 @@ Status BasicDopri5Integrator<System>::rosenbrock_sample(const System& sys, const
   return st;
 }
 
+// The stiff sample by RODAS4 (Hairer & Wanner 1996, Solving Ordinary Differential Equations II, sec. VI.4, the
+// coefficients of their code RODAS in its transformed form): E = I / (gamma h) - J, gamma = 1/4, and for the
+// autonomous system (the input is held in a sample)
+//   E u_i = f(y + sum_j<i a_ij u_j) + sum_j<i (c_ij / h) u_j,  i = 1..6,
+// where stages 5 and 6 are stiffly accurate: y + sum a_5j u_j + u_5 is the embedded third-order solution (the
+// sixth stage's argument) and the fourth-order result adds u_6, which is the error estimate, weighed as dopri5's;
+// the step follows err^(-1/4).  One Jacobian and one LU a step, six right-hand sides and six solves.
+template <class System>
+Status BasicDopri5Integrator<System>::rodas4_sample(const System& sys, const Input& in, State& y, double& t,
+                                                    double t_next) noexcept {
+  constexpr double kGamma = 0.25;
+  constexpr double a21 = 1.544, a31 = 0.9466785280815826, a32 = 0.2557011698983284, a41 = 3.314825187068521,
+                   a42 = 2.896124015972201, a43 = 0.9986419139977817, a51 = 1.221224509226641,
+                   a52 = 6.019134481288629, a53 = 12.53708332932087, a54 = -0.6878860361058950;
+  constexpr double c21 = -5.6688, c31 = -2.430093356833875, c32 = -0.2063599157091915, c41 = -0.1073529058151375,
+                   c42 = -9.594562251023355, c43 = -20.47028614809616, c51 = 7.496443313967647,
+                   c52 = -10.24680431464352, c53 = -33.99990352819905, c54 = 11.70890893206160,
+                   c61 = 8.083246795921522, c62 = -7.981132988064893, c63 = -31.52159432874371,
+                   c64 = 16.31930543123136, c65 = -6.058818238834054;
+  Status st;
+  st.stiff = true;
+  ++stiff_samples_;
+  fsal_ = false;
+  h_ = dt_;
+  State f{}, u1{}, u2{}, u3{}, u4{}, u5{}, u6{}, yn{};
+  double* W = W_.data();
+  long attempts = 0;
+  at_size(n_, [&](auto size) {
+    const int m = size;
+    while (t < t_next) {
+      const double remaining = t_next - t;
+      const double n_left = std::ceil(remaining / std::min(h_rosenbrock_, remaining) * (1.0 - 1e-12));
+      const double h = remaining / std::max(1.0, n_left);
+      if (++attempts > kRosenbrockAttempts || h < 1e-14 * dt_) {
+        st.code = Status::TooMuchWork;
+        return;
+      }
+      // E = I / (gamma h) - J: built as -(J) then the diagonal
+      Sys::jacobian_rhs(sys, y.data(), in, W, f.data());
+      for (int i = 0; i < m * m; ++i) W[i] = -W[i];
+      for (int i = 0; i < m; ++i) W[i + i * m] += 1.0 / (kGamma * h);
+      lu_factor(W, size, piv_.data());
+      const double ih = 1.0 / h;
+      for (int i = 0; i < m; ++i) u1[i] = f[i];
+      lu_solve(W, size, piv_.data(), u1.data());
+      for (int i = 0; i < m; ++i) yn[i] = y[i] + a21 * u1[i];
+      Sys::rhs(sys, yn.data(), in, f.data());
+      for (int i = 0; i < m; ++i) u2[i] = f[i] + ih * c21 * u1[i];
+      lu_solve(W, size, piv_.data(), u2.data());
+      for (int i = 0; i < m; ++i) yn[i] = y[i] + a31 * u1[i] + a32 * u2[i];
+      Sys::rhs(sys, yn.data(), in, f.data());
+      for (int i = 0; i < m; ++i) u3[i] = f[i] + ih * (c31 * u1[i] + c32 * u2[i]);
+      lu_solve(W, size, piv_.data(), u3.data());
+      for (int i = 0; i < m; ++i) yn[i] = y[i] + a41 * u1[i] + a42 * u2[i] + a43 * u3[i];
+      Sys::rhs(sys, yn.data(), in, f.data());
+      for (int i = 0; i < m; ++i) u4[i] = f[i] + ih * (c41 * u1[i] + c42 * u2[i] + c43 * u3[i]);
+      lu_solve(W, size, piv_.data(), u4.data());
+      for (int i = 0; i < m; ++i) yn[i] = y[i] + a51 * u1[i] + a52 * u2[i] + a53 * u3[i] + a54 * u4[i];
+      Sys::rhs(sys, yn.data(), in, f.data());
+      for (int i = 0; i < m; ++i) u5[i] = f[i] + ih * (c51 * u1[i] + c52 * u2[i] + c53 * u3[i] + c54 * u4[i]);
+      lu_solve(W, size, piv_.data(), u5.data());
+      for (int i = 0; i < m; ++i) yn[i] += u5[i];  // the embedded solution
+      Sys::rhs(sys, yn.data(), in, f.data());
+      for (int i = 0; i < m; ++i)
+        u6[i] = f[i] + ih * (c61 * u1[i] + c62 * u2[i] + c63 * u3[i] + c64 * u4[i] + c65 * u5[i]);
+      lu_solve(W, size, piv_.data(), u6.data());
+      st.rhs_evals += 6;
+      double sum = 0.0;
+      for (int i = 0; i < m; ++i) {
+        yn[i] += u6[i];
+        const double sc = atol_[i] + rtol_ * std::max(std::fabs(y[i]), std::fabs(yn[i]));
+        sum += (u6[i] / sc) * (u6[i] / sc);
+      }
+      const double err = std::sqrt(sum / m);
+      if (!(err <= 1.0)) {  // rejected (NaN: a stage blew up)
+        h_rosenbrock_ = h * (std::isfinite(err) ? std::max(kShrink, kSafety * std::pow(err, -0.25)) : kShrink);
+        continue;
+      }
+      for (int i = 0; i < m; ++i) y[i] = yn[i];
+      t = n_left <= 1.0 ? t_next : t + h;
+      ++st.internal_steps;
+      const double grow = err > 0.0 ? std::min(kGrow, std::max(kShrink, kSafety * std::pow(err, -0.25))) : kGrow;
+      h_rosenbrock_ = std::min(dt_, h * grow);
+    }
+  });
+  return st;
+}
+
 template <class System>
 Status BasicDopri5Integrator<System>::implicit_sample(const System& sys, const Input& in, State& y, double& t,
                                                       double t_next) noexcept {
@@ -237,7 +345,7 @@ Status BasicDopri5Integrator<System>::implicit_sample(const System& sys, const I
   if (rosenbrock_ && !rosenbrock_failed_) {
     const State y0 = y;
     const double t0 = t;
-    tried = rosenbrock_sample(sys, in, y, t, t_next);
+    tried = rosenbrock_order_ == 4 ? rodas4_sample(sys, in, y, t, t_next) : rosenbrock_sample(sys, in, y, t, t_next);
     if (tried.ok()) return tried;
     y = y0;  // more than kRosenbrockAttempts steps (an accuracy-bound sample at a tight tolerance): CVODE's BDF
     t = t0;

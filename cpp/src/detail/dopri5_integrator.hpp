@@ -91,6 +91,8 @@ class BasicDopri5Integrator {
   //! The stiff sample by the error-controlled Rosenbrock method (options.stiff_rosenbrock), its step
   //! carried across samples.
   Status rosenbrock_sample(const System& sys, const Input& in, State& y, double& t, double t_next) noexcept;
+  //! The same by RODAS4 (options.rosenbrock_order 4).
+  Status rodas4_sample(const System& sys, const Input& in, State& y, double& t, double t_next) noexcept;
   //! Advances the shadow over the sample just done, from t_start to t_next (starting it at y_start
   //! if it is not following the run yet), compares it with the result y and flags st.
   void verify(const System& sys, const Input& in, const State& y_start, double t_start, const State& y,
@@ -108,11 +110,15 @@ class BasicDopri5Integrator {
   bool shadow_live_ = false;   // the shadow follows the run (from its first stiff sample on)
   OutputGap<System> gap_;      // the run's peaks and the gap between the result and the shadow
   State k_[7];         // the stages; k_[0] is the slope at the current state
+  State ysti_{};       // the last trial step's stage-6 state (the stiffness test)
+  static constexpr int kHairerStiff = 15;  // accepted steps above the boundary that make a sample stiff
   bool fsal_ = false;  // k_[0] is f(y, in) of the state and input the next sample starts from
   Input fsal_in_{};
   double h_;           // the step the controller proposes next [s]
   int hold_ = 0;       // samples left on CVODE
   bool rosenbrock_ = false;  // stiff samples by rosenbrock_sample, not CVODE
+  int rosenbrock_order_ = 2;        // 2: rosenbrock_sample, 4: rodas4_sample
+  bool stiffness_test_ = false;     // Hairer's stiffness test in explicit_sample (options.stiffness_test)
   bool rosenbrock_failed_ = false;  // it gave up in this stretch of stiff samples: CVODE until it ends
   double h_rosenbrock_;             // the step rosenbrock_sample proposes next [s]
   // rosenbrock_sample's W = I - d h J (column-major, then its LU) and pivots: no allocation
