@@ -3,6 +3,8 @@
     python benchmarks/lab_speed.py [--cases identify,diagnose10,diagnose10sim,sweep1A] [--json FILE]
                                    [--profile] [--label NAME] [--v-stick V] [--continuation pair|search]
                                    [--stiff-steps N] [--search-stiff rosenbrock|cvode] [--ros2-rungs N,N]
+                                   [--decision-stiff rosenbrock|cvode] [--stiffness-test on|off]
+                                   [--rosenbrock-order 2|4] [--fit-ftol-max F]
     python benchmarks/lab_speed.py --table benchmarks/lab_speed.json
 
 The cases (records from ../shared/real-data/utfsm-mts-mrdamper, or $SH_SHARED_DIR/real-data/...):
@@ -285,6 +287,20 @@ def main() -> None:
     p.add_argument("--ros2-rungs", default=None, metavar="N,N",
                    help="the fixed ROS2 substep counts of the fits' integrator ladder, '' for none "
                         "(diagnosis.engine.SEARCH_ROS2_SUBSTEPS; default: the package's, none since stop 46)")
+    p.add_argument("--decision-stiff", choices=("rosenbrock", "cvode"), default=None,
+                   help="the integrator of the diagnosis' decision runs' stiff samples "
+                        "(diagnosis.engine.DECISION_STIFF_ROSENBROCK; default: the package's, rosenbrock since "
+                        "stop 47; cvode before)")
+    p.add_argument("--stiffness-test", choices=("on", "off"), default=None,
+                   help="Hairer's stiffness test in the diagnosis' pair (diagnosis.engine.STIFFNESS_TEST; default: "
+                        "the package's, on since stop 47; off before)")
+    p.add_argument("--rosenbrock-order", type=int, choices=(2, 4), default=None,
+                   help="the order of the Rosenbrock method of the diagnosis pair's stiff samples "
+                        "(diagnosis.engine.ROSENBROCK_ORDER; default: the package's, 4 (RODAS4) since stop 47; "
+                        "2 before)")
+    p.add_argument("--fit-ftol-max", type=float, default=None, metavar="F",
+                   help="the diagnosis fits' relative stopping tolerance at most (diagnosis.engine.FIT_FTOL_MAX; "
+                        "default: the package's, 1e-4 since stop 47; 1e-8, the fixed tolerance before)")
     a = p.parse_args()
     if a.table:
         print(table(Path(a.table)))
@@ -309,6 +325,19 @@ def main() -> None:
         from servohydraulics.diagnosis import engine
 
         engine.SEARCH_ROS2_SUBSTEPS = tuple(int(v) for v in a.ros2_rungs.split(",") if v.strip())
+    if a.rosenbrock_order is not None:
+        from servohydraulics.diagnosis import engine
+
+        engine.ROSENBROCK_ORDER = a.rosenbrock_order
+    if a.decision_stiff is not None or a.stiffness_test is not None or a.fit_ftol_max is not None:
+        from servohydraulics.diagnosis import engine
+
+        if a.decision_stiff is not None:
+            engine.DECISION_STIFF_ROSENBROCK = a.decision_stiff == "rosenbrock"
+        if a.stiffness_test is not None:
+            engine.STIFFNESS_TEST = a.stiffness_test == "on"
+        if a.fit_ftol_max is not None:
+            engine.FIT_FTOL_MAX = a.fit_ftol_max
     cases = [c.strip() for c in a.cases.split(",") if c.strip()]
     if a.json and Path(a.json).exists() and a.label in json.loads(Path(a.json).read_text()):
         # the JSON is keyed by label: a second run under one label would replace the first's cases
@@ -328,6 +357,11 @@ def main() -> None:
     out["stiff_steps_in_effect"] = _engine.STIFF_STEPS  # rows before stop 46 lack it: 24 (the core's) by default
     out["search_stiff"] = "rosenbrock" if _engine.SEARCH_STIFF_ROSENBROCK else "cvode"  # likewise: cvode before stop 46
     out["ros2_rungs"] = list(_engine.SEARCH_ROS2_SUBSTEPS)  # likewise: [8, 16] before stop 46
+    # rows before stop 47 lack these: cvode, off and 1e-8
+    out["decision_stiff"] = "rosenbrock" if _engine.DECISION_STIFF_ROSENBROCK else "cvode"
+    out["stiffness_test"] = bool(_engine.STIFFNESS_TEST)
+    out["fit_ftol_max"] = _engine.FIT_FTOL_MAX
+    out["rosenbrock_order"] = _engine.ROSENBROCK_ORDER  # 2 before stop 47
     counter = Counters()
     for case in cases:
         counter.reset()

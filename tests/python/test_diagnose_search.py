@@ -130,38 +130,43 @@ def _utfsm_10s_case():
     return _case(Record({k: np.asarray(v)[:n] for k, v in full.channels.items()}))
 
 
-def test_the_search_pairs_stiff_samples_by_the_rosenbrock_agree_with_cvodes():
-    """The search's pair does its stiff samples by the core's error-controlled Rosenbrock
-    (``SEARCH_STIFF_ROSENBROCK``, ``SolverOptions.stiff_rosenbrock``), not CVODE.  On the diagnose10 record through
-    the 0 A rig with 700 N of Coulomb friction (half its samples stiff) and with LuGre at its static
-    limit (sigma_0 1e10 N/m: round 1's answer there), the run agrees with the same pair doing them by
-    CVODE, an independent integrator, and with the decisions' run (CVODE at rtol 1e-8), each to a
-    tenth of the fits' test; it takes the same samples as stiff.  Where no sample is stiff (the 0 A
-    rig) the two pairs are the same run to the bit.  Without fixed ROS2 rungs the ladder now keeps the
+def test_the_pairs_stiff_samples_by_rodas4_agree_with_cvodes():
+    """The diagnosis' pair, the search's (rtol 1e-6) and the decisions' (1e-8), does its stiff samples by the
+    core's error-controlled RODAS4 (``SEARCH_STIFF_ROSENBROCK``, ``DECISION_STIFF_ROSENBROCK``,
+    ``ROSENBROCK_ORDER``), not CVODE, and finds them by Hairer's stiffness test as well (``STIFFNESS_TEST``).
+    On the diagnose10 record through the 0 A rig with 700 N of Coulomb friction (half its samples stiff) and
+    with LuGre at its static limit (sigma_0 1e10 N/m: round 1's answer there), each run agrees with the same
+    pair doing them by CVODE, an independent integrator, at its own tolerance, and with the CVODE pair at rtol
+    1e-8: the search's to a tenth of the fits' test, the decisions' to a hundredth.  Where no sample is stiff
+    (the 0 A rig) the two pairs are the same run to the bit.  Without fixed ROS2 rungs the ladder keeps the
     pair on the Coulomb rig."""
     case = _utfsm_10s_case()
     rig = _rig()
     rigs = {"coulomb": LIBRARY["coulomb_friction"].apply(rig, np.array([700.0])),
             "lugre at its bound": LIBRARY["lugre_friction"].apply(rig, np.array([1e10, 780.0])), "0 A": rig}
-    assert engine.SEARCH_STIFF_ROSENBROCK and engine.run_options(True).stiff_rosenbrock
-    assert not engine.run_options(False).stiff_rosenbrock
+    for search in (True, False):
+        o = engine.run_options(search)
+        assert o.stiff_rosenbrock and o.rosenbrock_order == 4 and o.stiffness_test
+    cvode_tight = engine.run_options(False)
+    cvode_tight.stiff_rosenbrock = False
     for name, r in rigs.items():
-        ros = simulate_command(r, "displacement", case.u, case.dt, case.x0_data, engine.run_options(True))
-        o = engine.run_options(True)
-        o.stiff_rosenbrock = False
-        cv = simulate_command(r, "displacement", case.u, case.dt, case.x0_data, o)
-        tight = simulate_command(r, "displacement", case.u, case.dt, case.x0_data, engine.run_options(False))
-        assert ros.work.stiff_samples == cv.work.stiff_samples, name
-        chans = [{c: s.channels[c] for c in engine.SIM_CHANNELS} for s in (ros, cv, tight)]
-        if name == "0 A":
-            assert ros.work.stiff_samples == 0
-            for c in engine.SIM_CHANNELS:
-                np.testing.assert_array_equal(chans[0][c], chans[1][c])
-            continue
-        assert ros.work.stiff_samples > 1000, name
-        for other in chans[1:]:
-            worst, rms = engine.agreement(chans[0], other, case)
-            assert worst <= 0.1 * AGREEMENT and rms <= 0.1 * AGREEMENT_RMS, (name, worst, rms)
+        tight = simulate_command(r, "displacement", case.u, case.dt, case.x0_data, cvode_tight)
+        for search, share in ((True, 0.1), (False, 0.01)):
+            ros = simulate_command(r, "displacement", case.u, case.dt, case.x0_data, engine.run_options(search))
+            o = engine.run_options(search)
+            o.stiff_rosenbrock = False
+            cv = simulate_command(r, "displacement", case.u, case.dt, case.x0_data, o)
+            chans = [{c: s.channels[c] for c in engine.SIM_CHANNELS} for s in (ros, cv, tight)]
+            if name == "0 A":
+                assert ros.work.stiff_samples == 0
+                for c in engine.SIM_CHANNELS:
+                    np.testing.assert_array_equal(chans[0][c], chans[1][c])
+                continue
+            assert ros.work.stiff_samples > 1000 and abs(ros.work.stiff_samples - cv.work.stiff_samples) <= \
+                0.01 * cv.work.stiff_samples, name
+            for other in chans[1:]:
+                worst, rms = engine.agreement(chans[0], other, case)
+                assert worst <= share * AGREEMENT and rms <= share * AGREEMENT_RMS, (name, search, worst, rms)
     opts = engine.search_options(rigs["coulomb"], [case], 0.0, [case.x0_data])[0]
     assert not engine.fixed_step(opts)
 
@@ -419,3 +424,28 @@ def test_the_pairs_stiff_switch_at_100_steps_keeps_its_runs_and_leaves_cvode_the
             for c in ("displacement", "force"):
                 y0, y1 = np.asarray(ref.channels[c], float), np.asarray(run.channels[c], float)
                 assert np.max(np.abs(y1 - y0)) <= tol * np.std(y0), (c, search, stiff)
+
+
+def test_the_fits_stop_where_a_step_gains_a_quarter_unit_of_the_decisions_statistic():
+    """``engine.fit_ftol``: a fit's relative stopping tolerance is FIT_STEP_GAIN over the residual's AR(1)
+    effective sample size summed over its series, at most FIT_FTOL_MAX.  Oracle: the closed form n (1 - rho) /
+    (1 + rho) of AR(1) series made with a known rho (white noise: n), within the estimate's sampling error."""
+    rng = np.random.default_rng(47)
+
+    def ar1(n: int, rho: float) -> np.ndarray:
+        e = rng.normal(size=n)
+        x = np.empty(n)
+        x[0] = e[0]
+        for i in range(1, n):
+            x[i] = rho * x[i - 1] + e[i]
+        return x
+
+    assert engine.FIT_STEP_GAIN == 0.25 and engine.FIT_FTOL_MAX == 1e-4
+    white = [rng.normal(size=50_000), 3.0 * rng.normal(size=50_000)]  # the scale of a series does not matter
+    got = engine.fit_ftol(np.concatenate(white), [50_000, 50_000])
+    assert got == pytest.approx(0.25 / 100_000, rel=0.03)
+    n, rho = 100_000, 0.5
+    got = engine.fit_ftol(ar1(n, rho), [n])
+    assert got == pytest.approx(0.25 / (n * (1 - rho) / (1 + rho)), rel=0.05)
+    n, rho = 20_000, 0.9  # n_eff about 1,050: 0.25 / n_eff is above the cap
+    assert engine.fit_ftol(ar1(n, rho), [n]) == 1e-4

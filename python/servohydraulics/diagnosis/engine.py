@@ -131,17 +131,20 @@ def run_options(search: bool):
     UTFSM MR damper, whose default run turns stiff) times less; a fit's own runs go on RK4 where
     that agrees with this pair (``search_options``).  No run is checked by the pair's
     shadow (``stiff_check``: the diagnosis reads no flag; the results are the same to the bit).
-    The pair hands a sample to its stiff integrator past ``STIFF_STEPS`` dopri5 steps in it (100, not
-    the core's 24); a search run's stiff samples go to the core's error-controlled Rosenbrock method
-    (``stiff_rosenbrock``, ``SEARCH_STIFF_ROSENBROCK``) rather than CVODE, a decision's to CVODE (the
-    core's default)."""
+    The pair hands a sample to its stiff integrator where Hairer's stiffness test finds it stiff
+    (``stiffness_test``, ``STIFFNESS_TEST``) or past ``STIFF_STEPS`` dopri5 steps in it (100, not the
+    core's 24); the stiff samples of a search run and of a decision's go to the core's error-controlled
+    Rosenbrock method (``stiff_rosenbrock``, ``SEARCH_STIFF_ROSENBROCK``, ``DECISION_STIFF_ROSENBROCK``)
+    rather than CVODE (the core's default)."""
     from ..identification.fit import FIT_RTOL
 
     opts = solver_options(rtol=FIT_RTOL if search else None, stiff_check=False)
     if STIFF_STEPS is not None:
         opts.stiff_steps = int(STIFF_STEPS)
-    if search and SEARCH_STIFF_ROSENBROCK:
+    if SEARCH_STIFF_ROSENBROCK if search else DECISION_STIFF_ROSENBROCK:
         opts.stiff_rosenbrock = True
+    opts.stiffness_test = STIFFNESS_TEST
+    opts.rosenbrock_order = ROSENBROCK_ORDER
     return opts
 
 
@@ -161,6 +164,19 @@ STIFF_STEPS: int | None = 100
 #: close to the decisions' rtol-1e-8 run (docs/benchmarks.md, stop 46).  False: CVODE; with
 #: ``SEARCH_ROS2_SUBSTEPS = (8, 16)`` the search of stop 45 (benchmarks/lab_speed.py --search-stiff cvode).
 SEARCH_STIFF_ROSENBROCK = True
+#: the decisions' runs likewise, at their rtol of 1e-8 (where the Rosenbrock run costs half CVODE's on the stiff
+#: friction rigs and stays within 1.3e-6 of the force's standard deviation of it: docs/benchmarks.md, stop 46).
+#: False: CVODE, the decisions of stop 46 (benchmarks/lab_speed.py --decision-stiff cvode)
+DECISION_STIFF_ROSENBROCK = True
+#: the order of that Rosenbrock method (SolverOptions.rosenbrock_order): 4, RODAS4, which on the stiff friction
+#: rigs takes fewer steps than the second-order formula at the search's and the decisions' tolerances, each run
+#: cheaper and closer to a tight reference (docs/benchmarks.md, stop 47; studies/pair_stiff_rosenbrock.py).
+#: 2: stop 46's formula (benchmarks/lab_speed.py --rosenbrock-order 2)
+ROSENBROCK_ORDER = 4
+#: the pair's runs find a stiff sample by Hairer's stiffness test as well as by ``STIFF_STEPS``
+#: (SolverOptions.stiffness_test): the dopri5 steps a stiff sample wastes before it goes to the stiff
+#: integrator are fewer (docs/benchmarks.md, stop 47).  False: the step count alone (--stiffness-test off)
+STIFFNESS_TEST = True
 
 
 class RunCache:
@@ -738,8 +754,9 @@ def fit(space: Space, cases: list[Case], z0: np.ndarray, base_tau: float, which:
             rig, tau = space.rig_and_tau(z[:p], base_tau)
             return residuals(simulate_all(rig, cases, tau, z[p:], options=options), cases, which, weights)
 
+        ftol = fit_ftol(fun(zs), series_lengths(cases, which))  # its run is the fit's first: served by RUNS
         return least_squares(fun, zs, bounds=(lo, hi), x_scale=np.concatenate([space.scale, sd]), diff_step=1e-3,
-                             max_nfev=max_nfev, method="trf", xtol=1e-6, ftol=1e-8, workers=workers())
+                             max_nfev=max_nfev, method="trf", xtol=1e-6, ftol=ftol, workers=workers())
 
     rig0, tau0 = space.rig_and_tau(zs[:p], base_tau)
     options = search_options(rig0, cases, tau0, zs[p:])
@@ -759,6 +776,26 @@ def fit(space: Space, cases: list[Case], z0: np.ndarray, base_tau: float, which:
         nfev += int(res.nfev)
     return FitResult(z=res.x[:p].copy(), x0=res.x[p:].copy(), jac=res.jac, fun=res.fun, nuisance_scale=sd,
                      nfev=nfev)
+
+
+#: the decisions' -2 log likelihood a fit's step must gain for the fit to go on (``fit_ftol``)
+FIT_STEP_GAIN = 0.25
+#: the fits' relative stopping tolerance at most (``fit_ftol``): sh.identify's (``identification.fit.FTOL``)
+FIT_FTOL_MAX = 1e-4
+
+
+def fit_ftol(r: np.ndarray, lengths: list[int]) -> float:
+    """The relative cost reduction below which a fit's step ends it (least_squares' ``ftol``): the step's gain
+    in the decisions' statistic, -2 log L = sum over the series of n_eff log SSR, about ``FIT_STEP_GAIN``
+    (a quarter of a unit: the BIC and held-out tests ask for 10).  A relative reduction d of the cost gains
+    about d sum(n_eff) there, n_eff each (record, channel) series' AR(1) effective sample size at the fit's
+    start ``r`` (its residuals, stacked as ``residuals`` does; ``lengths``: the series' lengths), so the
+    tolerance is ``FIT_STEP_GAIN / sum(n_eff)``, at most ``FIT_FTOL_MAX`` (1e-4 on the first 10 s of the UTFSM
+    1 A chirp, n_eff 2,566 through the 0 A rig).  Before stop 47 it was 1e-8 whatever the record, and a fit went
+    on to its evaluation budget on steps that no decision could see (docs/benchmarks.md, "Stop 47")."""
+    parts = np.split(np.asarray(r, float), np.cumsum(lengths)[:-1])
+    n = sum(max(1.0, ar1_effective_n(x.size, ar1_coefficient(x))) for x in parts if x.size > 2)
+    return float(min(FIT_FTOL_MAX, FIT_STEP_GAIN / max(n, 1.0)))
 
 
 #: where a fit goes on when its fixed step's result no longer agrees with the search's pair (``fit``): "pair"

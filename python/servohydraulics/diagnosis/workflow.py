@@ -13,6 +13,7 @@ import dataclasses
 import sys
 import time
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -258,19 +259,28 @@ def _diagnose(records, rig: Rig, mode: str, progress: bool, keep: int, max_effec
     sims0 = engine.simulate_all(current, setup.cases, 0.0, x0)
     if any(s is None for s in sims0):
         raise ValueError("the nominal rig's simulation fails on this record: check the rig and --mode")
-    checks += _nominal_run_checks(current, setup.cases, x0, accept)
-    setup = dataclasses.replace(setup, bar=_progress(max_effects * (len(setup.names) + keep), progress, "diagnose"))
-    state = _State(rig=current, tau=0.0, x0=x0, sims=sims0, history=[("nominal", engine.gap(sims0, setup.cases))])
-    last = None
-    for rnd in range(1, max_effects + 1):
-        outcome = _round(setup, state, rnd)
-        state.log.extend(outcome.log)
-        if outcome.outcome != "accept":
-            last = outcome
-            break
-        _accept(setup, state, outcome)
-    if setup.joint_refit and state.accepted:
-        _restore(setup, state, max(e["round"] for e in state.effects))
+    # the nominal run as compare makes it (the core's defaults, its check of a run that turned stiff included:
+    # 6 s of one core on the 52 s UTFSM sweep) reads nothing the rounds make: it runs beside them
+    pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="diagnose-nominal-checks")
+    nominal_checks = pool.submit(_nominal_run_checks, copy.copy(current), setup.cases, x0, accept)
+    try:
+        setup = dataclasses.replace(setup, bar=_progress(max_effects * (len(setup.names) + keep), progress,
+                                                         "diagnose"))
+        state = _State(rig=current, tau=0.0, x0=x0, sims=sims0,
+                       history=[("nominal", engine.gap(sims0, setup.cases))])
+        last = None
+        for rnd in range(1, max_effects + 1):
+            outcome = _round(setup, state, rnd)
+            state.log.extend(outcome.log)
+            if outcome.outcome != "accept":
+                last = outcome
+                break
+            _accept(setup, state, outcome)
+        if setup.joint_refit and state.accepted:
+            _restore(setup, state, max(e["round"] for e in state.effects))
+        checks += nominal_checks.result()
+    finally:
+        pool.shutdown(wait=False, cancel_futures=True)
     setup.bar.close()
     d = _result(setup, state, sims0, last, time.time() - t_start)
     d.checks, d.dt = checks, dt
