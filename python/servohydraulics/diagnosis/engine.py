@@ -164,13 +164,14 @@ STIFF_STEPS: int | None = 100
 #: close to the decisions' rtol-1e-8 run (docs/benchmarks.md, stop 46).  False: CVODE; with
 #: ``SEARCH_ROS2_SUBSTEPS = (8, 16)`` the search of stop 45 (benchmarks/lab_speed.py --search-stiff cvode).
 SEARCH_STIFF_ROSENBROCK = True
-#: the decisions' runs likewise, at their rtol of 1e-8 (where the Rosenbrock run costs half CVODE's on the stiff
-#: friction rigs and stays within 1.3e-6 of the force's standard deviation of it: docs/benchmarks.md, stop 46).
+#: the decisions' runs likewise, at their rtol of 1e-8: by RODAS4 (``ROSENBROCK_ORDER``) such a run is 2-10 times
+#: closer to CVODE at rtol 1e-10 than the pair with CVODE for its stiff samples (docs/benchmarks.md, stop 47;
+#: no faster on benchmarks/lab_speed.py's cases, whose decisions are few and mostly not stiff).
 #: False: CVODE, the decisions of stop 46 (benchmarks/lab_speed.py --decision-stiff cvode)
 DECISION_STIFF_ROSENBROCK = True
 #: the order of that Rosenbrock method (SolverOptions.rosenbrock_order): 4, RODAS4, which on the stiff friction
 #: rigs takes fewer steps than the second-order formula at the search's and the decisions' tolerances, each run
-#: cheaper and closer to a tight reference (docs/benchmarks.md, stop 47; studies/pair_stiff_rosenbrock.py).
+#: cheaper and closer to a tight reference (docs/benchmarks.md, stop 47; studies/pair_stiff_rodas4.py).
 #: 2: stop 46's formula (benchmarks/lab_speed.py --rosenbrock-order 2)
 ROSENBROCK_ORDER = 4
 #: the pair's runs find a stiff sample by Hairer's stiffness test as well as by ``STIFF_STEPS``

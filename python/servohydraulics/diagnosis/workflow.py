@@ -262,7 +262,7 @@ def _diagnose(records, rig: Rig, mode: str, progress: bool, keep: int, max_effec
     # the nominal run as compare makes it (the core's defaults, its check of a run that turned stiff included:
     # 6 s of one core on the 52 s UTFSM sweep) reads nothing the rounds make: it runs beside them
     pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="diagnose-nominal-checks")
-    nominal_checks = pool.submit(_nominal_run_checks, copy.copy(current), setup.cases, x0, accept)
+    nominal_checks = pool.submit(_nominal_run_checks, copy.deepcopy(current), setup.cases, x0, accept)
     try:
         setup = dataclasses.replace(setup, bar=_progress(max_effects * (len(setup.names) + keep), progress,
                                                          "diagnose"))
