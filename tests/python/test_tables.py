@@ -57,7 +57,8 @@ def test_solver_option_fields_drive_the_binding_and_solver_options():
     changed = sh.solver_options(method="cvode", restart="never", rtol=1e-6, atol_fraction=0.1, max_order=3,
                                 max_steps_per_sample=500, max_internal_step=1e-4, stiff_steps=10,
                                 stiff_fallback=False, stiff_check=False, rk4_substeps=4, rk4_h_rho=0.5, rk4_v_ref=0.2,
-                                rk4_flag_rtol=1e-4, rk4_max_refinements=2, ros2_substeps=8, stiff_rosenbrock=True)
+                                rk4_flag_rtol=1e-4, rk4_max_refinements=2, ros2_substeps=8, stiff_rosenbrock=True,
+                                rosenbrock_order=4, stiffness_test=True)
     assert all(getattr(changed, f) != getattr(o, f) for f in fields), changed
 
 
