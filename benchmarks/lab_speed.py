@@ -4,7 +4,7 @@
                                    [--profile] [--label NAME] [--v-stick V] [--continuation pair|search]
                                    [--stiff-steps N] [--search-stiff rosenbrock|cvode] [--ros2-rungs N,N]
                                    [--decision-stiff rosenbrock|cvode] [--stiffness-test on|off]
-                                   [--rosenbrock-order 2|4] [--fit-ftol-max F]
+                                   [--rosenbrock-order 2|4] [--fit-ftol-max F] [--fit-step-gain G]
     python benchmarks/lab_speed.py --table benchmarks/lab_speed.json
 
 The cases (records from ../shared/real-data/utfsm-mts-mrdamper, or $SH_SHARED_DIR/real-data/...):
@@ -298,6 +298,9 @@ def main() -> None:
                    help="the order of the Rosenbrock method of the diagnosis pair's stiff samples "
                         "(diagnosis.engine.ROSENBROCK_ORDER; default: the package's, 4 (RODAS4) since stop 47; "
                         "2 before)")
+    p.add_argument("--fit-step-gain", type=float, default=None, metavar="G",
+                   help="a diagnosis fit stops where a step gains less than G of -2 log L "
+                        "(diagnosis.engine.FIT_STEP_GAIN; default: the package's, 0.01 since stop 47)")
     p.add_argument("--fit-ftol-max", type=float, default=None, metavar="F",
                    help="the diagnosis fits' relative stopping tolerance at most (diagnosis.engine.FIT_FTOL_MAX; "
                         "default: the package's, 1e-4 since stop 47; 1e-8, the fixed tolerance before)")
@@ -329,6 +332,10 @@ def main() -> None:
         from servohydraulics.diagnosis import engine
 
         engine.ROSENBROCK_ORDER = a.rosenbrock_order
+    if a.fit_step_gain is not None:
+        from servohydraulics.diagnosis import engine
+
+        engine.FIT_STEP_GAIN = a.fit_step_gain
     if a.decision_stiff is not None or a.stiffness_test is not None or a.fit_ftol_max is not None:
         from servohydraulics.diagnosis import engine
 
@@ -361,6 +368,7 @@ def main() -> None:
     out["decision_stiff"] = "rosenbrock" if _engine.DECISION_STIFF_ROSENBROCK else "cvode"
     out["stiffness_test"] = bool(_engine.STIFFNESS_TEST)
     out["fit_ftol_max"] = _engine.FIT_FTOL_MAX
+    out["fit_step_gain"] = _engine.FIT_STEP_GAIN  # rows before stop 47 lack it: the fixed ftol 1e-8 then
     out["rosenbrock_order"] = _engine.ROSENBROCK_ORDER  # 2 before stop 47
     counter = Counters()
     for case in cases:

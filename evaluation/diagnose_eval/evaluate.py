@@ -30,14 +30,16 @@ TARGETS = {"recall_single": 0.90, "false_positive": 0.05, "param_error": 0.20, "
 
 
 def run_one(args: tuple) -> dict:
-    """One diagnosis: (id, record, rig, mode[, stiff_steps]): the last sets ``diagnosis.engine.STIFF_STEPS``
-    (None: the package's default) in the worker."""
+    """One diagnosis: (id, record, rig, mode[, stiff_steps[, fit_step_gain]]): the last two set
+    ``diagnosis.engine.STIFF_STEPS`` and ``FIT_STEP_GAIN`` (None: the package's default) in the worker."""
     rid, record, rig_path, mode = args[:4]
     import servohydraulics as sh
     from servohydraulics.diagnosis import engine
 
     if len(args) > 4 and args[4] is not None:
         engine.STIFF_STEPS = args[4]
+    if len(args) > 5 and args[5] is not None:
+        engine.FIT_STEP_GAIN = args[5]
 
     t0 = time.time()
     d = sh.diagnose([record], sh.load_rig(rig_path), mode=mode, progress=False)
@@ -468,6 +470,9 @@ def main() -> None:
     p.add_argument("--stiff-steps", type=int, default=None, metavar="N",
                    help="the diagnosis' error-controlled pair hands a sample to its stiff integrator past N "
                         "dopri5 steps (diagnosis.engine.STIFF_STEPS; default: the package's, 100)")
+    p.add_argument("--fit-step-gain", type=float, default=None, metavar="G",
+                   help="a diagnosis fit stops where a step gains less than G of -2 log L "
+                        "(diagnosis.engine.FIT_STEP_GAIN; default: the package's, 0.01)")
     p.add_argument("--cached-only", action="store_true",
                    help="report only the records already in --cache (a run cut short; the doc says how many)")
     a = p.parse_args()
@@ -507,8 +512,8 @@ def main() -> None:
                 done[r["id"]] = r
     if a.cached_only:
         manifest = [m for m in manifest if m["id"] in done]
-    jobs = [(m["id"], str(data / m["record"]), str(data / m["rig"]), m["mode"], a.stiff_steps) for m in manifest
-            if m["id"] not in done]
+    jobs = [(m["id"], str(data / m["record"]), str(data / m["rig"]), m["mode"], a.stiff_steps, a.fit_step_gain)
+            for m in manifest if m["id"] not in done]
     t0 = time.time()
     from tqdm import tqdm
 
@@ -531,6 +536,7 @@ def main() -> None:
            + (f" --only '{a.only}'" if a.only else "") + (f" --ids {a.ids}" if a.ids else "")
            + (f" --doc {a.doc}" if a.only or a.ids or a.doc != "docs/diagnose_eval.md" else "")
            + (f" --stiff-steps {a.stiff_steps}" if a.stiff_steps is not None else "")
+           + (f" --fit-step-gain {a.fit_step_gain:g}" if a.fit_step_gain is not None else "")
            + (f" --cache {a.cache} --cached-only: {len(manifest)} records of the set" if a.cached_only else ""))
     write_doc(m, results, key, doc, cmd, wall, a.jobs, before)
     doc.with_suffix(".json").write_text(json.dumps({"metrics": m, "records": results, "command": cmd,
