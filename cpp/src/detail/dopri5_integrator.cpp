@@ -181,6 +181,44 @@ typename BasicDopri5Integrator<System>::Outcome BasicDopri5Integrator<System>::e
   return Outcome::Done;
 }
 
+// The error-controlled Rosenbrock methods' step control (rosenbrock_sample, rodas4_sample): the one-step
+// method's step is carried from sample to sample, with no restart from order 1.
+template <class System>
+template <class Step, class Factor>
+Status BasicDopri5Integrator<System>::rosenbrock_steps(State& y, double& t, double t_next, Step&& step,
+                                                       Factor&& factor) noexcept {
+  Status st;
+  st.stiff = true;
+  ++stiff_samples_;
+  fsal_ = false;
+  h_ = dt_;
+  State yn{};
+  long attempts = 0;
+  at_size(n_, [&](auto size) {
+    const int m = size;
+    while (t < t_next) {
+      const double remaining = t_next - t;
+      const double n_left = std::ceil(remaining / std::min(h_rosenbrock_, remaining) * (1.0 - 1e-12));
+      const double h = remaining / std::max(1.0, n_left);
+      if (++attempts > kRosenbrockAttempts || h < 1e-14 * dt_) {
+        st.code = Status::TooMuchWork;
+        return;
+      }
+      const double err = step(size, h, yn, st);
+      if (!(err <= 1.0)) {  // rejected (NaN: a stage blew up)
+        h_rosenbrock_ = h * (std::isfinite(err) ? std::max(kShrink, kSafety * factor(err)) : kShrink);
+        continue;
+      }
+      for (int i = 0; i < m; ++i) y[i] = yn[i];
+      t = n_left <= 1.0 ? t_next : t + h;
+      ++st.internal_steps;
+      const double grow = err > 0.0 ? std::min(kGrow, std::max(kShrink, kSafety * factor(err))) : kGrow;
+      h_rosenbrock_ = std::min(dt_, h * grow);
+    }
+  });
+  return st;
+}
+
 // The stiff sample by Shampine and Reichelt's (1997, SIAM J. Sci. Comput. 18(1), "The MATLAB ODE
 // suite", section 3) second-order Rosenbrock formula, L-stable, with its third-order error estimate,
 // d = 1 / (2 + sqrt 2), W = I - h d J (the autonomous form: the input is held in a sample):
@@ -193,61 +231,37 @@ Status BasicDopri5Integrator<System>::rosenbrock_sample(const System& sys, const
                                                         double t_next) noexcept {
   constexpr double kD = 0.29289321881345248;    // 1 / (2 + sqrt 2)
   constexpr double kE32 = 7.4142135623730951;   // 6 + sqrt 2
-  Status st;
-  st.stiff = true;
-  ++stiff_samples_;
-  fsal_ = false;
-  h_ = dt_;
-  State f0{}, f1{}, f2{}, k1{}, k2{}, k3{}, yn{};
+  State f0{}, f1{}, f2{}, k1{}, k2{}, k3{};
   double* W = W_.data();
-  long attempts = 0;
-  at_size(n_, [&](auto size) {
+  const auto step = [&](auto size, double h, State& yn, Status& st) {
     const int m = size;
-    while (t < t_next) {
-      const double remaining = t_next - t;
-      const double n_left = std::ceil(remaining / std::min(h_rosenbrock_, remaining) * (1.0 - 1e-12));
-      const double h = remaining / std::max(1.0, n_left);
-      if (++attempts > kRosenbrockAttempts || h < 1e-14 * dt_) {
-        st.code = Status::TooMuchWork;
-        return;
-      }
-      Sys::jacobian_rhs(sys, y.data(), in, W, f0.data());
-      for (int i = 0; i < m * m; ++i) W[i] *= -kD * h;
-      for (int i = 0; i < m; ++i) W[i + i * m] += 1.0;
-      lu_factor(W, size, piv_.data());
-      for (int i = 0; i < m; ++i) k1[i] = f0[i];
-      lu_solve(W, size, piv_.data(), k1.data());
-      for (int i = 0; i < m; ++i) yn[i] = y[i] + 0.5 * h * k1[i];
-      Sys::rhs(sys, yn.data(), in, f1.data());
-      for (int i = 0; i < m; ++i) k2[i] = f1[i] - k1[i];
-      lu_solve(W, size, piv_.data(), k2.data());
-      for (int i = 0; i < m; ++i) {
-        k2[i] += k1[i];
-        yn[i] = y[i] + h * k2[i];
-      }
-      Sys::rhs(sys, yn.data(), in, f2.data());
-      for (int i = 0; i < m; ++i) k3[i] = f2[i] - kE32 * (k2[i] - f1[i]) - 2.0 * (k1[i] - f0[i]);
-      lu_solve(W, size, piv_.data(), k3.data());
-      st.rhs_evals += 3;
-      double sum = 0.0;
-      for (int i = 0; i < m; ++i) {
-        const double e = h / 6.0 * (k1[i] - 2.0 * k2[i] + k3[i]);
-        const double sc = atol_[i] + rtol_ * std::max(std::fabs(y[i]), std::fabs(yn[i]));
-        sum += (e / sc) * (e / sc);
-      }
-      const double err = std::sqrt(sum / m);
-      if (!(err <= 1.0)) {  // rejected (NaN: a stage blew up)
-        h_rosenbrock_ = h * (std::isfinite(err) ? std::max(kShrink, kSafety * std::cbrt(1.0 / err)) : kShrink);
-        continue;
-      }
-      for (int i = 0; i < m; ++i) y[i] = yn[i];
-      t = n_left <= 1.0 ? t_next : t + h;
-      ++st.internal_steps;
-      const double grow = err > 0.0 ? std::min(kGrow, std::max(kShrink, kSafety * std::cbrt(1.0 / err))) : kGrow;
-      h_rosenbrock_ = std::min(dt_, h * grow);
+    Sys::jacobian_rhs(sys, y.data(), in, W, f0.data());
+    for (int i = 0; i < m * m; ++i) W[i] *= -kD * h;
+    for (int i = 0; i < m; ++i) W[i + i * m] += 1.0;
+    lu_factor(W, size, piv_.data());
+    for (int i = 0; i < m; ++i) k1[i] = f0[i];
+    lu_solve(W, size, piv_.data(), k1.data());
+    for (int i = 0; i < m; ++i) yn[i] = y[i] + 0.5 * h * k1[i];
+    Sys::rhs(sys, yn.data(), in, f1.data());
+    for (int i = 0; i < m; ++i) k2[i] = f1[i] - k1[i];
+    lu_solve(W, size, piv_.data(), k2.data());
+    for (int i = 0; i < m; ++i) {
+      k2[i] += k1[i];
+      yn[i] = y[i] + h * k2[i];
     }
-  });
-  return st;
+    Sys::rhs(sys, yn.data(), in, f2.data());
+    for (int i = 0; i < m; ++i) k3[i] = f2[i] - kE32 * (k2[i] - f1[i]) - 2.0 * (k1[i] - f0[i]);
+    lu_solve(W, size, piv_.data(), k3.data());
+    st.rhs_evals += 3;
+    double sum = 0.0;
+    for (int i = 0; i < m; ++i) {
+      const double e = h / 6.0 * (k1[i] - 2.0 * k2[i] + k3[i]);
+      const double sc = atol_[i] + rtol_ * std::max(std::fabs(y[i]), std::fabs(yn[i]));
+      sum += (e / sc) * (e / sc);
+    }
+    return std::sqrt(sum / m);
+  };
+  return rosenbrock_steps(y, t, t_next, step, [](double err) { return std::cbrt(1.0 / err); });
 }
 
 // The stiff sample by RODAS4 (Hairer & Wanner 1996, Solving Ordinary Differential Equations II, sec. VI.4, the
@@ -269,73 +283,49 @@ Status BasicDopri5Integrator<System>::rodas4_sample(const System& sys, const Inp
                    c52 = -10.24680431464352, c53 = -33.99990352819905, c54 = 11.70890893206160,
                    c61 = 8.083246795921522, c62 = -7.981132988064893, c63 = -31.52159432874371,
                    c64 = 16.31930543123136, c65 = -6.058818238834054;
-  Status st;
-  st.stiff = true;
-  ++stiff_samples_;
-  fsal_ = false;
-  h_ = dt_;
-  State f{}, u1{}, u2{}, u3{}, u4{}, u5{}, u6{}, yn{};
+  State f{}, u1{}, u2{}, u3{}, u4{}, u5{}, u6{};
   double* W = W_.data();
-  long attempts = 0;
-  at_size(n_, [&](auto size) {
+  const auto step = [&](auto size, double h, State& yn, Status& st) {
     const int m = size;
-    while (t < t_next) {
-      const double remaining = t_next - t;
-      const double n_left = std::ceil(remaining / std::min(h_rosenbrock_, remaining) * (1.0 - 1e-12));
-      const double h = remaining / std::max(1.0, n_left);
-      if (++attempts > kRosenbrockAttempts || h < 1e-14 * dt_) {
-        st.code = Status::TooMuchWork;
-        return;
-      }
-      // E = I / (gamma h) - J: built as -(J) then the diagonal
-      Sys::jacobian_rhs(sys, y.data(), in, W, f.data());
-      for (int i = 0; i < m * m; ++i) W[i] = -W[i];
-      for (int i = 0; i < m; ++i) W[i + i * m] += 1.0 / (kGamma * h);
-      lu_factor(W, size, piv_.data());
-      const double ih = 1.0 / h;
-      for (int i = 0; i < m; ++i) u1[i] = f[i];
-      lu_solve(W, size, piv_.data(), u1.data());
-      for (int i = 0; i < m; ++i) yn[i] = y[i] + a21 * u1[i];
-      Sys::rhs(sys, yn.data(), in, f.data());
-      for (int i = 0; i < m; ++i) u2[i] = f[i] + ih * c21 * u1[i];
-      lu_solve(W, size, piv_.data(), u2.data());
-      for (int i = 0; i < m; ++i) yn[i] = y[i] + a31 * u1[i] + a32 * u2[i];
-      Sys::rhs(sys, yn.data(), in, f.data());
-      for (int i = 0; i < m; ++i) u3[i] = f[i] + ih * (c31 * u1[i] + c32 * u2[i]);
-      lu_solve(W, size, piv_.data(), u3.data());
-      for (int i = 0; i < m; ++i) yn[i] = y[i] + a41 * u1[i] + a42 * u2[i] + a43 * u3[i];
-      Sys::rhs(sys, yn.data(), in, f.data());
-      for (int i = 0; i < m; ++i) u4[i] = f[i] + ih * (c41 * u1[i] + c42 * u2[i] + c43 * u3[i]);
-      lu_solve(W, size, piv_.data(), u4.data());
-      for (int i = 0; i < m; ++i) yn[i] = y[i] + a51 * u1[i] + a52 * u2[i] + a53 * u3[i] + a54 * u4[i];
-      Sys::rhs(sys, yn.data(), in, f.data());
-      for (int i = 0; i < m; ++i) u5[i] = f[i] + ih * (c51 * u1[i] + c52 * u2[i] + c53 * u3[i] + c54 * u4[i]);
-      lu_solve(W, size, piv_.data(), u5.data());
-      for (int i = 0; i < m; ++i) yn[i] += u5[i];  // the embedded solution
-      Sys::rhs(sys, yn.data(), in, f.data());
-      for (int i = 0; i < m; ++i)
-        u6[i] = f[i] + ih * (c61 * u1[i] + c62 * u2[i] + c63 * u3[i] + c64 * u4[i] + c65 * u5[i]);
-      lu_solve(W, size, piv_.data(), u6.data());
-      st.rhs_evals += 6;
-      double sum = 0.0;
-      for (int i = 0; i < m; ++i) {
-        yn[i] += u6[i];
-        const double sc = atol_[i] + rtol_ * std::max(std::fabs(y[i]), std::fabs(yn[i]));
-        sum += (u6[i] / sc) * (u6[i] / sc);
-      }
-      const double err = std::sqrt(sum / m);
-      if (!(err <= 1.0)) {  // rejected (NaN: a stage blew up)
-        h_rosenbrock_ = h * (std::isfinite(err) ? std::max(kShrink, kSafety * std::pow(err, -0.25)) : kShrink);
-        continue;
-      }
-      for (int i = 0; i < m; ++i) y[i] = yn[i];
-      t = n_left <= 1.0 ? t_next : t + h;
-      ++st.internal_steps;
-      const double grow = err > 0.0 ? std::min(kGrow, std::max(kShrink, kSafety * std::pow(err, -0.25))) : kGrow;
-      h_rosenbrock_ = std::min(dt_, h * grow);
+    // E = I / (gamma h) - J: built as -(J) then the diagonal
+    Sys::jacobian_rhs(sys, y.data(), in, W, f.data());
+    for (int i = 0; i < m * m; ++i) W[i] = -W[i];
+    for (int i = 0; i < m; ++i) W[i + i * m] += 1.0 / (kGamma * h);
+    lu_factor(W, size, piv_.data());
+    const double ih = 1.0 / h;
+    for (int i = 0; i < m; ++i) u1[i] = f[i];
+    lu_solve(W, size, piv_.data(), u1.data());
+    for (int i = 0; i < m; ++i) yn[i] = y[i] + a21 * u1[i];
+    Sys::rhs(sys, yn.data(), in, f.data());
+    for (int i = 0; i < m; ++i) u2[i] = f[i] + ih * c21 * u1[i];
+    lu_solve(W, size, piv_.data(), u2.data());
+    for (int i = 0; i < m; ++i) yn[i] = y[i] + a31 * u1[i] + a32 * u2[i];
+    Sys::rhs(sys, yn.data(), in, f.data());
+    for (int i = 0; i < m; ++i) u3[i] = f[i] + ih * (c31 * u1[i] + c32 * u2[i]);
+    lu_solve(W, size, piv_.data(), u3.data());
+    for (int i = 0; i < m; ++i) yn[i] = y[i] + a41 * u1[i] + a42 * u2[i] + a43 * u3[i];
+    Sys::rhs(sys, yn.data(), in, f.data());
+    for (int i = 0; i < m; ++i) u4[i] = f[i] + ih * (c41 * u1[i] + c42 * u2[i] + c43 * u3[i]);
+    lu_solve(W, size, piv_.data(), u4.data());
+    for (int i = 0; i < m; ++i) yn[i] = y[i] + a51 * u1[i] + a52 * u2[i] + a53 * u3[i] + a54 * u4[i];
+    Sys::rhs(sys, yn.data(), in, f.data());
+    for (int i = 0; i < m; ++i) u5[i] = f[i] + ih * (c51 * u1[i] + c52 * u2[i] + c53 * u3[i] + c54 * u4[i]);
+    lu_solve(W, size, piv_.data(), u5.data());
+    for (int i = 0; i < m; ++i) yn[i] += u5[i];  // the embedded solution
+    Sys::rhs(sys, yn.data(), in, f.data());
+    for (int i = 0; i < m; ++i)
+      u6[i] = f[i] + ih * (c61 * u1[i] + c62 * u2[i] + c63 * u3[i] + c64 * u4[i] + c65 * u5[i]);
+    lu_solve(W, size, piv_.data(), u6.data());
+    st.rhs_evals += 6;
+    double sum = 0.0;
+    for (int i = 0; i < m; ++i) {
+      yn[i] += u6[i];
+      const double sc = atol_[i] + rtol_ * std::max(std::fabs(y[i]), std::fabs(yn[i]));
+      sum += (u6[i] / sc) * (u6[i] / sc);
     }
-  });
-  return st;
+    return std::sqrt(sum / m);
+  };
+  return rosenbrock_steps(y, t, t_next, step, [](double err) { return std::pow(err, -0.25); });
 }
 
 template <class System>

@@ -93,6 +93,11 @@ class BasicDopri5Integrator {
   Status rosenbrock_sample(const System& sys, const Input& in, State& y, double& t, double t_next) noexcept;
   //! The same by RODAS4 (options.rosenbrock_order 4).
   Status rodas4_sample(const System& sys, const Input& in, State& y, double& t, double t_next) noexcept;
+  //! The step control both share: equal steps to the sample's end from the proposed h_rosenbrock_, at most
+  //! kRosenbrockAttempts; step(size, h, yn, st) makes one trial step from y into yn and returns its weighted
+  //! error norm, factor(err) is err^(-1 / (order + 1)).
+  template <class Step, class Factor>
+  Status rosenbrock_steps(State& y, double& t, double t_next, Step&& step, Factor&& factor) noexcept;
   //! Advances the shadow over the sample just done, from t_start to t_next (starting it at y_start
   //! if it is not following the run yet), compares it with the result y and flags st.
   void verify(const System& sys, const Input& in, const State& y_start, double t_start, const State& y,
