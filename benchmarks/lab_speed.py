@@ -309,42 +309,22 @@ def main() -> None:
         print(table(Path(a.table)))
         return
     import servohydraulics as sh
+    from servohydraulics.diagnosis import engine
 
-    if a.continuation is not None:
-        from servohydraulics.diagnosis import engine
-
-        engine.FIT_CONTINUATION = a.continuation
-    if a.stiff_steps is not None:
-        from servohydraulics.diagnosis import engine
-
-        engine.STIFF_STEPS = a.stiff_steps
-    if a.search_stiff is not None:
-        from servohydraulics.diagnosis import engine
-
-        engine.SEARCH_STIFF_ROSENBROCK = a.search_stiff == "rosenbrock"
-        if a.search_stiff == "cvode":
-            engine.SEARCH_ROS2_SUBSTEPS = (8, 16)  # stop 45's search
+    # each flag sets one module switch of the diagnosis for this process (None: the package's default)
+    switches = {"FIT_CONTINUATION": a.continuation, "STIFF_STEPS": a.stiff_steps,
+                "ROSENBROCK_ORDER": a.rosenbrock_order, "FIT_STEP_GAIN": a.fit_step_gain,
+                "FIT_FTOL_MAX": a.fit_ftol_max,
+                "SEARCH_STIFF_ROSENBROCK": None if a.search_stiff is None else a.search_stiff == "rosenbrock",
+                "DECISION_STIFF_ROSENBROCK": None if a.decision_stiff is None else a.decision_stiff == "rosenbrock",
+                "STIFFNESS_TEST": None if a.stiffness_test is None else a.stiffness_test == "on"}
+    if a.search_stiff == "cvode":
+        switches["SEARCH_ROS2_SUBSTEPS"] = (8, 16)  # stop 45's search
     if a.ros2_rungs is not None:
-        from servohydraulics.diagnosis import engine
-
-        engine.SEARCH_ROS2_SUBSTEPS = tuple(int(v) for v in a.ros2_rungs.split(",") if v.strip())
-    if a.rosenbrock_order is not None:
-        from servohydraulics.diagnosis import engine
-
-        engine.ROSENBROCK_ORDER = a.rosenbrock_order
-    if a.fit_step_gain is not None:
-        from servohydraulics.diagnosis import engine
-
-        engine.FIT_STEP_GAIN = a.fit_step_gain
-    if a.decision_stiff is not None or a.stiffness_test is not None or a.fit_ftol_max is not None:
-        from servohydraulics.diagnosis import engine
-
-        if a.decision_stiff is not None:
-            engine.DECISION_STIFF_ROSENBROCK = a.decision_stiff == "rosenbrock"
-        if a.stiffness_test is not None:
-            engine.STIFFNESS_TEST = a.stiffness_test == "on"
-        if a.fit_ftol_max is not None:
-            engine.FIT_FTOL_MAX = a.fit_ftol_max
+        switches["SEARCH_ROS2_SUBSTEPS"] = tuple(int(v) for v in a.ros2_rungs.split(",") if v.strip())
+    for name, value in switches.items():
+        if value is not None:
+            setattr(engine, name, value)
     cases = [c.strip() for c in a.cases.split(",") if c.strip()]
     if a.json and Path(a.json).exists() and a.label in json.loads(Path(a.json).read_text()):
         # the JSON is keyed by label: a second run under one label would replace the first's cases
@@ -359,17 +339,15 @@ def main() -> None:
            "scipy": scipy.__version__, "cpus": os.cpu_count(),
            "command": "python benchmarks/lab_speed.py " + " ".join(sys.argv[1:]), "v_stick": a.v_stick,
            "continuation": a.continuation, "stiff_steps": a.stiff_steps, "cases": {}}
-    from servohydraulics.diagnosis import engine as _engine
-
-    out["stiff_steps_in_effect"] = _engine.STIFF_STEPS  # rows before stop 46 lack it: 24 (the core's) by default
-    out["search_stiff"] = "rosenbrock" if _engine.SEARCH_STIFF_ROSENBROCK else "cvode"  # likewise: cvode before stop 46
-    out["ros2_rungs"] = list(_engine.SEARCH_ROS2_SUBSTEPS)  # likewise: [8, 16] before stop 46
+    out["stiff_steps_in_effect"] = engine.STIFF_STEPS  # rows before stop 46 lack it: 24 (the core's) by default
+    out["search_stiff"] = "rosenbrock" if engine.SEARCH_STIFF_ROSENBROCK else "cvode"  # likewise: cvode before stop 46
+    out["ros2_rungs"] = list(engine.SEARCH_ROS2_SUBSTEPS)  # likewise: [8, 16] before stop 46
     # rows before stop 47 lack these: cvode, off and 1e-8
-    out["decision_stiff"] = "rosenbrock" if _engine.DECISION_STIFF_ROSENBROCK else "cvode"
-    out["stiffness_test"] = bool(_engine.STIFFNESS_TEST)
-    out["fit_ftol_max"] = _engine.FIT_FTOL_MAX
-    out["fit_step_gain"] = _engine.FIT_STEP_GAIN  # rows before stop 47 lack it: the fixed ftol 1e-8 then
-    out["rosenbrock_order"] = _engine.ROSENBROCK_ORDER  # 2 before stop 47
+    out["decision_stiff"] = "rosenbrock" if engine.DECISION_STIFF_ROSENBROCK else "cvode"
+    out["stiffness_test"] = bool(engine.STIFFNESS_TEST)
+    out["fit_ftol_max"] = engine.FIT_FTOL_MAX
+    out["fit_step_gain"] = engine.FIT_STEP_GAIN  # rows before stop 47 lack it: the fixed ftol 1e-8 then
+    out["rosenbrock_order"] = engine.ROSENBROCK_ORDER  # 2 before stop 47
     counter = Counters()
     for case in cases:
         counter.reset()
